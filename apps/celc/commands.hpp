@@ -1,0 +1,14 @@
+#pragma once
+/// \file commands.hpp
+/// One function per subcommand: each adds its CLI11 subcommand to the app and
+/// binds a callback. Subcommands parse options, call the library and write
+/// files; they hold no algorithms.
+#include <CLI/CLI.hpp>
+
+namespace celc::app {
+
+
+/// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
+void configureLogging(bool quiet, bool verbose);
+
+}  // namespace celc::app

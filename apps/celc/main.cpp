@@ -1,0 +1,38 @@
+// celc: event-camera linear velocity from the Continuous Event-Line Constraint.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+
+namespace celc::app {
+void configureLogging(bool quiet, bool verbose) {
+  spdlog::set_level(quiet ? spdlog::level::warn
+                          : (verbose ? spdlog::level::debug : spdlog::level::info));
+}
+}  // namespace celc::app
+
+int main(int argc, char** argv) {
+  auto logger = spdlog::stderr_color_mt("celc");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
+
+  CLI::App app{
+      "celc " CELC_VERSION
+      ": linear velocity of an event camera from the Continuous Event-Line Constraint\n"
+      "(Peng, Xu, Yang, Kneip, BMVC 2021). Units: seconds, pixels, metres, radians."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("celc ") + CELC_VERSION);
+  // Subcommands, in the order `celc --help` lists them.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "celc: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,63 @@
+#pragma once
+/// \file motion_model.hpp
+/// Camera motion over one window, relative to the camera at a reference time
+/// t_ref. For any time t the model gives
+///   R(t) = R_ref_t   (rotation of the camera at t, expressed in the reference camera frame)
+///   p(t) = P(t) v    (position of the camera at t in the reference frame; linear in v)
+/// so that a point X_t in the camera frame at t is R(t) X_t + p(t) in the reference frame.
+///
+/// Two models:
+///  - ConstantTwist (the paper's): constant body twist (v, w);
+///      R(t) = exp(w^ tau),  P(t) = J_l(w tau) tau,  tau = t - t_ref.
+///    v is the body-frame velocity, the same at every time of the window.
+///  - GyroIntegrated: R(t) integrated from a sampled angular-velocity signal
+///    (linear interpolation between samples), velocity constant in the
+///    reference frame: P(t) = tau I. v is the velocity in the reference camera frame.
+/// Both keep every CELC constraint linear in v.
+#include <vector>
+
+#include "celc/types.hpp"
+
+namespace celc {
+
+enum class MotionModelKind { ConstantTwist, GyroIntegrated };
+
+/// Parses "constant_twist" / "gyro_integrated"; throws std::invalid_argument otherwise.
+MotionModelKind parseMotionModelKind(const std::string& name);
+std::string toString(MotionModelKind kind);
+
+class MotionModel {
+ public:
+  /// Constant angular velocity w [rad/s, camera frame] about t_ref [s].
+  static MotionModel constantTwist(const Vec3& omega, double t_ref);
+  /// Angular-velocity samples (times [s], increasing; rates [rad/s] in the camera
+  /// frame), integrated with the trapezoidal rule. Needs at least one sample;
+  /// outside the sampled range the nearest end rate is held.
+  static MotionModel gyroIntegrated(const std::vector<double>& times,
+                                    const std::vector<Vec3>& rates, double t_ref);
+
+  MotionModelKind kind() const { return kind_; }
+  double referenceTime() const { return t_ref_; }
+  /// Mean angular velocity over [t0, t1] [rad/s]: the constant rate, or log(R(t0)^T R(t1)) / (t1 - t0).
+  Vec3 meanOmega(double t0, double t1) const;
+
+  /// R_ref_t.
+  Mat3 rotation(double t) const;
+  /// P(t) with p_ref_t = P(t) v.
+  Mat3 positionMatrix(double t) const;
+
+  /// The same model with a different constant rate (ConstantTwist) or with all
+  /// rate samples shifted by delta (GyroIntegrated): used to perturb the gyroscope.
+  MotionModel withOmegaOffset(const Vec3& delta) const;
+
+ private:
+  MotionModelKind kind_ = MotionModelKind::ConstantTwist;
+  double t_ref_ = 0.0;
+  Vec3 omega_ = Vec3::Zero();
+  // GyroIntegrated: samples and R_ref_ti at each sample time.
+  std::vector<double> times_;
+  std::vector<Vec3> rates_;
+  std::vector<Mat3> rotations_;
+};
+
+}  // namespace celc

@@ -1,0 +1,145 @@
+// Property tests of SO(3), the motion models and the camera model.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "celc/geometry/camera.hpp"
+#include "celc/geometry/motion_model.hpp"
+#include "celc/geometry/so3.hpp"
+
+using namespace celc;
+
+namespace {
+Vec3 randomVec(std::mt19937& rng, double scale) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Vec3(n(rng), n(rng), n(rng)) * scale;
+}
+}  // namespace
+
+TEST(So3, HatIsCrossProduct) {
+  const Vec3 a(1.0, -2.0, 0.5), b(0.3, 0.7, -1.1);
+  EXPECT_LT((so3::hat(a) * b - a.cross(b)).norm(), 1e-15);
+  EXPECT_LT((so3::vee(so3::hat(a)) - a).norm(), 1e-15);
+}
+
+TEST(So3, ExpLogRoundTripAllAngles) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> angle(0.0, M_PI - 1e-6);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 axis = randomVec(rng, 1.0).normalized();
+    // Include tiny angles where the Taylor branch is used.
+    const double th = (i % 4 == 0) ? std::pow(10.0, -1.0 - i % 9) : angle(rng);
+    const Vec3 phi = axis * th;
+    const Mat3 R = so3::exp(phi);
+    EXPECT_LT((R.transpose() * R - Mat3::Identity()).norm(), 1e-14);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-14);
+    EXPECT_LT((so3::log(R) - phi).norm(), 1e-9 * std::max(1.0, th)) << "th=" << th;
+  }
+}
+
+TEST(So3, ExpMatchesEigenAngleAxis) {
+  std::mt19937 rng(2);
+  for (int i = 0; i < 100; ++i) {
+    const Vec3 phi = randomVec(rng, 1.5);
+    const Mat3 ref = Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix();
+    EXPECT_LT((so3::exp(phi) - ref).norm(), 1e-13);
+  }
+}
+
+// J_l(phi) is the derivative of exp at phi: exp(phi + d) ~ exp(J_l(phi) d) exp(phi).
+TEST(So3, LeftJacobianAgainstFiniteDifferences) {
+  std::mt19937 rng(3);
+  const double h = 1e-6;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 phi = randomVec(rng, i % 5 == 0 ? 1e-5 : 1.0);
+    const Mat3 R = so3::exp(phi);
+    Mat3 numeric;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 d = Vec3::Unit(k) * h;
+      const Mat3 Rp = so3::exp(phi + d), Rm = so3::exp(phi - d);
+      numeric.col(k) = (so3::log(Rp * R.transpose()) - so3::log(Rm * R.transpose())) / (2 * h);
+    }
+    EXPECT_LT((numeric - so3::leftJacobian(phi)).norm(), 1e-7);
+    EXPECT_LT((so3::leftJacobian(phi) * so3::leftJacobianInverse(phi) - Mat3::Identity()).norm(),
+              1e-10);
+  }
+}
+
+TEST(So3, SmallAngleSeriesIsContinuous) {
+  const Vec3 axis = Vec3(0.3, -0.5, 0.8).normalized();
+  // Either side of the switch to the Taylor branch (th^2 = 1e-6).
+  for (double th : {0.99e-3, 1.01e-3, 1e-8, 0.0}) {
+    const Vec3 phi = axis * th;
+    const Mat3 W = so3::hat(phi);
+    const Mat3 W2 = W * W;
+    const Mat3 exp_series = Mat3::Identity() + W + 0.5 * W2 + W2 * W / 6.0 + W2 * W2 / 24.0;
+    const Mat3 jl_series = Mat3::Identity() + 0.5 * W + W2 / 6.0 + W2 * W / 24.0;
+    EXPECT_LT((so3::exp(phi) - exp_series).norm(), 1e-13);
+    // Reference series truncated after th^3: next term th^4/120 ~ 1e-14 at th = 1e-3.
+    EXPECT_LT((so3::leftJacobian(phi) - jl_series).norm(), 5e-14);
+  }
+}
+
+// The SE(3) exponential of a constant twist: translation is the integral of R(s) v ds.
+TEST(MotionModel, ConstantTwistTranslationIsIntegralOfRotatedVelocity) {
+  const Vec3 w(0.4, -1.2, 2.0), v(1.0, 2.0, -0.5);
+  const auto model = MotionModel::constantTwist(w, 0.3);
+  const double t = 1.7;
+  const int n = 20000;
+  Vec3 integral = Vec3::Zero();
+  const double ds = (t - 0.3) / n;
+  for (int i = 0; i < n; ++i) integral += so3::exp(w * (ds * (i + 0.5))) * v * ds;
+  EXPECT_LT((model.positionMatrix(t) * v - integral).norm(), 1e-7);
+  EXPECT_LT((model.rotation(0.3) - Mat3::Identity()).norm(), 1e-15);
+}
+
+TEST(MotionModel, GyroIntegratedWithConstantRateMatchesConstantTwist) {
+  const Vec3 w(0.5, -0.3, 1.8);
+  std::vector<double> times;
+  std::vector<Vec3> rates;
+  for (int i = 0; i <= 100; ++i) {
+    times.push_back(0.01 * i);
+    rates.push_back(w);
+  }
+  const auto gyro = MotionModel::gyroIntegrated(times, rates, 0.25);
+  const auto twist = MotionModel::constantTwist(w, 0.25);
+  for (double t : {0.0, 0.123, 0.25, 0.777, 1.0, 1.2}) {
+    EXPECT_LT((gyro.rotation(t) - twist.rotation(t)).norm(), 1e-12) << t;
+  }
+  EXPECT_LT((gyro.meanOmega(0.1, 0.9) - w).norm(), 1e-10);
+  EXPECT_LT((gyro.positionMatrix(0.75) - 0.5 * Mat3::Identity()).norm(), 1e-15);
+}
+
+TEST(MotionModel, GyroIntegratedFollowsVaryingRate) {
+  // w(t) = a + b t about a fixed axis: angle = a t + b t^2 / 2 exactly.
+  const Vec3 axis = Vec3(1.0, 2.0, -1.0).normalized();
+  const double a = 1.0, b = 3.0;
+  std::vector<double> times;
+  std::vector<Vec3> rates;
+  for (int i = 0; i <= 50; ++i) {
+    times.push_back(0.02 * i);
+    rates.push_back(axis * (a + b * times.back()));
+  }
+  const auto gyro = MotionModel::gyroIntegrated(times, rates, 0.0);
+  for (double t : {0.13, 0.5, 0.99}) {
+    const Mat3 expected = so3::exp(axis * (a * t + 0.5 * b * t * t));
+    EXPECT_LT((gyro.rotation(t) - expected).norm(), 1e-12) << t;
+  }
+}
+
+TEST(Camera, DistortUndistortRoundTrip) {
+  CameraModel cam;
+  for (auto model : {DistortionModel::RadTan, DistortionModel::Equidistant}) {
+    cam.distortion = model;
+    cam.coeffs = model == DistortionModel::RadTan
+                     ? std::array<double, 5>{-0.35, 0.15, 1e-3, -5e-4, -0.02}
+                     : std::array<double, 5>{-0.02, 0.01, -0.005, 0.001, 0.0};
+    for (double x = -0.5; x <= 0.5; x += 0.1)
+      for (double y = -0.4; y <= 0.4; y += 0.1) {
+        const Vec2 p(x, y);
+        EXPECT_LT((cam.undistort(cam.distort(p)) - p).norm(), 1e-10) << toString(model);
+      }
+  }
+  EXPECT_EQ(parseDistortionModel("fisheye"), DistortionModel::Equidistant);
+  EXPECT_THROW(parseDistortionModel("banana"), std::invalid_argument);
+}
