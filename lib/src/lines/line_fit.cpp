@@ -1,0 +1,126 @@
+#include "celc/lines/line_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+namespace celc {
+
+std::string LineFitOptions::validate() const {
+  std::ostringstream err;
+  if (!(interval_s > 0.0)) err << "interval_s must be > 0; ";
+  if (!(interval_fraction >= 0.0 && interval_fraction <= 0.5))
+    err << "interval_fraction must be in [0, 0.5]; ";
+  if (min_events < 2) err << "min_events must be >= 2; ";
+  if (!(max_rms_px > 0.0)) err << "max_rms_px must be > 0; ";
+  return err.str();
+}
+
+std::string toString(LineFitStatus status) {
+  switch (status) {
+    case LineFitStatus::Ok: return "ok";
+    case LineFitStatus::TooFewEvents: return "too_few_events";
+    case LineFitStatus::PoorFit: return "poor_fit";
+  }
+  return "unknown";
+}
+
+FittedLine fitLine(const std::vector<Vec3>& bearings, const std::vector<double>& times,
+                   double focal_px) {
+  FittedLine out;
+  out.n_events = static_cast<int>(bearings.size());
+  if (bearings.size() < 2) return out;
+  // Fit in pixel units around the centroid (keeps float precision).
+  Vec2 centroid = Vec2::Zero();
+  for (const auto& b : bearings) centroid += b.head<2>();
+  centroid /= static_cast<double>(bearings.size());
+  std::vector<cv::Point2f> pts;
+  pts.reserve(bearings.size());
+  for (const auto& b : bearings) {
+    const Vec2 p = (b.head<2>() - centroid) * focal_px;
+    pts.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  }
+  cv::Vec4f fit;
+  cv::fitLine(pts, fit, cv::DIST_HUBER, 0.0, 0.01, 0.01);
+  const Vec2 dir(fit[0], fit[1]);
+  const Vec2 p0 = centroid + Vec2(fit[2], fit[3]) / focal_px;
+  // Plane through the centre and the line: n = (p0, 1) x (dir, 0).
+  out.line.normal = Vec3(p0.x(), p0.y(), 1.0).cross(Vec3(dir.x(), dir.y(), 0.0)).normalized();
+  double t_sum = 0.0;
+  for (double t : times) t_sum += t;
+  out.line.t = times.empty() ? 0.0 : t_sum / static_cast<double>(times.size());
+  // Residuals and extent in pixels.
+  const Vec2 nrm(-dir.y(), dir.x());
+  double ss = 0.0, lo = 1e300, hi = -1e300;
+  for (const auto& p : pts) {
+    const Vec2 q = Vec2(p.x, p.y) - Vec2(fit[2], fit[3]);
+    ss += std::pow(nrm.dot(q), 2);
+    lo = std::min(lo, dir.dot(q));
+    hi = std::max(hi, dir.dot(q));
+  }
+  out.rms_px = std::sqrt(ss / static_cast<double>(pts.size()));
+  out.length_px = hi - lo;
+  out.status = LineFitStatus::Ok;
+  return out;
+}
+
+namespace {
+// Fits the events with times in [t0, t1). While the interval holds fewer than
+// min_events it slides toward `centre` by half its length; it stops sliding
+// once it reaches the centre.
+FittedLine fitInterval(const std::vector<double>& times, const std::vector<Vec3>& bearings,
+                       double t0, double t1, double centre, double focal_px,
+                       const LineFitOptions& opt) {
+  const double step = 0.5 * (t1 - t0) * (centre > t0 ? 1.0 : -1.0);
+  for (;;) {
+    const auto b = std::lower_bound(times.begin(), times.end(), t0) - times.begin();
+    const auto e = std::lower_bound(times.begin(), times.end(), t1) - times.begin();
+    const bool reached_centre = t0 <= centre && centre <= t1;
+    if (e - b >= opt.min_events || reached_centre || step == 0.0) {
+      FittedLine f;
+      if (e - b >= opt.min_events) {
+        f = fitLine(std::vector<Vec3>(bearings.begin() + b, bearings.begin() + e),
+                    std::vector<double>(times.begin() + b, times.begin() + e), focal_px);
+        if (f.status == LineFitStatus::Ok && f.rms_px > opt.max_rms_px)
+          f.status = LineFitStatus::PoorFit;
+      } else {
+        f.n_events = static_cast<int>(e - b);
+      }
+      f.t_begin = t0;
+      f.t_end = t1;
+      return f;
+    }
+    t0 += step;
+    t1 += step;
+  }
+}
+}  // namespace
+
+ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector<Vec3>& bearings,
+                             double focal_px, const LineFitOptions& opt) {
+  ClusterLines out;
+  if (times.size() < 2 || times.size() != bearings.size()) return out;
+  const double ts = times.front(), te = times.back(), tm = 0.5 * (ts + te);
+  const double len = opt.interval_fraction > 0.0 ? opt.interval_fraction * (te - ts)
+                                                 : std::min(opt.interval_s, 0.5 * (te - ts));
+  if (!(len > 0.0)) return out;
+  // The last interval is closed at te: nudge its end past the last timestamp.
+  const double te_open = std::nextafter(te, 1e300);
+  out.l1 = fitInterval(times, bearings, ts, ts + len, tm, focal_px, opt);
+  out.l3 = fitInterval(times, bearings, te_open - len, te_open, tm, focal_px, opt);
+  out.l2 = fitInterval(times, bearings, tm - 0.5 * len, tm + 0.5 * len, tm, focal_px, opt);
+  return out;
+}
+
+bool attachFittedLines(ClusterObservation& cluster, double focal_px, const LineFitOptions& options) {
+  const ClusterLines lines = fitClusterLines(cluster.times, cluster.bearings, focal_px, options);
+  if (!lines.ok()) return false;
+  cluster.l1 = lines.l1.line;
+  cluster.l3 = lines.l3.line;
+  cluster.has_l2 = lines.l2.status == LineFitStatus::Ok;
+  if (cluster.has_l2) cluster.l2 = lines.l2.line;
+  return true;
+}
+
+}  // namespace celc
