@@ -1,0 +1,121 @@
+#include "celc/sim/line_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace celc {
+
+std::string LineSceneOptions::validate() const {
+  std::ostringstream e;
+  if (n_lines < 1) e << "n_lines must be >= 1; ";
+  if (events_per_line < 2) e << "events_per_line must be >= 2; ";
+  if (!(duration > 0.0)) e << "duration must be > 0; ";
+  if (!velocity.allFinite() || !omega.allFinite()) e << "velocity and omega must be finite; ";
+  if (!(event_noise_px >= 0.0) || !(line_noise_px >= 0.0) || !(omega_noise >= 0.0))
+    e << "noise levels must be >= 0; ";
+  if (!(outlier_fraction >= 0.0 && outlier_fraction < 1.0)) e << "outlier_fraction must be in [0, 1); ";
+  if (!(x_range[1] >= x_range[0] && y_range[1] >= y_range[0] && z_range[1] >= z_range[0]))
+    e << "ranges must be [min, max]; ";
+  if (!(z_range[0] > 0.0)) e << "z_range must be in front of the camera (> 0); ";
+  if (!(gyro_rate_hz > 0.0)) e << "gyro_rate_hz must be > 0; ";
+  e << camera.validate();
+  return e.str();
+}
+
+namespace {
+Vec3 gaussian3(std::mt19937_64& rng, double sigma) {
+  std::normal_distribution<double> n(0.0, sigma);
+  return {n(rng), n(rng), n(rng)};
+}
+}  // namespace
+
+LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng) {
+  LineSceneTrial trial;
+  std::uniform_real_distribution<double> ux(o.x_range[0], o.x_range[1]),
+      uy(o.y_range[0], o.y_range[1]), uz(o.z_range[0], o.z_range[1]), u01(0.0, 1.0);
+  std::normal_distribution<double> ev_noise(0.0, o.event_noise_px), ln_noise(0.0, o.line_noise_px);
+  const double ts = 0.0, te = o.duration, tm = 0.5 * (ts + te);
+
+  // Motion: the truth and what the gyroscope tells the solvers.
+  const Vec3 gyro_error = gaussian3(rng, o.omega_noise);
+  if (o.motion == MotionModelKind::ConstantTwist) {
+    trial.true_motion = MotionModel::constantTwist(o.omega, ts);
+    trial.given_motion = MotionModel::constantTwist(o.omega + gyro_error, ts);
+  } else {
+    std::vector<double> times;
+    std::vector<Vec3> rates;
+    const int n = std::max(2, static_cast<int>(std::ceil(o.duration * o.gyro_rate_hz)) + 1);
+    for (int i = 0; i < n; ++i) {
+      const double t = ts + o.duration * i / (n - 1);
+      times.push_back(t);
+      rates.push_back(o.omega + o.omega_wobble * std::sin(2.0 * M_PI * t / o.duration));
+    }
+    trial.true_motion = MotionModel::gyroIntegrated(times, rates, ts);
+    trial.given_motion = trial.true_motion.withOmegaOffset(gyro_error);
+  }
+  const double speed = o.velocity.norm();
+  trial.true_direction = speed > 0.0 ? Vec3(o.velocity / speed) : Vec3::Zero();
+
+  const CameraModel& cam = o.camera;
+  auto pixelAt = [&](const Vec3& X, double t) {
+    const Mat3 R = trial.true_motion.rotation(t);
+    const Vec3 p = trial.true_motion.positionMatrix(t) * o.velocity;
+    return cam.project(R.transpose() * (X - p));
+  };
+  auto bearingOf = [&](const Vec2& px) { return cam.bearing(px); };
+  auto noisyLine = [&](const std::array<Vec3, 2>& seg, double t) {
+    const Vec2 a = pixelAt(seg[0], t) + Vec2(ln_noise(rng), ln_noise(rng));
+    const Vec2 b = pixelAt(seg[1], t) + Vec2(ln_noise(rng), ln_noise(rng));
+    return TimedLine{bearingOf(a).cross(bearingOf(b)).normalized(), t};
+  };
+
+  auto& obs = trial.observations;
+  obs.focal_px = cam.focal();
+  obs.clusters.resize(static_cast<size_t>(o.n_lines));
+  for (int i = 0; i < o.n_lines; ++i) {
+    std::array<Vec3, 2> seg{Vec3(ux(rng), uy(rng), uz(rng)), Vec3(ux(rng), uy(rng), uz(rng))};
+    trial.segments.push_back(seg);
+    auto& c = obs.clusters[static_cast<size_t>(i)];
+    c.id = i;
+    c.l1 = noisyLine(seg, ts);
+    c.l2 = noisyLine(seg, tm);
+    c.l3 = noisyLine(seg, te);
+    c.has_l2 = true;
+  }
+  // Events: a random line, a random time, a random point on the segment.
+  const int n_events = o.n_lines * o.events_per_line;
+  struct Raw {
+    double t;
+    Vec2 px;
+    int label;
+  };
+  std::vector<Raw> raw;
+  raw.reserve(static_cast<size_t>(n_events));
+  for (int e = 0; e < n_events; ++e) {
+    const double t = ts + (te - ts) * u01(rng);
+    if (u01(rng) < o.outlier_fraction) {
+      raw.push_back({t, Vec2(cam.width * u01(rng), cam.height * u01(rng)), -1});
+      continue;
+    }
+    const int line = static_cast<int>(u01(rng) * o.n_lines) % o.n_lines;
+    const auto& seg = trial.segments[static_cast<size_t>(line)];
+    const double s = u01(rng);
+    const Vec2 px = pixelAt(seg[0] + s * (seg[1] - seg[0]), t) + Vec2(ev_noise(rng), ev_noise(rng));
+    raw.push_back({t, px, line});
+  }
+  std::sort(raw.begin(), raw.end(), [](const Raw& a, const Raw& b) { return a.t < b.t; });
+  for (const Raw& r : raw) {
+    trial.pixel_events.push_back(
+        Event{r.t, static_cast<float>(r.px.x()), static_cast<float>(r.px.y()), true});
+    trial.labels.push_back(r.label);
+    // Outliers join a random cluster: the solvers must cope with them.
+    const int c = r.label >= 0 ? r.label : static_cast<int>(u01(rng) * o.n_lines) % o.n_lines;
+    auto& cl = obs.clusters[static_cast<size_t>(c)];
+    cl.times.push_back(r.t);
+    cl.bearings.push_back(bearingOf(r.px));
+  }
+  return trial;
+}
+
+}  // namespace celc

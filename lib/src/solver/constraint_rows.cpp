@@ -1,0 +1,210 @@
+#include "constraint_rows.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace celc::detail {
+
+ClusterFrame makeClusterFrame(const ClusterObservation& c, const MotionModel& motion) {
+  ClusterFrame f;
+  f.m1 = motion.rotation(c.l1.t) * c.l1.normal;
+  f.m3 = motion.rotation(c.l3.t) * c.l3.normal;
+  f.Ps = motion.positionMatrix(c.l1.t);
+  f.Pe = motion.positionMatrix(c.l3.t);
+  return f;
+}
+
+Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double t) {
+  const Mat3 Pk = motion.positionMatrix(t);
+  const Vec3 u = (frame.Pe - Pk).transpose() * frame.m3;
+  const Vec3 s = (frame.Ps - Pk).transpose() * frame.m1;
+  return frame.m1 * u.transpose() - frame.m3 * s.transpose();
+}
+
+ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, double t,
+                      const Vec3& f) {
+  const Mat3 Rk = motion.rotation(t);
+  const Mat3 B_ref = transferMatrix(frame, motion, t);
+  ConstraintRow row;
+  row.a = B_ref.transpose() * (Rk * f);
+  row.N.topRows<2>() = Rk.transpose().topRows<2>() * B_ref;
+  row.N.row(2).setZero();
+  return row;
+}
+
+double medianAbs(std::vector<double>& x) {
+  if (x.empty()) return 0.0;
+  for (double& v : x) v = std::abs(v);
+  auto mid = x.begin() + static_cast<long>(x.size() / 2);
+  std::nth_element(x.begin(), mid, x.end());
+  return *mid;
+}
+
+namespace {
+// Robust geometric cost of v: 1.4826 * median |a_i.v / |N_i v||.
+double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::vector<double>& r) {
+  r.resize(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double g = (rows[i].N * v).norm();
+    r[i] = g > 0.0 ? rows[i].a.dot(v) / g : 1e300;
+  }
+  return 1.4826 * medianAbs(r);
+}
+
+// IRLS from a starting direction. Each step solves the generalised
+// eigenproblem (sum w_i a_i a_i^T) v = lambda (sum w_i N_i^T N_i) v with
+// w_i = Huber(r_i / scale) / |N_i v_prev|^2. A plain weighted eigenvector
+// (denominator frozen) walks toward directions where a whole cluster's
+// transferred lines collapse (|N v| -> 0 makes a.v -> 0 too); keeping the
+// weighted normaliser on the right-hand side penalises that collapse, and at a
+// fixed point lambda is the weighted squared geometric residual.
+NullspaceSolution irlsFrom(const std::vector<ConstraintRow>& rows, Vec3 v, int max_iterations,
+                           double huber_k, double tolerance) {
+  NullspaceSolution out;
+  const size_t n = rows.size();
+  std::vector<double> r(n), g(n), absr(n);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> eig;
+  for (int it = 0; it < std::max(1, max_iterations); ++it) {
+    for (size_t i = 0; i < n; ++i) {
+      g[i] = (rows[i].N * v).norm();
+      r[i] = g[i] > 0.0 ? rows[i].a.dot(v) / g[i] : 0.0;
+      absr[i] = r[i];
+    }
+    const double scale = 1.4826 * medianAbs(absr);
+    const double thr = huber_k * std::max(scale, 1e-15);
+    Mat3 Ma = Mat3::Zero(), Mn = Mat3::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      if (!(g[i] > 1e-300)) continue;
+      const double huber = std::abs(r[i]) <= thr ? 1.0 : thr / std::abs(r[i]);
+      const double w = huber / (g[i] * g[i]);
+      Ma.noalias() += w * rows[i].a * rows[i].a.transpose();
+      Mn.noalias() += w * rows[i].N.transpose() * rows[i].N;
+    }
+    eig.compute(Ma, Mn);
+    if (eig.info() != Eigen::Success) return out;
+    Vec3 next = eig.eigenvectors().col(0).normalized();
+    if (next.dot(v) < 0.0) next = -next;
+    // Singular values of the normalised system: sqrt of the generalised
+    // eigenvalues, the weighted RMS geometric residual along each direction.
+    out.sigma_min = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
+    out.sigma_second = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+    out.iterations = it + 1;
+    const double delta = std::acos(std::min(1.0, next.dot(v)));
+    v = next;
+    if (delta < tolerance) break;
+  }
+  out.v = v;
+  out.scale = robustScale(rows, v, absr);
+  out.ok = v.allFinite() && v.norm() > 0.5;
+  return out;
+}
+}  // namespace
+
+std::vector<Vec3> hemisphereDirections(int n) {
+  // Fibonacci lattice on the upper hemisphere (z >= 0): v and -v are one solution.
+  std::vector<Vec3> dirs;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (i + 0.5) / n;  // (0, 1)
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    dirs.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return dirs;
+}
+
+NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
+                                  const NullspaceOptions& opt) {
+  if (rows.size() < 3) return {};
+  std::vector<Vec3> starts;
+  // Start 1: minimise sum (a_i.v)^2 / sum |N_i v|^2, the generalised eigenproblem
+  // (sum a a^T) v = lambda (sum N^T N) v.
+  Mat3 Ma = Mat3::Zero(), Mn = Mat3::Zero();
+  for (const auto& row : rows) {
+    Ma.noalias() += row.a * row.a.transpose();
+    Mn.noalias() += row.N.transpose() * row.N;
+  }
+  Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> gen(Ma, Mn);
+  if (gen.info() == Eigen::Success) starts.push_back(gen.eigenvectors().col(0).normalized());
+  // Further starts: the best directions of a coarse grid over the hemisphere,
+  // scored by the robust geometric cost on a strided subset of rows. The cost
+  // has a local minimum near each cluster's own line direction (there the
+  // transferred lines of that cluster become blends of l1 and l3 and fit its
+  // events well), so a single local start is not enough.
+  if (opt.grid_directions > 0 && opt.grid_starts > 0) {
+    std::vector<ConstraintRow> sub;
+    const size_t stride = std::max<size_t>(1, rows.size() / std::max(1, opt.grid_rows));
+    for (size_t i = 0; i < rows.size(); i += stride) sub.push_back(rows[i]);
+    std::vector<std::pair<double, Vec3>> scored;
+    std::vector<double> r;
+    for (const Vec3& d : hemisphereDirections(opt.grid_directions))
+      scored.emplace_back(robustScale(sub, d, r), d);
+    const size_t keep = std::min(scored.size(), static_cast<size_t>(opt.grid_starts));
+    std::partial_sort(scored.begin(), scored.begin() + static_cast<long>(keep), scored.end(),
+                      [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t i = 0; i < keep; ++i) starts.push_back(scored[i].second);
+  }
+  // Keep the start whose IRLS ends with the lowest robust geometric cost.
+  NullspaceSolution best;
+  for (const Vec3& s : starts) {
+    if (!s.allFinite()) continue;
+    NullspaceSolution sol = irlsFrom(rows, s, opt.max_iterations, opt.huber_k, opt.tolerance);
+    if (sol.ok && (!best.ok || sol.scale < best.scale)) best = sol;
+  }
+  return best;
+}
+
+std::vector<int> usableClusters(const WindowObservations& obs, int min_events) {
+  std::vector<int> idx;
+  for (size_t c = 0; c < obs.clusters.size(); ++c) {
+    const auto& cl = obs.clusters[c];
+    if (static_cast<int>(cl.size()) < min_events || cl.bearings.size() != cl.times.size()) continue;
+    if (!cl.l1.normal.allFinite() || !cl.l3.normal.allFinite()) continue;
+    if (!(cl.l1.normal.norm() > 0.0) || !(cl.l3.normal.norm() > 0.0)) continue;
+    if (!(cl.l3.t > cl.l1.t)) continue;
+    idx.push_back(static_cast<int>(c));
+  }
+  return idx;
+}
+
+ClusterParallax clusterParallax(const ClusterObservation& c, const MotionModel& motion,
+                                double focal_px, int max_events) {
+  ClusterParallax out;
+  const size_t n = c.size();
+  if (n < 8) return out;
+  const size_t stride = std::max<size_t>(1, n / static_cast<size_t>(std::max(1, max_events)));
+  const double t0 = c.times.front(), t1 = c.times.back();
+  const double tm = 0.5 * (t0 + t1), half = std::max(1e-9, 0.5 * (t1 - t0));
+  std::vector<Vec3> f;
+  std::vector<double> tau;
+  for (size_t k = 0; k < n; k += stride) {
+    if (!c.bearings[k].allFinite() || !std::isfinite(c.times[k])) continue;
+    f.push_back((motion.rotation(c.times[k]) * c.bearings[k]).normalized());
+    tau.push_back((c.times[k] - tm) / half);
+  }
+  if (f.size() < 8) return out;
+  // Static line: plane normal n minimising sum (n . f)^2.
+  Mat3 S = Mat3::Zero();
+  Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+  for (size_t k = 0; k < f.size(); ++k) {
+    S.noalias() += f[k] * f[k].transpose();
+    Eigen::Matrix<double, 6, 1> row;
+    row << f[k], tau[k] * f[k];
+    M.noalias() += row * row.transpose();
+  }
+  const Vec3 ns = Eigen::SelfAdjointEigenSolver<Mat3>(S).eigenvectors().col(0);
+  const Eigen::Matrix<double, 6, 1> x =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(M).eigenvectors().col(0);
+  std::vector<double> rs(f.size()), rm(f.size());
+  for (size_t k = 0; k < f.size(); ++k) {
+    rs[k] = ns.dot(f[k]);
+    const Vec3 nk = x.head<3>() + tau[k] * x.tail<3>();
+    const double nn = nk.norm();
+    rm[k] = nn > 0.0 ? nk.dot(f[k]) / nn : 0.0;
+  }
+  out.static_px = 1.4826 * medianAbs(rs) * focal_px;
+  out.moving_px = 1.4826 * medianAbs(rm) * focal_px;
+  return out;
+}
+
+}  // namespace celc::detail

@@ -1,0 +1,75 @@
+#pragma once
+// Internal: the linear constraint rows shared by CELC, CE3LC, the refinement
+// and the sign test. All vectors in the reference frame of the motion model
+// unless said otherwise.
+#include <vector>
+
+#include "celc/geometry/motion_model.hpp"
+#include "celc/solver/observations.hpp"
+
+namespace celc::detail {
+
+/// What a cluster contributes independently of its events: the plane
+/// normals of l1 and l3 in the reference frame and P at their times.
+struct ClusterFrame {
+  Vec3 m1, m3;   // R(t_s) l1, R(t_e) l3
+  Mat3 Ps, Pe;   // P(t_s), P(t_e)
+};
+ClusterFrame makeClusterFrame(const ClusterObservation& c, const MotionModel& motion);
+
+/// One linear constraint a^T v = 0 with its normaliser: the geometric residual
+/// is a^T v / |N v| (N's rows are the components that make the line's norm).
+struct ConstraintRow {
+  Vec3 a;
+  Mat3 N;
+};
+
+/// The CELC row of one event (time t, bearing f = (x, y, 1) in the camera at t):
+///   u = (P_e - P_k)^T m3,  s = (P_s - P_k)^T m1,
+///   B_ref = m1 u^T - m3 s^T,  a = B_ref^T (R_k f),  N = first two rows of R_k^T B_ref, third 0,
+/// so that a^T v / |N v| is the distance of (x, y) to the transferred line in
+/// normalised units.
+ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, double t, const Vec3& f);
+
+/// B_ref at time t (reference frame): l_ref(t) = B_ref v.
+Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double t);
+
+/// Robust homogeneous least squares: minimises sum rho(a_i^T v / |N_i v|) over
+/// unit v by IRLS with Huber weights and a MAD scale, from several starts (the
+/// generalised eigenvector of (sum a a^T, sum N^T N) and the best directions of
+/// a coarse hemisphere grid); the end point with the lowest robust cost wins.
+struct NullspaceOptions {
+  int max_iterations = 30;
+  double huber_k = 1.345;
+  double tolerance = 1e-9;
+  int grid_directions = 0;   // hemisphere grid size (0 = no grid)
+  int grid_starts = 2;       // IRLS runs from the best grid directions
+  int grid_rows = 200;       // rows used to score the grid
+};
+struct NullspaceSolution {
+  Vec3 v = Vec3::Zero();
+  double sigma_min = 0.0, sigma_second = 0.0;  // of the final weighted system
+  double scale = 0.0;                          // 1.4826 * median |r| [normalised units]
+  int iterations = 0;
+  bool ok = false;
+};
+NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
+                                  const NullspaceOptions& options);
+std::vector<Vec3> hemisphereDirections(int n);
+
+/// Usable clusters: enough events, finite data, l3 after l1.
+std::vector<int> usableClusters(const WindowObservations& obs, int min_events);
+
+/// Parallax of one cluster: robust scale of its rotation-compensated events
+/// about one static line, and about a line moving linearly in time [px].
+struct ClusterParallax {
+  double static_px = 0.0;
+  double moving_px = 0.0;
+};
+ClusterParallax clusterParallax(const ClusterObservation& c, const MotionModel& motion,
+                                double focal_px, int max_events);
+
+/// Median of |x| (x is reordered).
+double medianAbs(std::vector<double>& x);
+
+}  // namespace celc::detail

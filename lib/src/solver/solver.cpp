@@ -1,0 +1,377 @@
+// CELC linear, CE3LC, the sign test and the method dispatcher.
+#include "celc/solver/solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "constraint_rows.hpp"
+
+namespace celc {
+
+using detail::ClusterFrame;
+using detail::ConstraintRow;
+
+std::string toString(Method method) {
+  switch (method) {
+    case Method::Celc: return "celc";
+    case Method::CelcOpt: return "celc_opt";
+    case Method::CelcMl: return "celc_ml";
+    case Method::Ce3lc: return "ce3lc";
+  }
+  return "unknown";
+}
+
+const std::vector<Method>& allMethods() {
+  static const std::vector<Method> all{Method::Celc, Method::CelcOpt, Method::CelcMl,
+                                       Method::Ce3lc};
+  return all;
+}
+
+Method parseMethod(const std::string& name) {
+  for (Method m : allMethods())
+    if (toString(m) == name) return m;
+  throw std::invalid_argument("unknown method '" + name +
+                              "' (expected celc, celc_opt, celc_ml or ce3lc)");
+}
+
+std::vector<Method> parseMethodList(const std::string& list) {
+  std::vector<Method> out;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (item.empty()) continue;
+    if (item == "all") return allMethods();
+    const Method m = parseMethod(item);
+    if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+  }
+  if (out.empty()) throw std::invalid_argument("empty method list");
+  return out;
+}
+
+std::string toString(SolveStatus status) {
+  switch (status) {
+    case SolveStatus::Ok: return "ok";
+    case SolveStatus::Degenerate: return "degenerate";
+    case SolveStatus::InvalidInput: return "invalid_input";
+    case SolveStatus::Failed: return "failed";
+  }
+  return "failed";
+}
+
+std::string toString(Degeneracy reason) {
+  switch (reason) {
+    case Degeneracy::None: return "none";
+    case Degeneracy::TooFewClusters: return "too_few_clusters";
+    case Degeneracy::NoParallax: return "no_parallax";
+    case Degeneracy::NullspaceNotUnique: return "nullspace_not_unique";
+  }
+  return "none";
+}
+
+std::string LinearOptions::validate() const {
+  std::ostringstream e;
+  if (max_rows < 0) e << "max_rows must be >= 0; ";
+  if (max_iterations < 1) e << "max_iterations must be >= 1; ";
+  if (!(huber_k > 0.0)) e << "huber_k must be > 0; ";
+  if (!(tolerance > 0.0)) e << "tolerance must be > 0; ";
+  if (grid_directions < 0 || grid_starts < 0 || grid_rows < 1)
+    e << "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";
+  if (min_clusters < 1) e << "min_clusters must be >= 1; ";
+  if (min_cluster_events < 2) e << "min_cluster_events must be >= 2; ";
+  if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
+  if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
+  if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
+  return e.str();
+}
+
+std::string RefineOptions::validate() const {
+  std::ostringstream e;
+  if (!(huber_px > 0.0)) e << "huber_px must be > 0; ";
+  if (max_iterations < 1) e << "max_iterations must be >= 1; ";
+  if (max_events < 0) e << "max_events must be >= 0; ";
+  if (!(function_tolerance > 0.0)) e << "function_tolerance must be > 0; ";
+  if (num_threads < 1) e << "num_threads must be >= 1; ";
+  return e.str();
+}
+
+std::string SolverOptions::validate() const { return linear.validate() + refine.validate(); }
+
+double angleBetween(const Vec3& a, const Vec3& b) {
+  // atan2 form: accurate for small and large angles alike.
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+double angleBetweenSignAgnostic(const Vec3& a, const Vec3& b) {
+  const double phi = angleBetween(a, b);
+  return std::min(phi, M_PI - phi);
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double microsecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+SolverResult fail(SolveStatus status, Degeneracy reason, std::string message) {
+  SolverResult r;
+  r.status = status;
+  r.degeneracy = reason;
+  r.message = std::move(message);
+  return r;
+}
+
+// Checks shared by the linear solvers; returns true (and fills `result`) when
+// the window cannot give a velocity.
+bool checkDegenerate(const WindowObservations& obs, const MotionModel& motion,
+                     const std::vector<int>& usable, const LinearOptions& opt,
+                     SolverResult& result) {
+  if (static_cast<int>(usable.size()) < opt.min_clusters) {
+    result = fail(SolveStatus::Degenerate, Degeneracy::TooFewClusters,
+                  std::to_string(usable.size()) + " usable clusters, need " +
+                      std::to_string(opt.min_clusters));
+    return true;
+  }
+  int with_events = 0, with_parallax = 0;
+  for (int c : usable) {
+    if (obs.clusters[c].size() < 8) continue;
+    ++with_events;
+    const auto p = detail::clusterParallax(obs.clusters[c], motion, obs.focal_px, 300);
+    if (p.static_px >= opt.min_parallax_px &&
+        p.static_px >= opt.min_parallax_ratio * std::max(p.moving_px, 1e-12))
+      ++with_parallax;
+  }
+  if (with_events > 0 && with_parallax < opt.min_clusters) {
+    result = fail(SolveStatus::Degenerate, Degeneracy::NoParallax,
+                  std::to_string(with_parallax) + " clusters show parallax, need " +
+                      std::to_string(opt.min_clusters));
+    return true;
+  }
+  return false;
+}
+
+// Fills the result from a nullspace solution: degeneracy by singular values, sign.
+SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservations& obs,
+                    const MotionModel& motion, const LinearOptions& opt, int rows) {
+  if (!ns.ok) return fail(SolveStatus::Failed, Degeneracy::None, "robust nullspace did not converge");
+  SolverResult r;
+  r.sigma_min = ns.sigma_min;
+  r.sigma_second = ns.sigma_second;
+  r.iterations = ns.iterations;
+  r.rows_used = rows;
+  r.residual_px = ns.scale * obs.focal_px;
+  if (ns.sigma_second <= 0.0 || ns.sigma_min > opt.max_sigma_ratio * ns.sigma_second) {
+    r.status = SolveStatus::Degenerate;
+    r.degeneracy = Degeneracy::NullspaceNotUnique;
+    r.message = "two smallest singular values too close (ratio " +
+                std::to_string(ns.sigma_second > 0 ? ns.sigma_min / ns.sigma_second : 1.0) + ")";
+    return r;
+  }
+  r.v = ns.v.normalized();
+  if (opt.resolve_sign) {
+    const SignDecision s = resolveSign(obs, motion, r.v);
+    r.v *= s.sign;
+    r.sign_margin = s.margin * s.sign;
+  }
+  r.status = SolveStatus::Ok;
+  return r;
+}
+
+// Seeded random subset of k indices out of n (sorted), or all when k >= n or k == 0.
+std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed) {
+  std::vector<size_t> idx;
+  if (k == 0 || k >= n) {
+    idx.resize(n);
+    for (size_t i = 0; i < n; ++i) idx[i] = i;
+    return idx;
+  }
+  // Floyd's algorithm: k draws, no O(n) buffer.
+  std::mt19937_64 rng(seed);
+  std::unordered_set<size_t> chosen;
+  chosen.reserve(2 * k);
+  for (size_t j = n - k; j < n; ++j) {
+    const size_t t = std::uniform_int_distribution<size_t>(0, j)(rng);
+    if (!chosen.insert(t).second) chosen.insert(j);
+  }
+  idx.assign(chosen.begin(), chosen.end());
+  std::sort(idx.begin(), idx.end());
+  return idx;
+}
+
+detail::NullspaceOptions nullspaceOptions(const LinearOptions& o) {
+  detail::NullspaceOptions n;
+  n.max_iterations = o.max_iterations;
+  n.huber_k = o.huber_k;
+  n.tolerance = o.tolerance;
+  n.grid_directions = o.grid_directions;
+  n.grid_starts = o.grid_starts;
+  n.grid_rows = o.grid_rows;
+  return n;
+}
+
+bool validInput(const WindowObservations& obs, const MotionModel& motion, SolverResult& r) {
+  if (!(obs.focal_px > 0.0) || !std::isfinite(obs.focal_px)) {
+    r = fail(SolveStatus::InvalidInput, Degeneracy::None, "focal length must be positive");
+    return false;
+  }
+  if (!motion.rotation(motion.referenceTime()).allFinite()) {
+    r = fail(SolveStatus::InvalidInput, Degeneracy::None, "angular velocity is not finite");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& motion,
+                             const LinearOptions& opt) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (const std::string err = opt.validate(); !err.empty())
+    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
+  if (!validInput(obs, motion, result)) return result;
+  const std::vector<int> usable = detail::usableClusters(obs, opt.min_cluster_events);
+  if (checkDegenerate(obs, motion, usable, opt, result)) {
+    result.time_us = microsecondsSince(start);
+    return result;
+  }
+  // Flat index over the events of usable clusters, then a seeded subset.
+  std::vector<size_t> offsets{0};
+  for (int c : usable) offsets.push_back(offsets.back() + obs.clusters[c].size());
+  const std::vector<size_t> pick =
+      sampleIndices(offsets.back(), static_cast<size_t>(opt.max_rows), opt.seed);
+  std::vector<ClusterFrame> frames;
+  for (int c : usable) frames.push_back(detail::makeClusterFrame(obs.clusters[c], motion));
+  std::vector<ConstraintRow> rows;
+  rows.reserve(pick.size());
+  size_t ci = 0;
+  for (size_t flat : pick) {
+    while (flat >= offsets[ci + 1]) ++ci;
+    const auto& cl = obs.clusters[usable[ci]];
+    const size_t k = flat - offsets[ci];
+    if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
+    ConstraintRow row = detail::celcRow(frames[ci], motion, cl.times[k], cl.bearings[k]);
+    if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
+  }
+  const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
+  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));
+  result.time_us = microsecondsSince(start);
+  return result;
+}
+
+SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion,
+                        const LinearOptions& opt) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (const std::string err = opt.validate(); !err.empty())
+    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
+  if (!validInput(obs, motion, result)) return result;
+  std::vector<int> usable;
+  for (int c : detail::usableClusters(obs, 0 + 2)) {
+    const auto& cl = obs.clusters[c];
+    if (cl.has_l2 && cl.l2.normal.allFinite() && cl.l2.normal.norm() > 0.0) usable.push_back(c);
+  }
+  if (checkDegenerate(obs, motion, usable, opt, result)) {
+    result.time_us = microsecondsSince(start);
+    return result;
+  }
+  // Per cluster: l_ref(t_m) = B_ref v must be parallel to m2 = R(t_m) l2:
+  // [m2]_x B_ref v = 0, three rows (rank two), each normalised by |B_ref v|.
+  std::vector<ConstraintRow> rows;
+  rows.reserve(3 * usable.size());
+  for (int c : usable) {
+    const auto& cl = obs.clusters[c];
+    const ClusterFrame frame = detail::makeClusterFrame(cl, motion);
+    const Mat3 B = detail::transferMatrix(frame, motion, cl.l2.t);
+    const Vec3 m2 = (motion.rotation(cl.l2.t) * cl.l2.normal).normalized();
+    Mat3 m2x;
+    m2x << 0, -m2.z(), m2.y(), m2.z(), 0, -m2.x(), -m2.y(), m2.x(), 0;
+    const Mat3 C = m2x * B;
+    for (int j = 0; j < 3; ++j) rows.push_back({C.row(j).transpose(), B});
+  }
+  const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
+  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));
+  result.time_us = microsecondsSince(start);
+  return result;
+}
+
+SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v) {
+  // Depth of event k along its ray from the camera at t_k, where the ray meets
+  // the planes of l1 and l3 (least squares over both planes):
+  //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
+  // lambda is odd in v, so exactly one sign puts the line in front (lambda > 0).
+  int votes = 0, voters = 0;
+  long event_balance = 0;
+  for (int c : detail::usableClusters(obs, 2)) {
+    const auto& cl = obs.clusters[c];
+    const ClusterFrame fr = detail::makeClusterFrame(cl, motion);
+    const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
+    const size_t stride = std::max<size_t>(1, cl.size() / 100);
+    long pos = 0, neg = 0;
+    for (size_t k = 0; k < cl.size(); k += stride) {
+      const Vec3 fp = motion.rotation(cl.times[k]) * cl.bearings[k];
+      const Vec3 pk = motion.positionMatrix(cl.times[k]) * v;
+      const double a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
+      const double den = a1 * a1 + a3 * a3;
+      if (!(den > 1e-24)) continue;
+      const double lambda = (a1 * fr.m1.dot(ps - pk) + a3 * fr.m3.dot(pe - pk)) / den;
+      if (lambda > 0) ++pos;
+      else if (lambda < 0) ++neg;
+    }
+    if (pos == neg) continue;
+    ++voters;
+    votes += pos > neg ? 1 : -1;
+    event_balance += pos - neg;
+  }
+  SignDecision d;
+  if (voters == 0) return d;
+  d.margin = static_cast<double>(votes) / voters;
+  d.sign = votes > 0 || (votes == 0 && event_balance >= 0) ? 1 : -1;
+  return d;
+}
+
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods,
+                                       const SolverOptions& options) {
+  std::vector<SolverResult> out;
+  SolverResult linear;
+  bool have_linear = false;
+  auto getLinear = [&]() -> const SolverResult& {
+    if (!have_linear) {
+      linear = solveCelcLinear(obs, motion, options.linear);
+      have_linear = true;
+    }
+    return linear;
+  };
+  for (Method m : methods) {
+    switch (m) {
+      case Method::Celc: out.push_back(getLinear()); break;
+      case Method::Ce3lc: out.push_back(solveCe3lc(obs, motion, options.linear)); break;
+      case Method::CelcOpt:
+      case Method::CelcMl: {
+        const SolverResult& init = getLinear();
+        if (!init.ok()) {
+          out.push_back(init);
+          break;
+        }
+        SolverResult r = refineVelocity(obs, motion, init.v, m == Method::CelcMl, options.refine);
+        r.time_us += init.time_us;  // a refined estimate costs its initialisation too
+        r.sigma_min = init.sigma_min;
+        r.sigma_second = init.sigma_second;
+        r.sign_margin = init.sign_margin;
+        out.push_back(r);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace celc
