@@ -72,9 +72,13 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
 
   auto& obs = trial.observations;
   obs.focal_px = cam.focal();
-  obs.clusters.resize(static_cast<size_t>(o.n_lines));
-  for (int i = 0; i < o.n_lines; ++i) {
-    std::array<Vec3, 2> seg{Vec3(ux(rng), uy(rng), uz(rng)), Vec3(ux(rng), uy(rng), uz(rng))};
+  const int n_lines = o.fixed_segments.empty() ? o.n_lines : static_cast<int>(o.fixed_segments.size());
+  obs.clusters.resize(static_cast<size_t>(n_lines));
+  for (int i = 0; i < n_lines; ++i) {
+    std::array<Vec3, 2> seg = o.fixed_segments.empty()
+                                  ? std::array<Vec3, 2>{Vec3(ux(rng), uy(rng), uz(rng)),
+                                                        Vec3(ux(rng), uy(rng), uz(rng))}
+                                  : o.fixed_segments[static_cast<size_t>(i)];
     trial.segments.push_back(seg);
     auto& c = obs.clusters[static_cast<size_t>(i)];
     c.id = i;
@@ -84,7 +88,7 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
     c.has_l2 = true;
   }
   // Events: a random line, a random time, a random point on the segment.
-  const int n_events = o.n_lines * o.events_per_line;
+  const int n_events = n_lines * o.events_per_line;
   struct Raw {
     double t;
     Vec2 px;
@@ -98,7 +102,7 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
       raw.push_back({t, Vec2(cam.width * u01(rng), cam.height * u01(rng)), -1});
       continue;
     }
-    const int line = static_cast<int>(u01(rng) * o.n_lines) % o.n_lines;
+    const int line = static_cast<int>(u01(rng) * n_lines) % n_lines;
     const auto& seg = trial.segments[static_cast<size_t>(line)];
     const double s = u01(rng);
     const Vec2 px = pixelAt(seg[0] + s * (seg[1] - seg[0]), t) + Vec2(ev_noise(rng), ev_noise(rng));
@@ -110,7 +114,7 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
         Event{r.t, static_cast<float>(r.px.x()), static_cast<float>(r.px.y()), true});
     trial.labels.push_back(r.label);
     // Outliers join a random cluster: the solvers must cope with them.
-    const int c = r.label >= 0 ? r.label : static_cast<int>(u01(rng) * o.n_lines) % o.n_lines;
+    const int c = r.label >= 0 ? r.label : static_cast<int>(u01(rng) * n_lines) % n_lines;
     auto& cl = obs.clusters[static_cast<size_t>(c)];
     cl.times.push_back(r.t);
     cl.bearings.push_back(bearingOf(r.px));

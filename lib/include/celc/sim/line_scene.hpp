@@ -40,6 +40,8 @@ struct LineSceneOptions {
   MotionModelKind motion = MotionModelKind::ConstantTwist;
   Vec3 omega_wobble{0.5, -0.3, 0.4};  ///< [rad/s], GyroIntegrated only
   double gyro_rate_hz = 1000.0;       ///< [Hz], GyroIntegrated only
+  /// When not empty: these segments (reference frame [m]) instead of random ones.
+  std::vector<std::array<Vec3, 2>> fixed_segments;
   std::string validate() const;
 };
 
