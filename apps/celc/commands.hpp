@@ -7,6 +7,8 @@
 
 namespace celc::app {
 
+void registerSimulate(CLI::App& app);
+void registerSolve(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

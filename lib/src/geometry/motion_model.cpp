@@ -71,6 +71,17 @@ Mat3 MotionModel::positionMatrix(double t) const {
   return Mat3::Identity() * tau;
 }
 
+void MotionModel::pose(double t, Mat3& R, Mat3& P) const {
+  const double tau = t - t_ref_;
+  if (kind_ == MotionModelKind::ConstantTwist) {
+    so3::expAndLeftJacobian(omega_ * tau, R, P);
+    P *= tau;
+    return;
+  }
+  R = rotation(t);
+  P = Mat3::Identity() * tau;
+}
+
 Vec3 MotionModel::meanOmega(double t0, double t1) const {
   if (kind_ == MotionModelKind::ConstantTwist || t1 <= t0) return omega_;
   return so3::log(rotation(t0).transpose() * rotation(t1)) / (t1 - t0);

@@ -60,6 +60,14 @@ Mat3 leftJacobian(const Vec3& phi) {
   return Mat3::Identity() + k.b * W + k.c * W * W;
 }
 
+void expAndLeftJacobian(const Vec3& phi, Mat3& R, Mat3& J) {
+  const Coeffs k = coefficients(phi.squaredNorm());
+  const Mat3 W = hat(phi);
+  const Mat3 W2 = W * W;
+  R = Mat3::Identity() + k.a * W + k.b * W2;
+  J = Mat3::Identity() + k.b * W + k.c * W2;
+}
+
 Mat3 leftJacobianInverse(const Vec3& phi) {
   const double th2 = phi.squaredNorm();
   const Mat3 W = hat(phi);

@@ -39,9 +39,9 @@ Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double
 /// generalised eigenvector of (sum a a^T, sum N^T N) and the best directions of
 /// a coarse hemisphere grid); the end point with the lowest robust cost wins.
 struct NullspaceOptions {
-  int max_iterations = 30;
+  int max_iterations = 20;
   double huber_k = 1.345;
-  double tolerance = 1e-9;
+  double tolerance = 1e-6;
   int grid_directions = 0;   // hemisphere grid size (0 = no grid)
   int grid_starts = 2;       // IRLS runs from the best grid directions
   int grid_rows = 200;       // rows used to score the grid

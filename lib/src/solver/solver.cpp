@@ -143,7 +143,7 @@ bool checkDegenerate(const WindowObservations& obs, const MotionModel& motion,
   for (int c : usable) {
     if (obs.clusters[c].size() < 8) continue;
     ++with_events;
-    const auto p = detail::clusterParallax(obs.clusters[c], motion, obs.focal_px, 300);
+    const auto p = detail::clusterParallax(obs.clusters[c], motion, obs.focal_px, 120);
     if (p.static_px >= opt.min_parallax_px &&
         p.static_px >= opt.min_parallax_ratio * std::max(p.moving_px, 1e-12))
       ++with_parallax;
@@ -313,11 +313,13 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
     const auto& cl = obs.clusters[c];
     const ClusterFrame fr = detail::makeClusterFrame(cl, motion);
     const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
-    const size_t stride = std::max<size_t>(1, cl.size() / 100);
+    const size_t stride = std::max<size_t>(1, cl.size() / 60);
     long pos = 0, neg = 0;
     for (size_t k = 0; k < cl.size(); k += stride) {
-      const Vec3 fp = motion.rotation(cl.times[k]) * cl.bearings[k];
-      const Vec3 pk = motion.positionMatrix(cl.times[k]) * v;
+      Mat3 Rk, Pk;
+      motion.pose(cl.times[k], Rk, Pk);
+      const Vec3 fp = Rk * cl.bearings[k];
+      const Vec3 pk = Pk * v;
       const double a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
       const double den = a1 * a1 + a3 * a3;
       if (!(den > 1e-24)) continue;

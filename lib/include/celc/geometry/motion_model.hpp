@@ -45,6 +45,8 @@ class MotionModel {
   Mat3 rotation(double t) const;
   /// P(t) with p_ref_t = P(t) v.
   Mat3 positionMatrix(double t) const;
+  /// R(t) and P(t) together (one sin/cos for the constant twist).
+  void pose(double t, Mat3& R, Mat3& P) const;
 
   /// The same model with a different constant rate (ConstantTwist) or with all
   /// rate samples shifted by delta (GyroIntegrated): used to perturb the gyroscope.

@@ -21,6 +21,8 @@ Mat3 exp(const Vec3& phi);
 Vec3 log(const Mat3& R);
 /// Left Jacobian J_l(phi) of SO(3).
 Mat3 leftJacobian(const Vec3& phi);
+/// exp(phi) and J_l(phi) together, sharing one sin/cos.
+void expAndLeftJacobian(const Vec3& phi, Mat3& R, Mat3& J);
 /// Inverse of the left Jacobian.
 Mat3 leftJacobianInverse(const Vec3& phi);
 

@@ -57,9 +57,9 @@ struct SolverResult {
 struct LinearOptions {
   int max_rows = 1000;           ///< random subset of event rows (0 = all) [rows]
   std::uint64_t seed = 1;        ///< seed of the row subset
-  int max_iterations = 30;       ///< IRLS iterations
+  int max_iterations = 20;       ///< IRLS iterations
   double huber_k = 1.345;        ///< Huber threshold in units of the robust scale
-  double tolerance = 1e-9;       ///< stop when the direction moves less than this [rad]
+  double tolerance = 1e-6;       ///< stop when the direction moves less than this [rad]
   /// Global start: the robust cost is scored on this many hemisphere
   /// directions (0 = off) and IRLS also runs from the best grid_starts of them.
   /// Off by default: on the paper's scene it changes the median error by < 2%

@@ -1,0 +1,153 @@
+// `celc simulate`: the paper's simulation study (CSV per sweep, plots, table).
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fmt/format.h>
+#include <iostream>
+
+#include "celc/config/config.hpp"
+#include "celc/io/labelled_events.hpp"
+#include "celc/pipeline/simulation_study.hpp"
+#include "commands.hpp"
+#include "progress.hpp"
+
+namespace fs = std::filesystem;
+
+namespace celc::app {
+namespace {
+
+struct SimulateArgs {
+  std::string sweep = "all";
+  std::string config;
+  std::string outdir = "celc_simulate";
+  std::string methods;
+  int trials = 0;  // 0 = from the configuration
+  long long seed = -1;
+  int threads = 0;
+  bool force = false, no_plots = false, quiet = false, verbose = false;
+};
+
+// Finds scripts/plot_simulation.py: $CELC_SCRIPTS_DIR, the source tree, or next to the binary.
+std::string findPlotScript() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("CELC_SCRIPTS_DIR")) candidates.emplace_back(env);
+  candidates.emplace_back(CELC_SCRIPTS_DIR);
+  candidates.emplace_back(fs::path("scripts"));
+  for (const auto& dir : candidates) {
+    const fs::path p = dir / "plot_simulation.py";
+    if (fs::exists(p)) return p.string();
+  }
+  return {};
+}
+
+std::string fmtCell(double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : "-"; }
+
+// The default-setting table (mean +- std of eps and phi per method).
+void printDefaultTable(const std::vector<SweepCell>& cells) {
+  std::cout << "\nDefault setting (paper Sec. 5.1): mean +- std over the trials with status ok\n\n"
+            << "| method | ok / trials | eps [m/s-dir] | phi [rad] | median phi [rad] | sign right | median time [us] |\n"
+            << "|---|---|---|---|---|---|---|\n";
+  for (const auto& c : cells)
+    std::cout << fmt::format("| {} | {} / {} | {} +- {} | {} +- {} | {} | {} | {:.0f} |\n",
+                             toString(c.method), c.n_ok, c.trials, fmtCell(c.eps_mean),
+                             fmtCell(c.eps_std), fmtCell(c.phi_mean), fmtCell(c.phi_std),
+                             fmtCell(c.phi_median), c.sign_right, c.time_median_us);
+}
+
+// A sweep as a compact table: rows levels, columns methods, mean phi [rad].
+void printSweepTable(const Sweep& sweep, const std::vector<SweepCell>& cells,
+                     const std::vector<Method>& methods) {
+  std::cout << "\nSweep " << sweep.name << ": mean phi [rad] (ok trials)\n\n| " << sweep.parameter;
+  for (Method m : methods) std::cout << " | " << toString(m);
+  std::cout << " |\n|---";
+  for (size_t i = 0; i < methods.size(); ++i) std::cout << "|---";
+  std::cout << "|\n";
+  for (size_t i = 0; i < cells.size(); i += methods.size()) {
+    std::cout << "| " << fmt::format("{:g}", cells[i].level);
+    for (size_t m = 0; m < methods.size(); ++m) {
+      const auto& c = cells[i + m];
+      std::cout << " | " << fmtCell(c.phi_mean) << " (" << c.n_ok << ")";
+    }
+    std::cout << " |\n";
+  }
+}
+
+void runSimulate(const SimulateArgs& a) {
+  configureLogging(a.quiet, a.verbose);
+  SimulateConfig cfg;
+  if (!a.config.empty()) cfg = loadSimulateConfig(a.config);
+  if (a.trials > 0) cfg.trials = a.trials;
+  if (a.seed >= 0) cfg.seed = static_cast<std::uint64_t>(a.seed);
+  if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
+
+  std::vector<const Sweep*> sweeps{&findSweep("default")};
+  if (a.sweep == "all") {
+    for (const auto& s : paperSweeps())
+      if (s.name != "default") sweeps.push_back(&s);
+  } else if (a.sweep != "default") {
+    sweeps.push_back(&findSweep(a.sweep));
+  }
+
+  const fs::path out(a.outdir);
+  if (fs::exists(out / "config.yaml") && !a.force)
+    throw std::runtime_error(out.string() + ": holds results of an earlier run (use --force to overwrite)");
+  fs::create_directories(out);
+  writeFileAtomically((out / "config.yaml").string(), toYaml(cfg));
+  spdlog::info("simulate: {} sweep(s), {} trials per level, seed {}, output {}", sweeps.size(),
+               cfg.trials, cfg.seed, out.string());
+
+  for (const Sweep* sweep : sweeps) {
+    Progress progress("simulate " + sweep->name, a.quiet);
+    const auto cells = runSweep(*sweep, cfg, a.threads,
+                                [&](int done, int total) { progress.update(done, total); });
+    std::string csv = sweepCsvHeader() + "\n";
+    for (const auto& c : cells) csv += sweepCsvRow(c) + "\n";
+    writeFileAtomically((out / (sweep->name + ".csv")).string(), csv);
+    if (sweep->name == "default") printDefaultTable(cells);
+    else printSweepTable(*sweep, cells, cfg.methods);
+  }
+  std::cout << std::flush;
+
+  if (a.no_plots || sweeps.size() < 2) return;
+  const std::string script = findPlotScript();
+  if (script.empty()) {
+    spdlog::warn("plot script scripts/plot_simulation.py not found: no plots (set CELC_SCRIPTS_DIR)");
+    return;
+  }
+  const std::string cmd = "python3 '" + script + "' '" + out.string() + "'";
+  if (std::system(cmd.c_str()) != 0)
+    spdlog::warn("plotting failed (needs python3-matplotlib): {}", cmd);
+  else
+    spdlog::info("plots written to {}/*.png", out.string());
+}
+
+}  // namespace
+
+void registerSimulate(CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  auto* cmd = app.add_subcommand(
+      "simulate",
+      "The paper's simulation study (Sec. 5.1): random 3D lines, events with pixel noise, per "
+      "level of a swept parameter the mean/std of eps = |v_gt - v| and phi = angle(v_gt, v) "
+      "[rad] per method. Writes OUTDIR/<sweep>.csv, OUTDIR/config.yaml and plots "
+      "OUTDIR/<sweep>.png; prints the tables.");
+  cmd->add_option("--sweep", a->sweep,
+                  "all, default, event_noise, line_noise, omega_noise, speed, interval or lines")
+      ->capture_default_str();
+  cmd->add_option("-c,--config", a->config, "YAML configuration (see config/simulate.yaml)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--outdir", a->outdir, "output folder")->capture_default_str();
+  cmd->add_option("--trials", a->trials, "random trials per level (default: config, 500)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--seed", a->seed, "random seed (default: config, 1)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", a->threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--methods", a->methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc (default all)");
+  cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
+  cmd->add_flag("--no-plots", a->no_plots, "skip the PNG plots");
+  cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");
+  cmd->add_flag("-v,--verbose", a->verbose, "debug logging");
+  cmd->callback([a]() { runSimulate(*a); });
+}
+
+}  // namespace celc::app

@@ -1,0 +1,80 @@
+// Solver speed on the paper's default scene (5 lines, 2 px noise).
+#include <benchmark/benchmark.h>
+
+#include "celc/sim/line_scene.hpp"
+#include "celc/solver/solver.hpp"
+#include "solver/constraint_rows.hpp"
+
+using namespace celc;
+
+namespace {
+LineSceneTrial scene(int events_per_line) {
+  LineSceneOptions o;
+  o.events_per_line = events_per_line;
+  std::mt19937_64 rng(42);
+  return generateLineScene(o, rng);
+}
+
+std::vector<detail::ConstraintRow> rowsOf(const LineSceneTrial& tr) {
+  std::vector<detail::ConstraintRow> rows;
+  for (const auto& c : tr.observations.clusters) {
+    const auto frame = detail::makeClusterFrame(c, tr.given_motion);
+    for (size_t k = 0; k < c.size(); ++k)
+      rows.push_back(detail::celcRow(frame, tr.given_motion, c.times[k], c.bearings[k]));
+  }
+  return rows;
+}
+}  // namespace
+
+// The robust nullspace (IRLS) alone on 1000 prebuilt rows.
+static void BM_CelcLinearSolve1000Rows(benchmark::State& state) {
+  const auto rows = rowsOf(scene(200));
+  detail::NullspaceOptions opt;
+  int iterations = 0;
+  for (auto _ : state) {
+    const auto sol = detail::robustNullspace(rows, opt);
+    iterations = sol.iterations;
+    benchmark::DoNotOptimize(sol);
+  }
+  state.counters["irls_iterations"] = iterations;
+}
+BENCHMARK(BM_CelcLinearSolve1000Rows)->Unit(benchmark::kMicrosecond);
+
+// Building the 1000 rows (rotations, left Jacobians, transfer matrices).
+static void BM_CelcBuildRows1000(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state) benchmark::DoNotOptimize(rowsOf(tr));
+}
+BENCHMARK(BM_CelcBuildRows1000)->Unit(benchmark::kMicrosecond);
+
+// The whole CELC linear method: checks, rows, IRLS, sign.
+static void BM_CelcLinearMethod1000Events(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(solveCelcLinear(tr.observations, tr.given_motion, {}));
+}
+BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
+
+static void BM_Ce3lc5Lines(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state) benchmark::DoNotOptimize(solveCe3lc(tr.observations, tr.given_motion, {}));
+}
+BENCHMARK(BM_Ce3lc5Lines)->Unit(benchmark::kMicrosecond);
+
+// Refinement of v alone (Ceres) from the linear estimate; arg = events.
+static void BM_RefineVelocity(benchmark::State& state) {
+  const auto tr = scene(static_cast<int>(state.range(0)) / 5);
+  const auto init = solveCelcLinear(tr.observations, tr.given_motion, {});
+  for (auto _ : state)
+    benchmark::DoNotOptimize(refineVelocity(tr.observations, tr.given_motion, init.v, false, {}));
+}
+BENCHMARK(BM_RefineVelocity)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+// Joint refinement of v and every cluster's l1, l3 (maximum likelihood).
+static void BM_RefineJoint(benchmark::State& state) {
+  const auto tr = scene(static_cast<int>(state.range(0)) / 5);
+  const auto init = solveCelcLinear(tr.observations, tr.given_motion, {});
+  for (auto _ : state)
+    benchmark::DoNotOptimize(refineVelocity(tr.observations, tr.given_motion, init.v, true, {}));
+}
+BENCHMARK(BM_RefineJoint)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
