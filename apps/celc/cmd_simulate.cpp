@@ -115,7 +115,10 @@ void runSimulate(const SimulateArgs& a) {
     spdlog::warn("plot script scripts/plot_simulation.py not found: no plots (set CELC_SCRIPTS_DIR)");
     return;
   }
-  const std::string cmd = "python3 '" + script + "' '" + out.string() + "'";
+  // Debian's interpreter (where python3-matplotlib installs) unless $CELC_PYTHON says otherwise.
+  std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (const char* env = std::getenv("CELC_PYTHON")) python = env;
+  const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
   if (std::system(cmd.c_str()) != 0)
     spdlog::warn("plotting failed (needs python3-matplotlib): {}", cmd);
   else
