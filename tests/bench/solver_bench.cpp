@@ -55,11 +55,29 @@ static void BM_CelcLinearMethod1000Events(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
 
+// CE3LC itself (5 clusters, 15 rows); the window checks are measured apart.
 static void BM_Ce3lc5Lines(benchmark::State& state) {
   const auto tr = scene(200);
-  for (auto _ : state) benchmark::DoNotOptimize(solveCe3lc(tr.observations, tr.given_motion, {}));
+  LinearOptions opt;
+  opt.check_parallax = false;
+  for (auto _ : state) benchmark::DoNotOptimize(solveCe3lc(tr.observations, tr.given_motion, opt));
 }
 BENCHMARK(BM_Ce3lc5Lines)->Unit(benchmark::kMicrosecond);
+
+// The window checks shared by all methods (usable clusters, parallax).
+static void BM_WindowChecks1000Events(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state) benchmark::DoNotOptimize(checkWindow(tr.observations, tr.given_motion, {}));
+}
+BENCHMARK(BM_WindowChecks1000Events)->Unit(benchmark::kMicrosecond);
+
+// All four methods on one window, as `celc simulate` runs them.
+static void BM_AllMethodsOneWindow(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(solveMethods(tr.observations, tr.given_motion, allMethods(), {}));
+}
+BENCHMARK(BM_AllMethodsOneWindow)->Unit(benchmark::kMillisecond);
 
 // Refinement of v alone (Ceres) from the linear estimate; arg = events.
 static void BM_RefineVelocity(benchmark::State& state) {

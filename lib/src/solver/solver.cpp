@@ -139,6 +139,7 @@ bool checkDegenerate(const WindowObservations& obs, const MotionModel& motion,
                       std::to_string(opt.min_clusters));
     return true;
   }
+  if (!opt.check_parallax) return false;
   int with_events = 0, with_parallax = 0;
   for (int c : usable) {
     if (obs.clusters[c].size() < 8) continue;
@@ -339,10 +340,29 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   return d;
 }
 
+SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motion,
+                         const LinearOptions& opt) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (const std::string err = opt.validate(); !err.empty())
+    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
+  if (!validInput(obs, motion, result)) return result;
+  if (!checkDegenerate(obs, motion, detail::usableClusters(obs, opt.min_cluster_events), opt,
+                       result))
+    result.status = SolveStatus::Ok;
+  result.time_us = microsecondsSince(start);
+  return result;
+}
+
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
-                                       const SolverOptions& options) {
+                                       const SolverOptions& options_in) {
   std::vector<SolverResult> out;
+  // Window-level checks once; a degenerate window is degenerate for every method.
+  const SolverResult window = checkWindow(obs, motion, options_in.linear);
+  if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
+  SolverOptions options = options_in;
+  options.linear.check_parallax = false;
   SolverResult linear;
   bool have_linear = false;
   auto getLinear = [&]() -> const SolverResult& {

@@ -78,6 +78,9 @@ struct LinearOptions {
   /// (robust scales); fewer than min_clusters such clusters -> degenerate.
   double min_parallax_ratio = 1.5;
   double min_parallax_px = 0.5;  ///< and the static-line scale exceeds this [px]
+  /// Run the parallax test inside the solver. solveMethods runs it once per
+  /// window and turns it off for the individual methods.
+  bool check_parallax = true;
   bool resolve_sign = true;      ///< cheirality test; else the sign is arbitrary
   std::string validate() const;
 };
@@ -117,10 +120,16 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
                             const Vec3& initial, bool refine_lines, const RefineOptions& options);
 
 /// Runs the requested methods on one window; celc_opt and celc_ml start from
-/// the celc result (computed once). Results are in the order of `methods`.
+/// the celc result (computed once), the cluster and parallax checks run once.
+/// Results are in the order of `methods`.
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options);
+
+/// The window-level checks shared by every method: enough usable clusters and
+/// parallax. Returns a Degenerate result, or one with status Ok when the window can be solved.
+SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motion,
+                         const LinearOptions& options);
 
 /// Cheirality: the sign of v that puts the clusters' triangulated 3D lines in
 /// front of the camera. Returns +1 or -1 and the vote margin in [-1, 1] for +v.
