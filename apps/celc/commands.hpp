@@ -7,6 +7,8 @@
 
 namespace celc::app {
 
+/// `celc info FILE|DIR` (cmd_info.cpp).
+void registerInfo(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);
