@@ -7,7 +7,8 @@
 //  - "IMUS" IMUPacket: 0 elements [IMU table {0 t int64 [us], 1 temperature,
 //    2..4 accel [g], 5..7 gyro [deg/s], 8..10 magnetometer}]
 // The file data table ("FTAB") at dataTablePosition, compressed like packets:
-// 0 Table [FileDataDefinition {0 ByteOffset int64, 1 PacketInfo struct {int32
+// 0 Table [FileDataDefinition {0 ByteOffset int64 (of the packet's payload; its
+// 8-byte header precedes it), 1 PacketInfo struct {int32
 // stream, int32 size}, 2 NumElements int64, 3 TimestampStart, 4 TimestampEnd}].
 #include <lz4frame.h>
 #include <zstd.h>
@@ -159,7 +160,7 @@ class Aedat4Reader final : public EventReader {
     for (const auto& e : table_) {
       if (e.stream != event_stream_) continue;
       if (e.t1 >= t_us) {
-        f_.seek(std::uint64_t(e.offset));
+        f_.seek(std::uint64_t(e.offset) - 8);
         cur_ = count_ = 0;
         return true;
       }
@@ -358,7 +359,7 @@ class Aedat4Reader final : public EventReader {
           e.n = b.scalar<std::int64_t>(d, 2, 0);
           e.t0 = b.scalar<std::int64_t>(d, 3, 0);
           e.t1 = b.scalar<std::int64_t>(d, 4, 0);
-          if (e.offset < std::int64_t(data_start_) || std::uint64_t(e.offset) + 8 > end_of_packets())
+          if (e.offset < std::int64_t(data_start_) + 8 || std::uint64_t(e.offset) > end_of_packets())
             throw FbError(first + 4 * i, "data table entry offset " + std::to_string(e.offset) + " outside the packets");
           table_.push_back(e);
         }
@@ -368,11 +369,11 @@ class Aedat4Reader final : public EventReader {
     }
     // Validate entries against the packet headers they point to.
     for (const auto& e : table_) {
-      f_.seek(std::uint64_t(e.offset));
+      f_.seek(std::uint64_t(e.offset) - 8);
       unsigned char h[8];
       f_.readExact(h, 8, "packet header");
       if (loadLE<std::int32_t>(h) != e.stream || loadLE<std::int32_t>(h + 4) != e.size)
-        f_.fail(std::uint64_t(e.offset), "data table entry does not match the packet header there");
+        f_.fail(std::uint64_t(e.offset) - 8, "data table entry does not match the packet header there");
     }
     f_.seek(keep);
     return !table_.empty();

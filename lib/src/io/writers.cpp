@@ -217,7 +217,22 @@ void writeAedat2(const std::string& path, const std::vector<Event>& events, cons
           "\"/>\r\n");
   out.put("#                <entry key=\"ImuAccelScale\" value=\"ImuAccelScaleG" + std::to_string(accel_g) + "\"/>\r\n");
   out.put("#End of Preferences for this AEChip\r\n");
-  const double glsb = 32768.0 / gyro_dps, alsb = 32768.0 / accel_g;
+  // the nominal sensitivities the reader uses (MPU-6x50 datasheet values, as jAER)
+  double glsb = 0, alsb = 0;
+  switch (gyro_dps) {
+    case 250: glsb = 131.0; break;
+    case 500: glsb = 65.5; break;
+    case 1000: glsb = 32.8; break;
+    case 2000: glsb = 16.4; break;
+    default: throw IoError(path + ": gyro full scale must be 250, 500, 1000 or 2000 deg/s");
+  }
+  switch (accel_g) {
+    case 2: alsb = 16384.0; break;
+    case 4: alsb = 8192.0; break;
+    case 8: alsb = 4096.0; break;
+    case 16: alsb = 2048.0; break;
+    default: throw IoError(path + ": accel full scale must be 2, 4, 8 or 16 g");
+  }
   std::vector<unsigned char> b;
   b.reserve(events.size() * 8 + imu.size() * 56);
   std::size_t j = 0;
@@ -259,8 +274,15 @@ void writeAedat31(const std::string& path, const std::vector<Event>& events, con
     putLE<std::int32_t>(b, n);
   };
   std::size_t j = 0;
-  for (std::size_t i = 0; i < events.size(); i += std::size_t(per_packet)) {
-    const std::size_t n = std::min(events.size() - i, std::size_t(per_packet));
+  for (std::size_t i = 0, n = 0; i < events.size(); i += n) {
+    n = std::min(events.size() - i, std::size_t(per_packet));
+    // one timestamp overflow value per packet: cut the packet where it changes
+    const std::int64_t ov = us(events[i].t) >> 31;
+    for (std::size_t m = 1; m < n; ++m)
+      if ((us(events[i + m].t) >> 31) != ov) {
+        n = m;
+        break;
+      }
     // IMU samples up to this packet's first event, as one IMU6 packet
     std::size_t k = j;
     while (k < imu.size() && imu[k].t <= events[i].t) ++k;
@@ -358,7 +380,7 @@ void writeAedat4(const std::string& path, const std::vector<Event>& events, cons
   const std::size_t header_size = header(-1).size();
   std::int64_t pos = 14 + std::int64_t(header_size);
   for (std::size_t i = 0; i < packets.size(); ++i) {
-    entries[i].offset = pos;
+    entries[i].offset = pos + 8;  // DV convention: the payload's offset
     pos += 8 + std::int64_t(packets[i].size());
   }
   Out out(path);
