@@ -39,6 +39,7 @@ bool WindowSource::pull() {
       if (e.t < o_.t_start) continue;
       if (e.t >= o_.t_end) {
         eof_ = true;  // time-ordered input: nothing further is in range
+        past_end_ = true;
         break;
       }
       buf_.push_back(e);
@@ -78,7 +79,8 @@ bool WindowSource::next(EventWindow& w) {
   // make sure the buffer reaches t1 (or the end)
   while ((buf_.empty() || buf_.back().t < t1) && pull()) {
   }
-  const bool complete = !buf_.empty() && buf_.back().t >= t1;
+  // complete when events reach t1, or the stream passed t_end and t1 <= t_end
+  const bool complete = (!buf_.empty() && buf_.back().t >= t1) || (past_end_ && t1 <= o_.t_end);
   if (!complete) {
     if (!o_.keep_partial) return false;
     if (std::none_of(buf_.begin(), buf_.end(), [&](const Event& e) { return e.t >= t0; })) return false;

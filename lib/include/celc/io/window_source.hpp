@@ -54,6 +54,7 @@ class WindowSource {
   std::deque<Event> buf_;
   std::vector<Event> batch_;
   bool eof_ = false;
+  bool past_end_ = false;  ///< an event at or after t_end was seen
   bool started_ = false;
   double next_t0_ = 0.0;
   std::uint64_t index_ = 0;
