@@ -7,6 +7,7 @@
 //               4 gx, 5 gy, 6 gz), value = int16 in bits 12..27; seven words per sample.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
@@ -136,8 +137,10 @@ class Aedat2Reader final : public EventReader {
     notes_.push_back("chip " + (h_.chip.empty() ? std::string("unknown") : h_.chip));
     notes_.push_back("header " + std::to_string(h_.lines) + " lines, data at byte " +
                      std::to_string(h_.data_start));
-    notes_.push_back("IMU scale " + std::to_string(h_.gyro_lsb_per_dps) + " LSB/(deg/s), " +
-                     std::to_string(h_.accel_lsb_per_g) + " LSB/g");
+    char scale[96];
+    std::snprintf(scale, sizeof(scale), "IMU scale %g LSB/(deg/s), %g LSB/g", h_.gyro_lsb_per_dps,
+                  h_.accel_lsb_per_g);
+    notes_.push_back(scale);
     buf_.resize(std::size_t(8) << 20);
   }
   Format format() const override { return Format::Aedat2; }

@@ -89,7 +89,10 @@ std::unique_ptr<EventReader> openEventSource(const std::string& path, const Read
   switch (detectFormat(path)) {
     case Format::RpgDirectory: {
       const std::string imu = exists(path + "/imu.txt") ? path + "/imu.txt" : std::string();
-      return openTextEvents(path + "/events.txt", imu, options);
+      auto reader = openTextEvents(path + "/events.txt", imu, options);
+      for (const char* f : {"imu.txt", "groundtruth.txt", "calib.txt"})
+        reader->addNote(std::string(f) + (exists(path + "/" + f) ? " present" : " absent"));
+      return reader;
     }
     case Format::Text: return openTextEvents(path, "", options);
     case Format::Aedat2: return detail::openAedat2(path, options);

@@ -98,6 +98,7 @@ class EventReader {
   const ReaderWarnings& warnings() const { return warnings_; }
   /// Human-readable notes about the source (chip name, compression, streams...).
   const std::vector<std::string>& notes() const { return notes_; }
+  void addNote(const std::string& note) { notes_.push_back(note); }
 
  protected:
   void warn(std::uint64_t ReaderWarnings::*counter, const std::string& message);
