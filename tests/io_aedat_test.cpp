@@ -77,6 +77,17 @@ TEST(IoAedat, Aedat2FullScaleFromHeaderAndDavis346) {
   expectSameImu(r->readImu(), f.imu, 0.51 / 16.4 * kDeg, 0.51 / 2048 * kG);
 }
 
+TEST(IoAedat, Aedat2FirstDataByteIsHash) {
+  TempDir d;
+  // raw y = 179 - 37 = 142: the address's first byte is 0x23 = '#'
+  std::vector<Event> ev = {{1.0, 5.0f, 37.0f, true}, {1.5, 6.0f, 38.0f, false}};
+  writeAedat2(d.file("h.aedat"), ev, {});
+  const std::string b = celc::testing::readBytes(d.file("h.aedat"));
+  ASSERT_EQ(b[b.size() - 16], '#');
+  auto r = openEventSource(d.file("h.aedat"));
+  expectSameEvents(readAllEvents(*r), ev);
+}
+
 TEST(IoAedat, Aedat2TimestampWrapIsUnwrapped) {
   TempDir d;
   auto ev = celc::testing::randomEvents(40000, 240, 180, 5, 4294.96);  // crosses 2^32 us

@@ -72,6 +72,17 @@ Aedat2Header readHeader(BinFile& f, const ReaderOptions& o) {
     }
     f.seek(start);
     if (!f.readLine(line, 1 << 20)) break;
+    // The first data word may begin with the byte '#' (a DVS event with raw y in
+    // 140..143 on a DAVIS240): header lines are text, so a "line" holding control
+    // bytes other than tab / CR / LF is data.
+    if (std::any_of(line.begin(), line.end(), [](char ch) {
+          const auto u = static_cast<unsigned char>(ch);
+          return u < 0x20 && u != '\t' && u != '\r' && u != '\n';
+        })) {
+      f.seek(start);
+      h.data_start = start;
+      break;
+    }
     ++h.lines;
     if (f.tell() > max_header) f.fail(start, "header longer than 64 MB");
     if (line.back() != '\n') {
