@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace celc::io {
 
@@ -24,6 +25,8 @@ std::string GyroWindowOptions::validate() const {
 GyroTrack::GyroTrack(const std::vector<ImuSample>& imu, const Mat3& R_cam_imu, double time_offset,
                      const GyroWindowOptions& options)
     : options_(options) {
+  const std::string err = options_.validate();
+  if (!err.empty()) throw std::invalid_argument("gyro window options: " + err);
   t_.reserve(imu.size());
   w_.reserve(imu.size());
   for (const ImuSample& s : imu) {
