@@ -199,9 +199,17 @@ TEST(IoTextBad, PixelsOutsideSensorDropped) {
   auto r = openEventSource(d.file("e.txt"), o);
   EXPECT_EQ(readAllEvents(*r).size(), 2u);
   EXPECT_EQ(r->warnings().outside_sensor, 2u);
-  // without a sensor size only negative pixels are outside
+  // without a sensor size only negative pixels (and >= 65536) are outside
   auto r2 = openEventSource(d.file("e.txt"));
   EXPECT_EQ(readAllEvents(*r2).size(), 3u);
+  celc::testing::writeBytes(d.file("huge.txt"), "0.1 1e30 2 1
+0.2 1.5 2.5 1
+");
+  auto r3 = openEventSource(d.file("huge.txt"));
+  auto ev = readAllEvents(*r3);
+  ASSERT_EQ(ev.size(), 1u);  // sub-pixel coordinates (simulators) are kept as floats
+  EXPECT_EQ(ev[0].x, 1.5f);
+  EXPECT_EQ(r3->warnings().outside_sensor, 1u);
 }
 
 TEST(IoTextBad, EmptyMissingBinaryAndHugeLine) {

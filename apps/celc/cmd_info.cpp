@@ -62,8 +62,8 @@ void registerInfo(CLI::App& app) {
       "info", "What an event recording holds: format, sensor size, counts, ON share, duration, rates, warnings");
   cmd->add_option("input", args->path, "events file (events.txt, .aedat, .aedat2, .aedat31, .aedat4) or RPG/UZH-FPV directory")
       ->required();
-  cmd->add_option("--width", args->width, "sensor width [px] when the file does not say (0 = unknown)");
-  cmd->add_option("--height", args->height, "sensor height [px] when the file does not say (0 = unknown)");
+  cmd->add_option("--width", args->width, "sensor width [px]; overrides the file's (0 = from the file, or unknown)");
+  cmd->add_option("--height", args->height, "sensor height [px]; overrides the file's (0 = from the file, or unknown)");
   cmd->add_option("--imu-columns", args->imu_columns, "IMU text column order without a header: auto | rpg | gyro_first")
       ->capture_default_str();
   cmd->add_option("--time-scale", args->time_scale, "text timestamps times this = seconds (1e-6 for us)")

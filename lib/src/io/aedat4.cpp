@@ -156,7 +156,9 @@ class Aedat4Reader final : public EventReader {
 
   bool seekTime(double t_start) override {
     if (!loadTable()) return false;
-    const auto t_us = std::int64_t(std::floor(t_start * 1e6));
+    if (std::isnan(t_start)) return false;
+    const double t_clamped = std::clamp(std::floor(t_start * 1e6), -9.0e18, 9.0e18);
+    const auto t_us = std::int64_t(t_clamped);
     for (const auto& e : table_) {
       if (e.stream != event_stream_) continue;
       if (e.t1 >= t_us) {

@@ -175,7 +175,9 @@ class TextEventReader final : public EventReader {
                  std::to_string(t) + " before previous " + std::to_string(prev_t_));
       prev_t_ = t;
       has_prev_ = true;
-      if (xd < 0 || yd < 0 || (width_ > 0 && xd >= width_) || (height_ > 0 && yd >= height_)) {
+      // without a sensor size, 65536 bounds any sensor (and keeps integer conversions defined)
+      const double wmax = width_ > 0 ? width_ : 65536.0, hmax = height_ > 0 ? height_ : 65536.0;
+      if (!(xd >= 0 && yd >= 0 && xd < wmax && yd < hmax)) {
         warn(&ReaderWarnings::outside_sensor,
              path_ + ": line " + std::to_string(lr_.lineNumber()) + ": pixel (" +
                  std::to_string(xd) + ", " + std::to_string(yd) + ") outside the " +
