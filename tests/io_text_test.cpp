@@ -202,9 +202,7 @@ TEST(IoTextBad, PixelsOutsideSensorDropped) {
   // without a sensor size only negative pixels (and >= 65536) are outside
   auto r2 = openEventSource(d.file("e.txt"));
   EXPECT_EQ(readAllEvents(*r2).size(), 3u);
-  celc::testing::writeBytes(d.file("huge.txt"), "0.1 1e30 2 1
-0.2 1.5 2.5 1
-");
+  celc::testing::writeBytes(d.file("huge.txt"), "0.1 1e30 2 1\n0.2 1.5 2.5 1\n");
   auto r3 = openEventSource(d.file("huge.txt"));
   auto ev = readAllEvents(*r3);
   ASSERT_EQ(ev.size(), 1u);  // sub-pixel coordinates (simulators) are kept as floats
