@@ -7,10 +7,10 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <yaml-cpp/yaml.h>
 
 #include "celc/config/config.hpp"
 #include "celc/geometry/camera.hpp"
+#include "celc/io/calibration.hpp"
 #include "celc/io/labelled_events.hpp"
 #include "celc/lines/line_fit.hpp"
 #include "celc/solver/solver.hpp"
@@ -45,49 +45,6 @@ Vec3 parseVec3(const std::string& text, const std::string& what) {
   return {v[0], v[1], v[2]};
 }
 
-// Camera intrinsics from a calibration YAML (docs/calibration.md, section
-// `camera`) or an RPG calib.txt line `fx fy cx cy k1 k2 p1 p2 k3`.
-CameraModel loadCamera(const std::string& path) {
-  CameraModel cam;
-  if (path.size() >= 4 && path.substr(path.size() - 4) == ".txt") {
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error(path + ": cannot open");
-    double k[9];
-    for (double& x : k)
-      if (!(in >> x)) throw std::runtime_error(path + ":1: expected 'fx fy cx cy k1 k2 p1 p2 k3'");
-    cam.fx = k[0], cam.fy = k[1], cam.cx = k[2], cam.cy = k[3];
-    cam.distortion = DistortionModel::RadTan;
-    cam.coeffs = {k[4], k[5], k[6], k[7], k[8]};
-  } else {
-    YAML::Node root;
-    try {
-      root = YAML::LoadFile(path);
-    } catch (const YAML::Exception& e) {
-      throw std::runtime_error(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-    }
-    const YAML::Node c = root["camera"];
-    if (!c) throw std::runtime_error(path + ": no 'camera' section");
-    try {
-      cam.fx = c["fx"].as<double>();
-      cam.fy = c["fy"].as<double>();
-      cam.cx = c["cx"].as<double>();
-      cam.cy = c["cy"].as<double>();
-      if (c["width"]) cam.width = c["width"].as<int>();
-      if (c["height"]) cam.height = c["height"].as<int>();
-      if (c["distortion_model"])
-        cam.distortion = parseDistortionModel(c["distortion_model"].as<std::string>());
-      if (c["distortion"]) {
-        const auto d = c["distortion"].as<std::vector<double>>();
-        for (size_t i = 0; i < std::min<size_t>(5, d.size()); ++i) cam.coeffs[i] = d[i];
-      }
-    } catch (const std::exception& e) {
-      throw std::runtime_error(path + ": section 'camera': " + e.what());
-    }
-  }
-  if (const auto err = cam.validate(); !err.empty()) throw std::runtime_error(path + ": " + err);
-  return cam;
-}
-
 // Gyroscope CSV `t,wx,wy,wz` (seconds, rad/s, camera frame) for the gyro-integrated model.
 MotionModel loadGyro(const std::string& path, double t_ref) {
   std::ifstream in(path);
@@ -117,7 +74,7 @@ void runSolve(const SolveArgs& a) {
   if (a.calib.empty() && !a.normalized)
     throw std::runtime_error("solve: pixel events need --calib FILE (or pass --normalized)");
   CameraModel cam;
-  if (!a.calib.empty()) cam = loadCamera(a.calib);
+  if (!a.calib.empty()) cam = io::loadCalibration(a.calib).camera;
   else cam.fx = cam.fy = a.focal;
 
   // Group by cluster (id >= 0), sorted by time.

@@ -9,6 +9,8 @@ namespace celc::app {
 
 void registerSimulate(CLI::App& app);
 void registerSolve(CLI::App& app);
+/// `celc info FILE|DIR` (cmd_info.cpp).
+void registerInfo(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   // Subcommands, in the order `celc --help` lists them.
   celc::app::registerSimulate(app);
   celc::app::registerSolve(app);
+  celc::app::registerInfo(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,78 @@
+// `celc info FILE|DIR`: what an event recording holds.
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <string>
+
+#include "celc/io/event_reader.hpp"
+#include "commands.hpp"
+
+namespace celc::app {
+
+namespace {
+struct InfoArgs {
+  std::string path;
+  int width = 0, height = 0;
+  std::string imu_columns = "auto";
+  double time_scale = 1.0;
+  bool strict = false;
+};
+
+int runInfo(const InfoArgs& a) {
+  io::ReaderOptions o;
+  o.width = a.width;
+  o.height = a.height;
+  o.imu_columns = io::parseImuColumns(a.imu_columns);
+  o.text_time_scale = a.time_scale;
+  o.strict = a.strict;
+  const io::FileInfo info = io::scanFile(a.path, o);
+  std::printf("file:          %s\n", info.path.c_str());
+  std::printf("format:        %s\n", io::toString(info.format).c_str());
+  if (info.width > 0)
+    std::printf("sensor:        %d x %d px\n", info.width, info.height);
+  else
+    std::printf("sensor:        unknown (pixels seen up to x=%d, y=%d)\n", info.max_x, info.max_y);
+  for (const auto& n : info.notes) std::printf("note:          %s\n", n.c_str());
+  std::printf("events:        %llu\n", static_cast<unsigned long long>(info.events));
+  if (info.events > 0) {
+    std::printf("ON share:      %.4f (%llu ON)\n", double(info.on_events) / double(info.events),
+                static_cast<unsigned long long>(info.on_events));
+    std::printf("time range:    [%.6f, %.6f] s\n", info.t_min, info.t_max);
+    std::printf("duration:      %.6f s\n", info.duration());
+    std::printf("event rate:    %.4g events/s\n", info.eventRate());
+  }
+  std::printf("IMU samples:   %llu\n", static_cast<unsigned long long>(info.imu_samples));
+  if (info.imu_samples > 0) {
+    std::printf("IMU range:     [%.6f, %.6f] s\n", info.imu_t_first, info.imu_t_last);
+    std::printf("IMU rate:      %.2f Hz\n", info.imuRate());
+  }
+  std::printf("warnings:      %llu (timestamps backwards %llu, pixels outside sensor %llu, skipped %llu)\n",
+              static_cast<unsigned long long>(info.warnings.total()),
+              static_cast<unsigned long long>(info.warnings.backwards_time),
+              static_cast<unsigned long long>(info.warnings.outside_sensor),
+              static_cast<unsigned long long>(info.warnings.skipped_records));
+  for (const auto& m : info.warnings.messages) std::printf("  warning: %s\n", m.c_str());
+  return 0;
+}
+}  // namespace
+
+void registerInfo(CLI::App& app) {
+  auto args = std::make_shared<InfoArgs>();
+  auto* cmd = app.add_subcommand(
+      "info", "What an event recording holds: format, sensor size, counts, ON share, duration, rates, warnings");
+  cmd->add_option("input", args->path, "events file (events.txt, .aedat, .aedat2, .aedat31, .aedat4) or RPG/UZH-FPV directory")
+      ->required();
+  cmd->add_option("--width", args->width, "sensor width [px]; overrides the file's (0 = from the file, or unknown)");
+  cmd->add_option("--height", args->height, "sensor height [px]; overrides the file's (0 = from the file, or unknown)");
+  cmd->add_option("--imu-columns", args->imu_columns, "IMU text column order without a header: auto | rpg | gyro_first")
+      ->capture_default_str();
+  cmd->add_option("--time-scale", args->time_scale, "text timestamps times this = seconds (1e-6 for us)")
+      ->capture_default_str();
+  cmd->add_flag("--strict", args->strict, "treat warnings (backwards timestamps, pixels outside) as errors");
+  cmd->callback([args]() {
+    const int rc = runInfo(*args);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace celc::app

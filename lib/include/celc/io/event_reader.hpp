@@ -1,0 +1,146 @@
+#pragma once
+/// \file event_reader.hpp
+/// Streaming readers for event-camera recordings. Every reader yields events as
+/// (t [s], x, y [px, origin top-left, x right, y down], polarity) and IMU samples
+/// (t [s], gyro [rad/s], accel [m/s^2]) in the sensor's own IMU frame, whatever
+/// the units of the file.
+///
+/// Formats: RPG / Event Camera Dataset / UZH-FPV text (a directory holding
+/// events.txt [+ imu.txt], or a single events text file), AEDAT 2.0 (jAER,
+/// DAVIS), AEDAT 3.1 (cAER) and AEDAT 4.0 (DV). openEventSource() detects the
+/// format from the magic line (`#!AER-DAT2.0`, `#!AER-DAT3.1`, `#!AER-DAT4.0`).
+///
+/// Bad-input policy (docs/io.md):
+///  - errors (an IoError naming the file and the line or byte offset): bad magic,
+///    truncated binary records, sizes or offsets out of range, corrupt
+///    compression or flatbuffers, non-numeric text fields, wrong column counts;
+///  - counted warnings: timestamps going backwards (event kept), pixels outside
+///    the sensor (event dropped), unknown AEDAT event types (skipped).
+///    With ReaderOptions::strict, a warning is an error too.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "celc/types.hpp"
+
+namespace celc::io {
+
+/// Thrown at the I/O boundary; what() is one line: "FILE: line N: ..." or "FILE: byte N: ...".
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Format { Text, RpgDirectory, Aedat2, Aedat31, Aedat4 };
+std::string toString(Format format);
+
+/// Column order of an IMU text file (when the file has no header naming them).
+enum class ImuColumns {
+  Auto,         ///< from a `#` header line naming the columns, else RPG order
+  RpgAccelFirst,  ///< t ax ay az gx gy gz (Event Camera Dataset imu.txt)
+  GyroFirst,    ///< t wx wy wz ax ay az (UZH-FPV; a leading id column is detected by count)
+};
+ImuColumns parseImuColumns(const std::string& name);  ///< "auto" | "rpg" | "gyro_first"
+
+struct ReaderOptions {
+  /// Sensor size [px] when the file does not say (text formats); 0 = unknown:
+  /// no pixel-range check. A non-zero value overrides the size in the file.
+  int width = 0;
+  int height = 0;
+  ImuColumns imu_columns = ImuColumns::Auto;
+  /// Text timestamps are multiplied by this to give seconds (1 for seconds, 1e-6 for us, 1e-9 for ns).
+  double text_time_scale = 1.0;
+  /// Turn every counted warning into an error.
+  bool strict = false;
+  /// Upper bound of one decoded AEDAT packet [bytes]: a hostile size beyond it is an error.
+  std::size_t max_packet_bytes = std::size_t(256) << 20;
+  /// AEDAT 3.1: read only this source id (-1 = every source, merged in file order).
+  int aedat_source = -1;
+  /// Empty when valid, else what is wrong.
+  std::string validate() const;
+};
+
+/// Counted warnings (first few messages kept verbatim).
+struct ReaderWarnings {
+  std::uint64_t backwards_time = 0;   ///< timestamp smaller than the previous event's (kept)
+  std::uint64_t outside_sensor = 0;   ///< pixel outside [0,width)x[0,height) (dropped)
+  std::uint64_t skipped_records = 0;  ///< unknown event types / special events skipped
+  std::vector<std::string> messages;  ///< up to 20 first messages
+  std::uint64_t total() const { return backwards_time + outside_sensor + skipped_records; }
+};
+
+/// Pull reader: events in file order, IMU on request.
+class EventReader {
+ public:
+  virtual ~EventReader() = default;
+  virtual Format format() const = 0;
+  /// The event source path (a file; for a directory its events file).
+  const std::string& path() const { return path_; }
+  /// Sensor size [px]; 0 when unknown.
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// Clears `batch` and fills it with up to `max` next events (max >= 1).
+  /// Returns false when the stream is exhausted (then batch is empty).
+  virtual bool next(std::vector<Event>& batch, std::size_t max) = 0;
+  /// Every IMU sample of the recording (a separate pass; independent of next()).
+  /// Empty when the source has none.
+  virtual std::vector<ImuSample> readImu() = 0;
+  /// Number of IMU samples without keeping them (default: readImu().size()).
+  virtual std::uint64_t countImu() { return readImu().size(); }
+  /// Skips ahead so that the next event read is the first with t >= t_start [s]
+  /// (some earlier events of the same packet may remain; callers filter).
+  /// Returns false when the reader cannot seek (then nothing changes).
+  virtual bool seekTime(double t_start) { (void)t_start; return false; }
+  /// Warnings counted so far by next().
+  const ReaderWarnings& warnings() const { return warnings_; }
+  /// Human-readable notes about the source (chip name, compression, streams...).
+  const std::vector<std::string>& notes() const { return notes_; }
+  void addNote(const std::string& note) { notes_.push_back(note); }
+
+ protected:
+  void warn(std::uint64_t ReaderWarnings::*counter, const std::string& message);
+  std::string path_;
+  int width_ = 0, height_ = 0;
+  ReaderOptions options_;
+  ReaderWarnings warnings_;
+  std::vector<std::string> notes_;
+};
+
+/// Detects the format (directory in RPG/UZH-FPV layout, `#!AER-DAT` magic,
+/// else a text events file) and opens a reader. Throws IoError.
+std::unique_ptr<EventReader> openEventSource(const std::string& path,
+                                             const ReaderOptions& options = {});
+/// Format of a path without opening a reader. Throws IoError when unreadable.
+Format detectFormat(const std::string& path);
+
+/// A summary from one full pass (what `celc info` prints).
+struct FileInfo {
+  Format format = Format::Text;
+  std::string path;
+  int width = 0, height = 0;      ///< sensor size [px] (0 = unknown)
+  int max_x = -1, max_y = -1;     ///< largest pixel coordinates seen
+  std::uint64_t events = 0;
+  std::uint64_t on_events = 0;
+  double t_first = 0.0, t_last = 0.0;  ///< first / last event time [s] (file order)
+  double t_min = 0.0, t_max = 0.0;     ///< min / max event time [s]
+  std::uint64_t imu_samples = 0;
+  double imu_t_first = 0.0, imu_t_last = 0.0;
+  ReaderWarnings warnings;
+  std::vector<std::string> notes;
+  double duration() const { return events > 1 ? t_max - t_min : 0.0; }
+  double eventRate() const { return duration() > 0 ? double(events) / duration() : 0.0; }
+  double imuRate() const {
+    return imu_samples > 1 && imu_t_last > imu_t_first
+               ? double(imu_samples - 1) / (imu_t_last - imu_t_first) : 0.0;
+  }
+};
+/// One full pass over the source (events streamed in batches, IMU counted).
+FileInfo scanFile(const std::string& path, const ReaderOptions& options = {});
+
+/// Reads all events of a source (convenience for small files and tests).
+std::vector<Event> readAllEvents(EventReader& reader);
+
+}  // namespace celc::io

@@ -1,0 +1,406 @@
+// AEDAT 4.0 (DV): "#!AER-DAT4.0\r\n", an int32 size then the IOHeader flatbuffer
+// ("IOHE": 0 compression enum {0 none, 1 LZ4, 2 LZ4 high, 3 Zstd, 4 Zstd high},
+// 1 dataTablePosition int64 (-1 when absent), 2 infoNode string (XML stream
+// description)), then packets: int32 stream id, int32 size, size bytes of one
+// compressed frame holding a flatbuffer payload:
+//  - "EVTS" EventPacket: 0 elements [Event struct {int64 t [us]; int16 x; int16 y; bool on}] (16 bytes)
+//  - "IMUS" IMUPacket: 0 elements [IMU table {0 t int64 [us], 1 temperature,
+//    2..4 accel [g], 5..7 gyro [deg/s], 8..10 magnetometer}]
+// The file data table ("FTAB") at dataTablePosition, compressed like packets:
+// 0 Table [FileDataDefinition {0 ByteOffset int64 (of the packet's payload; its
+// 8-byte header precedes it), 1 PacketInfo struct {int32
+// stream, int32 size}, 2 NumElements int64, 3 TimestampStart, 4 TimestampEnd}].
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "io/aedat_readers.hpp"
+#include "io/binary_file.hpp"
+#include "io/flatbuf.hpp"
+
+namespace celc::io::detail {
+namespace {
+
+struct StreamInfo {
+  int id = -1;
+  std::string type;
+  int width = 0, height = 0;
+};
+
+std::string xmlAttr(const std::string& block, const std::string& key) {
+  const std::string k = "key=\"" + key + "\"";
+  std::size_t p = block.find(k);
+  if (p == std::string::npos) return {};
+  p = block.find('>', p);
+  if (p == std::string::npos) return {};
+  std::size_t e = block.find('<', p);
+  if (e == std::string::npos) return {};
+  return block.substr(p + 1, e - p - 1);
+}
+
+std::vector<StreamInfo> parseStreams(const std::string& xml) {
+  std::vector<StreamInfo> out;
+  std::vector<std::pair<std::size_t, int>> starts;
+  const std::string marker = "/outInfo/";
+  std::size_t p = 0;
+  while ((p = xml.find(marker, p)) != std::string::npos) {
+    p += marker.size();
+    std::size_t e = p;
+    while (e < xml.size() && std::isdigit(static_cast<unsigned char>(xml[e]))) ++e;
+    if (e > p && e < xml.size() && xml[e] == '/' && e + 1 < xml.size() && xml[e + 1] == '"' && e - p < 6)
+      starts.emplace_back(p, std::stoi(xml.substr(p, e - p)));
+  }
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    const std::size_t end = i + 1 < starts.size() ? starts[i + 1].first : xml.size();
+    const std::string block = xml.substr(starts[i].first, end - starts[i].first);
+    StreamInfo s;
+    s.id = starts[i].second;
+    s.type = xmlAttr(block, "typeIdentifier");
+    const std::string w = xmlAttr(block, "sizeX"), h = xmlAttr(block, "sizeY");
+    if (!w.empty() && w.size() < 7 && std::all_of(w.begin(), w.end(), ::isdigit)) s.width = std::stoi(w);
+    if (!h.empty() && h.size() < 7 && std::all_of(h.begin(), h.end(), ::isdigit)) s.height = std::stoi(h);
+    out.push_back(s);
+  }
+  return out;
+}
+
+/// Root table of a packet payload, size-prefixed or not, with identifier check.
+FbBuf::Table payloadRoot(const FbBuf& b, const char* ident) {
+  b.need(0, 12, "payload header");
+  if (std::memcmp(b.data() + 4, ident, 4) == 0) return b.root(false, ident);
+  if (std::memcmp(b.data() + 8, ident, 4) == 0) return b.root(true, ident);
+  throw FbError(4, std::string("payload identifier is not '") + ident + "'");
+}
+
+struct TableEntry {
+  std::int64_t offset, t0, t1, n;
+  std::int32_t stream, size;
+};
+
+class Aedat4Reader final : public EventReader {
+ public:
+  Aedat4Reader(const std::string& path, const ReaderOptions& o) : f_(path) {
+    path_ = path;
+    options_ = o;
+    char magic[14];
+    std::size_t got = f_.read(magic, 14);
+    std::string m(magic, got);
+    std::size_t hdr_at;
+    if (m.rfind("#!AER-DAT4.0\r\n", 0) == 0) hdr_at = 14;
+    else if (m.rfind("#!AER-DAT4.0\n", 0) == 0) hdr_at = 13;
+    else f_.fail(0, "bad magic line: expected '#!AER-DAT4.0'");
+    f_.seek(hdr_at);
+    unsigned char sz[4];
+    f_.readExact(sz, 4, "IOHeader size");
+    const auto hsize = loadLE<std::int32_t>(sz);
+    if (hsize < 8 || std::uint64_t(hsize) > f_.size() - f_.tell() || hsize > (64 << 20))
+      f_.fail(hdr_at, "IOHeader size " + std::to_string(hsize) + " out of range");
+    std::vector<unsigned char> hb(std::size_t(hsize) + 4);
+    std::memcpy(hb.data(), sz, 4);
+    f_.readExact(hb.data() + 4, std::size_t(hsize), "IOHeader");
+    data_start_ = f_.tell();
+    std::string xml;
+    try {
+      FbBuf b(hb.data(), hb.size());
+      auto t = b.root(true, "IOHE");
+      compression_ = b.scalar<std::int32_t>(t, 0, 0);
+      table_pos_ = b.scalar<std::int64_t>(t, 1, -1);
+      xml = b.string(t, 2);
+    } catch (const FbError& e) {
+      f_.fail(hdr_at + e.offset, std::string("IOHeader: ") + e.what());
+    }
+    if (compression_ < 0 || compression_ > 4)
+      f_.fail(hdr_at, "unknown compression " + std::to_string(compression_));
+    if (table_pos_ >= 0 && (std::uint64_t(table_pos_) < data_start_ || std::uint64_t(table_pos_) > f_.size()))
+      f_.fail(hdr_at, "data table position " + std::to_string(table_pos_) + " outside the file");
+    streams_ = parseStreams(xml);
+    static const char* cnames[] = {"none", "LZ4", "LZ4 high", "Zstd", "Zstd high"};
+    notes_.push_back(std::string("compression ") + cnames[compression_]);
+    for (const auto& s : streams_) {
+      notes_.push_back("stream " + std::to_string(s.id) + " " + s.type +
+                       (s.width ? " " + std::to_string(s.width) + "x" + std::to_string(s.height) : ""));
+      if (s.type == "EVTS" && event_stream_ < 0) {
+        event_stream_ = s.id;
+        width_ = s.width;
+        height_ = s.height;
+      }
+      if (s.type == "IMUS" && imu_stream_ < 0) imu_stream_ = s.id;
+    }
+    if (table_pos_ >= 0) notes_.push_back("file data table at byte " + std::to_string(table_pos_));
+    if (o.width > 0) width_ = o.width;
+    if (o.height > 0) height_ = o.height;
+    f_.seek(data_start_);
+  }
+  Format format() const override { return Format::Aedat4; }
+
+  bool next(std::vector<Event>& batch, std::size_t max) override {
+    batch.clear();
+    if (max == 0) max = 1;
+    while (batch.size() < max) {
+      if (cur_ == count_ && !nextPacket(true, nullptr)) break;
+      drain(batch, max);
+    }
+    return !batch.empty();
+  }
+
+  std::vector<ImuSample> readImu() override {
+    Aedat4Reader other(path_, options_);
+    std::vector<ImuSample> imu;
+    while (other.nextPacket(false, &imu)) {
+    }
+    return imu;
+  }
+
+  bool seekTime(double t_start) override {
+    if (!loadTable()) return false;
+    if (std::isnan(t_start)) return false;
+    const double t_clamped = std::clamp(std::floor(t_start * 1e6), -9.0e18, 9.0e18);
+    const auto t_us = std::int64_t(t_clamped);
+    for (const auto& e : table_) {
+      if (e.stream != event_stream_) continue;
+      if (e.t1 >= t_us) {
+        f_.seek(std::uint64_t(e.offset) - 8);
+        cur_ = count_ = 0;
+        return true;
+      }
+    }
+    f_.seek(end_of_packets());
+    cur_ = count_ = 0;
+    return true;
+  }
+
+ private:
+  std::uint64_t end_of_packets() const { return table_pos_ >= 0 ? std::uint64_t(table_pos_) : f_.size(); }
+
+  void drain(std::vector<Event>& batch, std::size_t max) {
+    for (; cur_ < count_ && batch.size() < max; ++cur_) {
+      const unsigned char* p = events_ + 16 * cur_;
+      const auto t = loadLE<std::int64_t>(p);
+      const auto x = loadLE<std::int16_t>(p + 8);
+      const auto y = loadLE<std::int16_t>(p + 10);
+      const bool on = p[12] != 0;
+      if (x < 0 || y < 0 || (width_ > 0 && x >= width_) || (height_ > 0 && y >= height_)) {
+        warn(&ReaderWarnings::outside_sensor,
+             path_ + ": packet at byte " + std::to_string(pkt_byte_) + ", event " + std::to_string(cur_) +
+                 ": pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the sensor");
+        continue;
+      }
+      if (have_prev_ && t < prev_t_)
+        warn(&ReaderWarnings::backwards_time,
+             path_ + ": packet at byte " + std::to_string(pkt_byte_) + ", event " + std::to_string(cur_) +
+                 ": timestamp " + std::to_string(t) + " us before previous " + std::to_string(prev_t_));
+      prev_t_ = t;
+      have_prev_ = true;
+      Event e;
+      e.t = double(t) * 1e-6;
+      e.x = float(x);
+      e.y = float(y);
+      e.on = on;
+      batch.push_back(e);
+    }
+  }
+
+  /// Decompresses `in` into out_ (bounded by max_packet_bytes).
+  void decompress(const std::vector<unsigned char>& in, std::uint64_t at) {
+    const std::size_t cap = options_.max_packet_bytes;
+    if (compression_ == 0) {
+      out_ = in;
+      return;
+    }
+    out_.clear();
+    if (compression_ == 1 || compression_ == 2) {
+      LZ4F_dctx* ctx = nullptr;
+      if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)))
+        f_.fail(at, "cannot create an LZ4 context");
+      std::size_t src = 0;
+      std::size_t dst_used = 0;
+      out_.resize(std::min(cap, std::max<std::size_t>(in.size() * 4, 1 << 16)));
+      std::size_t ret = 1;
+      while (src < in.size()) {
+        if (dst_used == out_.size()) {
+          if (out_.size() >= cap) {
+            LZ4F_freeDecompressionContext(ctx);
+            f_.fail(at, "LZ4 packet decompresses beyond the " + std::to_string(cap) + "-byte limit");
+          }
+          out_.resize(std::min(cap, out_.size() * 2));
+        }
+        std::size_t dst_len = out_.size() - dst_used;
+        std::size_t src_len = in.size() - src;
+        ret = LZ4F_decompress(ctx, out_.data() + dst_used, &dst_len, in.data() + src, &src_len, nullptr);
+        if (LZ4F_isError(ret)) {
+          std::string msg = LZ4F_getErrorName(ret);
+          LZ4F_freeDecompressionContext(ctx);
+          f_.fail(at, "corrupt LZ4 frame: " + msg);
+        }
+        src += src_len;
+        dst_used += dst_len;
+        if (ret == 0) break;
+        if (src_len == 0 && dst_len == 0) break;
+      }
+      LZ4F_freeDecompressionContext(ctx);
+      if (ret != 0) f_.fail(at, "truncated LZ4 frame");
+      out_.resize(dst_used);
+      return;
+    }
+    // Zstd
+    ZSTD_DStream* ds = ZSTD_createDStream();
+    ZSTD_initDStream(ds);
+    ZSTD_inBuffer ib{in.data(), in.size(), 0};
+    out_.resize(std::min(cap, std::max<std::size_t>(in.size() * 4, 1 << 16)));
+    std::size_t used = 0;
+    std::size_t ret = 1;
+    while (true) {
+      if (used == out_.size()) {
+        if (out_.size() >= cap) {
+          ZSTD_freeDStream(ds);
+          f_.fail(at, "Zstd packet decompresses beyond the " + std::to_string(cap) + "-byte limit");
+        }
+        out_.resize(std::min(cap, out_.size() * 2));
+      }
+      ZSTD_outBuffer ob{out_.data(), out_.size(), used};
+      ret = ZSTD_decompressStream(ds, &ob, &ib);
+      used = ob.pos;
+      if (ZSTD_isError(ret)) {
+        std::string msg = ZSTD_getErrorName(ret);
+        ZSTD_freeDStream(ds);
+        f_.fail(at, "corrupt Zstd frame: " + msg);
+      }
+      if (ret == 0) break;
+      if (ib.pos == ib.size && ob.pos < ob.size) break;  // input exhausted, frame incomplete
+    }
+    ZSTD_freeDStream(ds);
+    if (ret != 0) f_.fail(at, "truncated Zstd frame");
+    out_.resize(used);
+  }
+
+  /// Reads packets until an event packet is loaded (want_events) or, for IMU
+  /// collection, through every packet. Returns false at the end.
+  bool nextPacket(bool want_events, std::vector<ImuSample>* imu) {
+    while (true) {
+      const std::uint64_t at = f_.tell();
+      if (at >= end_of_packets()) return false;
+      unsigned char h[8];
+      f_.readExact(h, 8, "packet header");
+      const auto stream = loadLE<std::int32_t>(h);
+      const auto size = loadLE<std::int32_t>(h + 4);
+      if (size <= 0 || std::uint64_t(size) > end_of_packets() - f_.tell())
+        f_.fail(at, "packet size " + std::to_string(size) + " out of range (" +
+                        std::to_string(end_of_packets() - f_.tell()) + " bytes left): truncated or corrupt");
+      if (std::size_t(size) > options_.max_packet_bytes)
+        f_.fail(at, "packet size " + std::to_string(size) + " exceeds the limit");
+      const bool is_events = stream == event_stream_ && want_events;
+      const bool is_imu = stream == imu_stream_ && imu;
+      if (!is_events && !is_imu) {
+        f_.seek(f_.tell() + std::uint64_t(size));
+        continue;
+      }
+      raw_.resize(std::size_t(size));
+      f_.readExact(raw_.data(), raw_.size(), "packet");
+      decompress(raw_, at);
+      try {
+        FbBuf b(out_.data(), out_.size());
+        if (is_events) {
+          auto t = payloadRoot(b, "EVTS");
+          std::size_t first = 0, count = 0;
+          if (!b.vector(t, 0, 16, first, count)) count = 0;
+          events_ = out_.data() + first;
+          cur_ = 0;
+          count_ = count;
+          pkt_byte_ = at;
+          if (count_ > 0) return true;
+          continue;
+        }
+        auto t = payloadRoot(b, "IMUS");
+        std::size_t first = 0, count = 0;
+        if (!b.vector(t, 0, 4, first, count)) continue;
+        for (std::size_t i = 0; i < count; ++i) {
+          auto it = b.table(b.deref(first + 4 * i));
+          ImuSample s;
+          s.t = double(b.scalar<std::int64_t>(it, 0, 0)) * 1e-6;
+          float v[6];
+          for (int k = 0; k < 6; ++k) v[k] = b.scalar<float>(it, 2 + k, 0.0f);
+          s.accel = Vec3(v[0], v[1], v[2]) * kGravity;
+          s.gyro = Vec3(v[3], v[4], v[5]) * kDegToRad;
+          if (!s.accel.allFinite() || !s.gyro.allFinite())
+            f_.fail(at, "non-finite IMU value in sample " + std::to_string(i));
+          imu->push_back(s);
+        }
+      } catch (const FbError& e) {
+        f_.fail(at, std::string("packet payload (decompressed offset ") + std::to_string(e.offset) +
+                        "): " + e.what());
+      }
+    }
+  }
+
+  bool loadTable() {
+    if (table_loaded_) return !table_.empty();
+    table_loaded_ = true;
+    if (table_pos_ < 0) return false;
+    const std::uint64_t keep = f_.tell();
+    const std::uint64_t len = f_.size() - std::uint64_t(table_pos_);
+    if (len == 0 || len > options_.max_packet_bytes) f_.fail(std::uint64_t(table_pos_), "data table size out of range");
+    f_.seek(std::uint64_t(table_pos_));
+    std::vector<unsigned char> raw(len);
+    f_.readExact(raw.data(), raw.size(), "data table");
+    decompress(raw, std::uint64_t(table_pos_));
+    try {
+      FbBuf b(out_.data(), out_.size());
+      auto t = payloadRoot(b, "FTAB");
+      std::size_t first = 0, count = 0;
+      if (b.vector(t, 0, 4, first, count)) {
+        for (std::size_t i = 0; i < count; ++i) {
+          auto d = b.table(b.deref(first + 4 * i));
+          TableEntry e;
+          e.offset = b.scalar<std::int64_t>(d, 0, -1);
+          const std::size_t ph = b.field(d, 1, 8);
+          e.stream = ph ? b.get<std::int32_t>(ph) : -1;
+          e.size = ph ? b.get<std::int32_t>(ph + 4) : 0;
+          e.n = b.scalar<std::int64_t>(d, 2, 0);
+          e.t0 = b.scalar<std::int64_t>(d, 3, 0);
+          e.t1 = b.scalar<std::int64_t>(d, 4, 0);
+          if (e.offset < std::int64_t(data_start_) + 8 || std::uint64_t(e.offset) > end_of_packets())
+            throw FbError(first + 4 * i, "data table entry offset " + std::to_string(e.offset) + " outside the packets");
+          table_.push_back(e);
+        }
+      }
+    } catch (const FbError& e) {
+      f_.fail(std::uint64_t(table_pos_), std::string("data table: ") + e.what());
+    }
+    // Validate entries against the packet headers they point to.
+    for (const auto& e : table_) {
+      f_.seek(std::uint64_t(e.offset) - 8);
+      unsigned char h[8];
+      f_.readExact(h, 8, "packet header");
+      if (loadLE<std::int32_t>(h) != e.stream || loadLE<std::int32_t>(h + 4) != e.size)
+        f_.fail(std::uint64_t(e.offset) - 8, "data table entry does not match the packet header there");
+    }
+    f_.seek(keep);
+    return !table_.empty();
+  }
+
+  BinFile f_;
+  std::uint64_t data_start_ = 0;
+  std::int32_t compression_ = 0;
+  std::int64_t table_pos_ = -1;
+  std::vector<StreamInfo> streams_;
+  int event_stream_ = -1, imu_stream_ = -1;
+  std::vector<unsigned char> raw_, out_;
+  const unsigned char* events_ = nullptr;
+  std::size_t cur_ = 0, count_ = 0;
+  std::uint64_t pkt_byte_ = 0;
+  bool have_prev_ = false;
+  std::int64_t prev_t_ = 0;
+  bool table_loaded_ = false;
+  std::vector<TableEntry> table_;
+};
+
+}  // namespace
+
+std::unique_ptr<EventReader> openAedat4(const std::string& path, const ReaderOptions& o) {
+  return std::make_unique<Aedat4Reader>(path, o);
+}
+
+}  // namespace celc::io::detail

@@ -1,0 +1,483 @@
+// AEDAT 2.0 / 3.1 / 4.0 readers: round trips through the writers, corrupted and
+// hostile files, and conformance with the real recordings in ../shared/data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "celc/io/window_source.hpp"
+#include "celc/io/writers.hpp"
+#include "io_test_util.hpp"
+
+using namespace celc;
+using namespace celc::io;
+using celc::testing::TempDir;
+
+namespace {
+
+void expectSameEvents(const std::vector<Event>& a, const std::vector<Event>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_NEAR(a[i].t, b[i].t, 1e-9) << i;  // whole microseconds on both sides
+    ASSERT_EQ(a[i].x, b[i].x) << i;
+    ASSERT_EQ(a[i].y, b[i].y) << i;
+    ASSERT_EQ(a[i].on, b[i].on) << i;
+  }
+}
+
+/// IMU equality within the file's resolution.
+void expectSameImu(const std::vector<ImuSample>& a, const std::vector<ImuSample>& b, double gyro_tol,
+                   double accel_tol) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_NEAR(a[i].t, b[i].t, 1e-9) << i;
+    ASSERT_LT((a[i].gyro - b[i].gyro).cwiseAbs().maxCoeff(), gyro_tol) << i;
+    ASSERT_LT((a[i].accel - b[i].accel).cwiseAbs().maxCoeff(), accel_tol) << i;
+  }
+}
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kG = 9.80665;
+
+struct Fixture {
+  std::vector<Event> ev;
+  std::vector<ImuSample> imu;
+};
+Fixture fixture(std::size_t n = 20000, int w = 240, int h = 180, double t0 = 10.0) {
+  Fixture f;
+  f.ev = celc::testing::randomEvents(n, w, h, 11, t0);
+  f.imu = celc::testing::randomImu(f.ev.front().t, f.ev.back().t, 12);
+  return f;
+}
+
+}  // namespace
+
+TEST(IoAedat, Aedat2RoundTrip) {
+  TempDir d;
+  auto f = fixture();
+  writeAedat2(d.file("a.aedat"), f.ev, f.imu);
+  EXPECT_EQ(detectFormat(d.file("a.aedat")), Format::Aedat2);
+  auto r = openEventSource(d.file("a.aedat"));
+  EXPECT_EQ(r->width(), 240);
+  EXPECT_EQ(r->height(), 180);
+  expectSameEvents(readAllEvents(*r), f.ev);
+  // half an LSB: 0.5 / 32.8 deg/s and 0.5 / 4096 g
+  expectSameImu(r->readImu(), f.imu, 0.51 / 32.8 * kDeg, 0.51 / 4096 * kG);
+  EXPECT_EQ(r->warnings().total(), 0u);
+}
+
+TEST(IoAedat, Aedat2FullScaleFromHeaderAndDavis346) {
+  TempDir d;
+  auto f = fixture(3000, 346, 260);
+  writeAedat2(d.file("a.aedat"), f.ev, f.imu, "DAVIS346B", 2000, 16);
+  auto r = openEventSource(d.file("a.aedat"));
+  EXPECT_EQ(r->width(), 346);
+  EXPECT_EQ(r->height(), 260);
+  expectSameEvents(readAllEvents(*r), f.ev);
+  expectSameImu(r->readImu(), f.imu, 0.51 / 16.4 * kDeg, 0.51 / 2048 * kG);
+}
+
+TEST(IoAedat, Aedat2FirstDataByteIsHash) {
+  TempDir d;
+  // raw y = 179 - 37 = 142: the address's first byte is 0x23 = '#'
+  std::vector<Event> ev = {{1.0, 5.0f, 37.0f, true}, {1.5, 6.0f, 38.0f, false}};
+  writeAedat2(d.file("h.aedat"), ev, {});
+  const std::string b = celc::testing::readBytes(d.file("h.aedat"));
+  ASSERT_EQ(b[b.size() - 16], '#');
+  auto r = openEventSource(d.file("h.aedat"));
+  expectSameEvents(readAllEvents(*r), ev);
+}
+
+TEST(IoAedat, Aedat2TimestampWrapIsUnwrapped) {
+  TempDir d;
+  auto ev = celc::testing::randomEvents(40000, 240, 180, 5, 4294.96);  // crosses 2^32 us
+  ASSERT_GT(ev.back().t, 4294.967296);
+  writeAedat2(d.file("w.aedat"), ev, {});
+  auto r = openEventSource(d.file("w.aedat"));
+  expectSameEvents(readAllEvents(*r), ev);
+  EXPECT_EQ(r->warnings().backwards_time, 0u);
+}
+
+TEST(IoAedat, Aedat31RoundTripWithOverflow) {
+  TempDir d;
+  auto f = fixture(20000, 240, 180, 2147.47);  // crosses 2^31 us: tsOverflow 0 -> 1
+  ASSERT_GT(f.ev.back().t, 2147.483648);
+  writeAedat31(d.file("a.aedat31"), f.ev, f.imu, "DAVIS240C", 1000);
+  auto r = openEventSource(d.file("a.aedat31"));
+  EXPECT_EQ(r->format(), Format::Aedat31);
+  EXPECT_EQ(r->width(), 240);
+  expectSameEvents(readAllEvents(*r), f.ev);
+  // float32 in g and deg/s
+  auto imu = r->readImu();
+  ASSERT_EQ(imu.size(), f.imu.size());
+  for (std::size_t i = 0; i < imu.size(); ++i) {
+    EXPECT_LT((imu[i].gyro - f.imu[i].gyro).norm(), 1e-5);
+    EXPECT_LT((imu[i].accel - f.imu[i].accel).norm(), 1e-4);
+  }
+}
+
+TEST(IoAedat, Aedat31SourceFilter) {
+  TempDir d;
+  auto f = fixture(1000);
+  writeAedat31(d.file("a.aedat31"), f.ev, {}, "DAVIS240C", 100);
+  ReaderOptions o;
+  o.aedat_source = 2;  // the writer uses source 1
+  auto r = openEventSource(d.file("a.aedat31"), o);
+  EXPECT_TRUE(readAllEvents(*r).empty());
+  o.aedat_source = 1;
+  auto r1 = openEventSource(d.file("a.aedat31"), o);
+  EXPECT_EQ(readAllEvents(*r1).size(), 1000u);
+}
+
+TEST(IoAedat, Aedat4RoundTripEveryCompression) {
+  TempDir d;
+  auto f = fixture(30000, 320, 240);
+  for (auto c : {Aedat4Compression::None, Aedat4Compression::Lz4, Aedat4Compression::Zstd}) {
+    const std::string p = d.file("a" + std::to_string(int(c)) + ".aedat4");
+    writeAedat4(p, f.ev, f.imu, 320, 240, c, 4096, true);
+    auto r = openEventSource(p);
+    EXPECT_EQ(r->format(), Format::Aedat4);
+    EXPECT_EQ(r->width(), 320);
+    EXPECT_EQ(r->height(), 240);
+    expectSameEvents(readAllEvents(*r), f.ev);
+    auto imu = r->readImu();
+    ASSERT_EQ(imu.size(), f.imu.size());
+    for (std::size_t i = 0; i < imu.size(); ++i) {
+      EXPECT_LT((imu[i].gyro - f.imu[i].gyro).norm(), 1e-5);
+      EXPECT_LT((imu[i].accel - f.imu[i].accel).norm(), 1e-4);
+    }
+  }
+}
+
+TEST(IoAedat, Aedat4SeekWithDataTable) {
+  TempDir d;
+  auto f = fixture(50000, 320, 240);
+  writeAedat4(d.file("t.aedat4"), f.ev, {}, 320, 240, Aedat4Compression::Lz4, 1000, true);
+  writeAedat4(d.file("n.aedat4"), f.ev, {}, 320, 240, Aedat4Compression::Lz4, 1000, false);
+  const double ts = f.ev[37777].t;
+  auto r = openEventSource(d.file("t.aedat4"));
+  ASSERT_TRUE(r->seekTime(ts));
+  auto rest = readAllEvents(*r);
+  // it skipped whole packets before the one holding ts, and nothing at or after ts
+  EXPECT_EQ(rest.size(), 50000u - 37000u);  // packets of 1000: from the one holding event 37777
+  std::size_t after = 0;
+  for (const auto& e : f.ev) after += e.t >= ts;
+  std::size_t got_after = 0;
+  for (const auto& e : rest) got_after += e.t >= ts;
+  EXPECT_EQ(got_after, after);
+  auto r2 = openEventSource(d.file("n.aedat4"));
+  EXPECT_FALSE(r2->seekTime(ts));  // no table: the window source filters instead
+  // window source with a time range gives the same events either way
+  for (const auto& p : {d.file("t.aedat4"), d.file("n.aedat4")}) {
+    auto rr = openEventSource(p);
+    WindowOptions wo;
+    wo.events_per_window = 500;
+    wo.t_start = ts;
+    WindowSource ws(*rr, wo);
+    EventWindow w;
+    ASSERT_TRUE(ws.next(w));
+    EXPECT_EQ(w.events.front().t, ts);
+  }
+}
+
+// ---- bad input -----------------------------------------------------------------
+
+TEST(IoAedatBad, BadMagicLines) {
+  TempDir d;
+  celc::testing::writeBytes(d.file("a.aedat"), "#!AER-DAT9.9\r\n");
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat")), "byte 0", "unsupported AEDAT version");
+  auto f = fixture(100);
+  writeAedat2(d.file("b.aedat"), f.ev, {});
+  std::string b = celc::testing::readBytes(d.file("b.aedat"));
+  b[10] = '1';  // "#!AER-DAT1.0" is not 2.0
+  celc::testing::writeBytes(d.file("b.aedat"), b);
+  EXPECT_IO_ERROR(openEventSource(d.file("b.aedat")), "byte 0", "unsupported AEDAT version");
+  celc::testing::writeBytes(d.file("c.aedat4"), "#!AER-DAT4.0 \n");
+  EXPECT_IO_ERROR(openEventSource(d.file("c.aedat4")), "byte 0", "bad magic");
+  celc::testing::writeBytes(d.file("d.aedat31"), "#!AER-DAT3.1x\r\n");
+  EXPECT_IO_ERROR(openEventSource(d.file("d.aedat31")), "byte 0", "bad magic");
+}
+
+TEST(IoAedatBad, Aedat2TruncatedRecordAndHeader) {
+  TempDir d;
+  auto f = fixture(1000);
+  writeAedat2(d.file("a.aedat"), f.ev, {});
+  std::string b = celc::testing::readBytes(d.file("a.aedat"));
+  celc::testing::writeBytes(d.file("t.aedat"), b.substr(0, b.size() - 3));
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat")), "t.aedat: byte " + std::to_string(b.size() - 8),
+                  "truncated event record");
+  // header cut inside the preferences block
+  const std::size_t prefs = b.find("#End of Preferences");
+  celc::testing::writeBytes(d.file("h.aedat"), b.substr(0, prefs));
+  EXPECT_IO_ERROR(openEventSource(d.file("h.aedat")), "byte " + std::to_string(prefs), "truncated");
+  // header line cut without newline
+  celc::testing::writeBytes(d.file("l.aedat"), "#!AER-DAT2.0\r\n# AEChip: DAVIS240C");
+  EXPECT_IO_ERROR(openEventSource(d.file("l.aedat")), "truncated");
+  // unknown chip: the size is needed to flip y
+  celc::testing::writeBytes(d.file("u.aedat"), "#!AER-DAT2.0\r\n# AEChip: foo.Mystery\r\n");
+  EXPECT_IO_ERROR(openEventSource(d.file("u.aedat")), "sensor size unknown", "Mystery");
+  ReaderOptions o;
+  o.width = 240, o.height = 180;
+  EXPECT_NO_THROW(openEventSource(d.file("u.aedat"), o));
+}
+
+TEST(IoAedatBad, Aedat2OutsideSensorAndBackwards) {
+  TempDir d;
+  std::string b = "#!AER-DAT2.0\r\n# AEChip: x.DAVIS240C\r\n";
+  auto pair = [&](std::uint32_t a, std::uint32_t t) {
+    for (std::uint32_t v : {a, t})
+      for (int s = 24; s >= 0; s -= 8) b.push_back(char((v >> s) & 0xFF));
+  };
+  pair((10u << 22) | (300u << 12), 100);  // x = 300 > 239
+  pair((10u << 22) | (5u << 12), 200);
+  pair((200u << 22) | (5u << 12), 300);   // y = 200 > 179
+  pair((10u << 22) | (6u << 12), 150);    // backwards
+  pair((10u << 22) | (7u << 12) | 0x400u, 400);  // external event: not a pixel
+  celc::testing::writeBytes(d.file("a.aedat"), b);
+  auto r = openEventSource(d.file("a.aedat"));
+  auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(ev[0].y, 179.0f - 10.0f);  // flipped from the bottom-left origin
+  EXPECT_EQ(r->warnings().outside_sensor, 2u);
+  EXPECT_EQ(r->warnings().backwards_time, 1u);
+  ReaderOptions strict;
+  strict.strict = true;
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("a.aedat"), strict), "byte ", "outside");
+}
+
+TEST(IoAedatBad, Aedat31HostileAndTruncatedPackets) {
+  TempDir d;
+  auto f = fixture(1000);
+  writeAedat31(d.file("a.aedat31"), f.ev, {}, "DAVIS240C", 500);
+  const std::string b = celc::testing::readBytes(d.file("a.aedat31"));
+  const std::size_t data = b.find("#!END-HEADER\r\n") + 14;
+  // truncated inside the second packet
+  celc::testing::writeBytes(d.file("t.aedat31"), b.substr(0, b.size() - 100));
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat31")),
+                  "byte " + std::to_string(data + 28 + 500 * 8), "beyond the end of the file");
+  // hostile capacity: 2^31-1 events of 8 bytes
+  std::string h = b;
+  const std::int32_t huge = 0x7FFFFFFF;
+  std::memcpy(&h[data + 16], &huge, 4);
+  celc::testing::writeBytes(d.file("h.aedat31"), h);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("h.aedat31")), "byte " + std::to_string(data), "beyond the end of the file");
+  // capacity == number == large, but beyond the file
+  std::string h2 = b;
+  const std::int32_t big = 100000000;
+  std::memcpy(&h2[data + 16], &big, 4);
+  std::memcpy(&h2[data + 20], &big, 4);
+  celc::testing::writeBytes(d.file("h2.aedat31"), h2);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("h2.aedat31")), "byte " + std::to_string(data), "beyond the end");
+  // wrong event size for polarity
+  std::string s = b;
+  const std::int32_t nine = 9;
+  std::memcpy(&s[data + 4], &nine, 4);
+  celc::testing::writeBytes(d.file("s.aedat31"), s);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("s.aedat31")), "byte " + std::to_string(data));
+  // header without end
+  celc::testing::writeBytes(d.file("e.aedat31"), "#!AER-DAT3.1\r\n#Source 1: DAVIS240C\r\n");
+  EXPECT_IO_ERROR(openEventSource(d.file("e.aedat31")), "END-HEADER");
+  // pixel outside the sensor: x = 500
+  std::string o = b;
+  const std::uint32_t px = (500u << 17) | (3u << 2) | 1u;
+  std::memcpy(&o[data + 28], &px, 4);
+  celc::testing::writeBytes(d.file("o.aedat31"), o);
+  auto r = openEventSource(d.file("o.aedat31"));
+  EXPECT_EQ(readAllEvents(*r).size(), 999u);
+  EXPECT_EQ(r->warnings().outside_sensor, 1u);
+}
+
+TEST(IoAedatBad, Aedat4HostileSizesCorruptFramesAndBombs) {
+  TempDir d;
+  auto f = fixture(5000, 320, 240);
+  writeAedat4(d.file("a.aedat4"), f.ev, f.imu, 320, 240, Aedat4Compression::Lz4, 1000, false);
+  const std::string b = celc::testing::readBytes(d.file("a.aedat4"));
+  std::int32_t hsize;
+  std::memcpy(&hsize, &b[14], 4);
+  const std::size_t first = 18 + std::size_t(hsize);
+  // hostile IOHeader size
+  std::string h = b;
+  const std::int32_t huge = 0x7FFFFFF0;
+  std::memcpy(&h[14], &huge, 4);
+  celc::testing::writeBytes(d.file("h.aedat4"), h);
+  EXPECT_IO_ERROR(openEventSource(d.file("h.aedat4")), "byte 14", "IOHeader size");
+  // hostile packet size
+  std::string p = b;
+  std::memcpy(&p[first + 4], &huge, 4);
+  celc::testing::writeBytes(d.file("p.aedat4"), p);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("p.aedat4")), "byte " + std::to_string(first), "packet size");
+  // truncated file
+  celc::testing::writeBytes(d.file("t.aedat4"), b.substr(0, b.size() - 50));
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat4")), "truncated");
+  // corrupt LZ4 frame (garbage in the first packet's payload)
+  std::string c = b;
+  for (std::size_t i = first + 8 + 10; i < first + 8 + 60; ++i) c[i] = char(0xA5);
+  celc::testing::writeBytes(d.file("c.aedat4"), c);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("c.aedat4")), "byte " + std::to_string(first));
+  // decompression bomb guard: a limit smaller than one decoded packet (1000 * 16 bytes)
+  ReaderOptions small;
+  small.max_packet_bytes = 12000;  // > the compressed packet (~9 kB), < decoded (16 kB)
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("a.aedat4"), small), "beyond the 12000-byte limit");
+}
+
+TEST(IoAedatBad, Aedat4FlatbufferOffsetsChecked) {
+  TempDir d;
+  auto f = fixture(100, 320, 240);
+  writeAedat4(d.file("a.aedat4"), f.ev, {}, 320, 240, Aedat4Compression::None, 1000, false);
+  const std::string b = celc::testing::readBytes(d.file("a.aedat4"));
+  std::int32_t hsize;
+  std::memcpy(&hsize, &b[14], 4);
+  const std::size_t payload = 18 + std::size_t(hsize) + 8;
+  // the EventPacket vector count (payload layout of the writer: count at 36)
+  std::string v = b;
+  const std::uint32_t many = 0x10000000;
+  std::memcpy(&v[payload + 36], &many, 4);
+  celc::testing::writeBytes(d.file("v.aedat4"), v);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("v.aedat4")), "exceeds the buffer");
+  // the root offset pointing outside
+  std::string r = b;
+  const std::uint32_t far = 0x00FFFFFF;
+  std::memcpy(&r[payload + 4], &far, 4);
+  celc::testing::writeBytes(d.file("r.aedat4"), r);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("r.aedat4")), "out of bounds");
+  // a wrong identifier
+  std::string i = b;
+  i[payload + 8] = 'X';
+  celc::testing::writeBytes(d.file("i.aedat4"), i);
+  EXPECT_IO_ERROR(celc::testing::drain(d.file("i.aedat4")), "identifier");
+}
+
+/// Random byte flips and truncations of small valid files: every outcome is
+/// either a successful read or an IoError (no crash, hang, other exception or
+/// huge allocation: max_packet_bytes bounds every buffer).
+TEST(IoAedatBad, MutationFuzzNeverCrashes) {
+  TempDir d;
+  auto f = fixture(600, 240, 180);
+  writeAedat2(d.file("a.aedat2"), f.ev, f.imu);
+  writeAedat31(d.file("a.aedat31"), f.ev, f.imu, "DAVIS240C", 100);
+  writeAedat4(d.file("l.aedat4"), f.ev, f.imu, 240, 180, Aedat4Compression::Lz4, 100, true);
+  writeAedat4(d.file("z.aedat4"), f.ev, f.imu, 240, 180, Aedat4Compression::Zstd, 100, true);
+  writeAedat4(d.file("n.aedat4"), f.ev, f.imu, 240, 180, Aedat4Compression::None, 100, true);
+  writeEventsText(d.file("e.txt"), f.ev);
+  std::mt19937 rng(2024);
+  ReaderOptions o;
+  o.max_packet_bytes = 1 << 20;
+  int errors = 0, oks = 0;
+  for (const char* name : {"a.aedat2", "a.aedat31", "l.aedat4", "z.aedat4", "n.aedat4", "e.txt"}) {
+    const std::string good = celc::testing::readBytes(d.file(name));
+    for (int trial = 0; trial < 60; ++trial) {
+      std::string m = good;
+      if (trial % 4 == 3) {
+        m.resize(std::uniform_int_distribution<std::size_t>(0, m.size() - 1)(rng));
+      } else {
+        const int flips = 1 + trial % 8;
+        for (int k = 0; k < flips; ++k)
+          m[std::uniform_int_distribution<std::size_t>(0, m.size() - 1)(rng)] = char(rng() & 0xFF);
+      }
+      const std::string p = d.file(std::string("m_") + name);
+      celc::testing::writeBytes(p, m);
+      try {
+        (void)scanFile(p, o);
+        ++oks;
+      } catch (const IoError& e) {
+        ++errors;
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << name << " trial " << trial << ": unexpected exception " << e.what();
+      }
+    }
+  }
+  EXPECT_GT(errors, 50);  // the corruptions are mostly detected
+  EXPECT_GT(oks, 10);     // flips inside event payloads stay readable
+}
+
+// ---- conformance with ../shared/data (README facts) --------------------------------
+
+TEST(IoAedatConformance, Davis240Aedat2) {
+  const std::string p = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  SKIP_IF_NO_SHARED(p);
+  auto r = openEventSource(p);
+  EXPECT_EQ(r->width(), 240);
+  EXPECT_EQ(r->height(), 180);
+  auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 162771u);
+  std::size_t on = 0;
+  for (const auto& e : ev) on += e.on;
+  EXPECT_EQ(on, 82944u);
+  EXPECT_EQ(std::llround(ev.front().t * 1e6), 294976755);
+  EXPECT_EQ(std::llround(ev.back().t * 1e6), 297049406);
+  auto imu = r->readImu();
+  ASSERT_EQ(imu.size(), 4833u);
+  // ~429 us apart
+  EXPECT_NEAR((imu.back().t - imu.front().t) / double(imu.size() - 1), 429e-6, 5e-6);
+  // at rest about (0.01, -1.0, -0.03) g with the header's 8 g scale
+  const Vec3 a0 = imu.front().accel / kG;
+  EXPECT_NEAR(a0.x(), 0.01, 0.1);
+  EXPECT_NEAR(a0.y(), -1.0, 0.1);
+  EXPECT_NEAR(a0.z(), -0.03, 0.1);
+  EXPECT_EQ(r->warnings().total(), 0u);
+}
+
+TEST(IoAedatConformance, DerivedAedat31MatchesAedat2) {
+  const std::string p2 = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  const std::string p3 = celc::testing::sharedData("aedat/davis240c_translation_boxes.DERIVED.aedat31");
+  SKIP_IF_NO_SHARED(p3);
+  auto r2 = openEventSource(p2);
+  auto r3 = openEventSource(p3);
+  EXPECT_EQ(r3->width(), 240);
+  // same events, same top-left convention (y flipped in both)
+  expectSameEvents(readAllEvents(*r3), readAllEvents(*r2));
+  auto imu3 = r3->readImu();
+  auto imu2 = r2->readImu();
+  ASSERT_EQ(imu3.size(), 4833u);
+  // the transcoder negated accel x (README / header); gyro and accel y, z agree
+  for (std::size_t i = 0; i < imu3.size(); i += 97) {
+    EXPECT_NEAR(imu3[i].t, imu2[i].t, 1e-9);
+    EXPECT_LT((imu3[i].gyro - imu2[i].gyro).norm(), 1e-4);
+    EXPECT_NEAR(imu3[i].accel.y(), imu2[i].accel.y(), 1e-3);
+    EXPECT_NEAR(imu3[i].accel.x(), -imu2[i].accel.x(), 1e-3);
+  }
+}
+
+TEST(IoAedatConformance, DvxplorerAedat4AllCompressions) {
+  const std::string lz4 = celc::testing::sharedData("aedat/dvxplorer_sample_lz4.aedat4");
+  SKIP_IF_NO_SHARED(lz4);
+  auto r = openEventSource(lz4);
+  EXPECT_EQ(r->width(), 320);
+  EXPECT_EQ(r->height(), 240);
+  auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 111954u);
+  std::size_t on = 0;
+  for (const auto& e : ev) on += e.on;
+  EXPECT_EQ(on, 55023u);
+  EXPECT_EQ(std::llround(ev.front().t * 1e6), 1605537493718345LL);
+  EXPECT_EQ(std::llround(ev.back().t * 1e6), 1605537494308262LL);
+  auto imu = r->readImu();
+  ASSERT_EQ(imu.size(), 475u);
+  EXPECT_EQ(std::llround(imu.front().t * 1e6), 1605537493718788LL);
+  const Vec3 a = imu.front().accel / kG, g = imu.front().gyro / kDeg;
+  EXPECT_LT((a - Vec3(0.126, -0.995, -0.393)).norm(), 2e-3);
+  EXPECT_LT((g - Vec3(0.412, 0.076, -0.412)).norm(), 2e-3);
+  for (const char* other : {"aedat/dvxplorer_sample_zstd.DERIVED.aedat4",
+                            "aedat/dvxplorer_sample_uncompressed.DERIVED.aedat4"}) {
+    auto r2 = openEventSource(celc::testing::sharedData(other));
+    expectSameEvents(readAllEvents(*r2), ev);
+    expectSameImu(r2->readImu(), imu, 1e-12, 1e-12);
+  }
+  // the file data table allows a time-range read
+  auto rs = openEventSource(lz4);
+  const double ts = ev[80000].t;
+  ASSERT_TRUE(rs->seekTime(ts));
+  auto rest = readAllEvents(*rs);
+  EXPECT_LT(rest.size(), 111954u - 60000u);
+  std::size_t want = 0, got = 0;
+  for (const auto& e : ev) want += e.t >= ts;
+  for (const auto& e : rest) got += e.t >= ts;
+  EXPECT_EQ(got, want);
+}
+
+TEST(IoAedatConformance, HeaderOnlyTruncatedIsReported) {
+  const std::string p = celc::testing::sharedData("aedat/header_only_truncated.aedat");
+  SKIP_IF_NO_SHARED(p);
+  EXPECT_IO_ERROR(openEventSource(p), "header_only_truncated.aedat: byte 599", "truncated");
+}

@@ -1,0 +1,56 @@
+// `celc info` end to end: what it prints for a generated file, and a one-line
+// error with a non-zero exit status for a bad one.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+#include "celc/io/writers.hpp"
+#include "io_test_util.hpp"
+
+using namespace celc;
+using celc::testing::TempDir;
+
+namespace {
+int run(const std::string& cmd, std::string& out) {
+  out.clear();
+  std::FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return -1;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int st = ::pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+}  // namespace
+
+TEST(IoCli, InfoPrintsCountsAndRates) {
+  TempDir d;
+  auto ev = celc::testing::randomEvents(3000, 240, 180, 9, 5.0);
+  auto imu = celc::testing::randomImu(ev.front().t, ev.back().t, 10);
+  io::writeAedat4(d.file("a.aedat4"), ev, imu, 240, 180, io::Aedat4Compression::Zstd, 1000, true);
+  std::size_t on = 0;
+  for (const auto& e : ev) on += e.on;
+  std::string out;
+  ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("a.aedat4"), out), 0) << out;
+  EXPECT_NE(out.find("format:        AEDAT 4.0"), std::string::npos) << out;
+  EXPECT_NE(out.find("sensor:        240 x 180 px"), std::string::npos) << out;
+  EXPECT_NE(out.find("events:        3000"), std::string::npos) << out;
+  EXPECT_NE(out.find("(" + std::to_string(on) + " ON)"), std::string::npos) << out;
+  EXPECT_NE(out.find("IMU samples:   " + std::to_string(imu.size())), std::string::npos) << out;
+  EXPECT_NE(out.find("compression Zstd"), std::string::npos) << out;
+}
+
+TEST(IoCli, InfoBadFileIsOneLineErrorNonZeroExit) {
+  TempDir d;
+  celc::testing::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 x 2 1\n");
+  std::string out;
+  EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("e.txt"), out), 0);
+  EXPECT_NE(out.find("e.txt: line 2: non-numeric x"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  celc::testing::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1 1 2 1\n");
+  ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("w.txt"), out), 0) << out;
+  EXPECT_NE(out.find("timestamps backwards 1"), std::string::npos) << out;
+  EXPECT_NE(run(std::string(CELC_BINARY) + " info --strict " + d.file("w.txt"), out), 0);
+}

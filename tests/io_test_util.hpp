@@ -1,0 +1,104 @@
+#pragma once
+// Helpers shared by the io tests: a per-test temporary directory, synthetic
+// recordings with a fixed seed, raw file editing for corruption cases.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "celc/io/event_reader.hpp"
+
+namespace celc::testing {
+
+/// A fresh directory under the system temp dir, removed at destruction.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           ("celc_io_" + std::to_string(::getpid()) + "_" + (info ? std::string(info->test_suite_name()) + "_" + info->name() : "x"));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  ~TempDir() { std::filesystem::remove_all(dir_); }
+  std::string file(const std::string& name) const { return (dir_ / name).string(); }
+
+ private:
+  std::filesystem::path dir_;
+};
+
+/// Time-ordered events on a width x height sensor, whole-microsecond times from t0 [s].
+inline std::vector<Event> randomEvents(std::size_t n, int width, int height, unsigned seed, double t0 = 10.0) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> ux(0, width - 1), uy(0, height - 1), dt(0, 20), pol(0, 1);
+  std::vector<Event> ev(n);
+  long long t_us = (long long)(t0 * 1e6);
+  for (auto& e : ev) {
+    t_us += dt(rng);
+    e.t = double(t_us) * 1e-6;
+    e.x = float(ux(rng));
+    e.y = float(uy(rng));
+    e.on = pol(rng) == 1;
+  }
+  return ev;
+}
+
+/// IMU at 1 kHz over [t0, t1): smooth gyro [rad/s] and accel [m/s^2] within +-4 g / +-500 deg/s.
+inline std::vector<ImuSample> randomImu(double t0, double t1, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<ImuSample> imu;
+  const long long a = (long long)std::ceil(t0 * 1e3), b = (long long)std::floor(t1 * 1e3);
+  for (long long k = a; k < b; ++k) {
+    ImuSample s;
+    s.t = double(k) * 1e-3;
+    s.gyro = Vec3(u(rng), u(rng), u(rng)) * 3.0;
+    s.accel = Vec3(u(rng), u(rng), u(rng)) * 20.0;
+    imu.push_back(s);
+  }
+  return imu;
+}
+
+inline std::string readBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+inline void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+/// Reads everything (events and IMU) from a source; throws what the reader throws.
+inline std::size_t drain(const std::string& path, const io::ReaderOptions& o = {}) {
+  auto r = io::openEventSource(path, o);
+  std::size_t n = io::readAllEvents(*r).size();
+  n += r->readImu().size();
+  return n;
+}
+
+/// Expects an IoError whose message contains every fragment.
+#define EXPECT_IO_ERROR(stmt, ...)                                                   \
+  do {                                                                               \
+    try {                                                                            \
+      stmt;                                                                          \
+      ADD_FAILURE() << "no IoError from " #stmt;                                     \
+    } catch (const celc::io::IoError& e) {                                           \
+      const std::string msg_ = e.what();                                             \
+      for (const std::string& frag_ : std::vector<std::string>{__VA_ARGS__})                                \
+        EXPECT_NE(msg_.find(frag_), std::string::npos) << "message: " << msg_ << "\nmissing: " << frag_; \
+      EXPECT_EQ(msg_.find('\n'), std::string::npos) << "multi-line message: " << msg_; \
+    }                                                                                \
+  } while (0)
+
+inline std::string sharedData(const std::string& rel) {
+  return std::string(CELC_SOURCE_DIR) + "/../shared/data/" + rel;
+}
+#define SKIP_IF_NO_SHARED(path)                                                                     \
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent (" << path                \
+                                                   << "): conformance test needs ../shared/data"
+
+}  // namespace celc::testing

@@ -1,0 +1,210 @@
+// Window source over readers, and the gyroscope over a window.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "celc/geometry/so3.hpp"
+#include "celc/io/imu_window.hpp"
+#include "celc/io/window_source.hpp"
+#include "celc/io/writers.hpp"
+#include "io_test_util.hpp"
+
+using namespace celc;
+using namespace celc::io;
+using celc::testing::TempDir;
+
+TEST(IoWindow, CountWindowsCoverTheFileInOrder) {
+  TempDir d;
+  const auto ev = celc::testing::randomEvents(10500, 240, 180, 7);
+  writeEventsText(d.file("e.txt"), ev);
+  auto r = openEventSource(d.file("e.txt"));
+  WindowOptions o;
+  o.events_per_window = 1000;
+  o.read_batch = 300;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  std::size_t k = 0;
+  while (ws.next(w)) {
+    ASSERT_EQ(w.events.size(), 1000u);
+    EXPECT_EQ(w.index, k);
+    EXPECT_NEAR(w.events.front().t, ev[k * 1000].t, 1e-9);
+    EXPECT_NEAR(w.t1, ev[k * 1000 + 999].t, 1e-9);
+    ++k;
+  }
+  EXPECT_EQ(k, 10u);  // the last 500 events do not make a full window
+  EXPECT_LE(ws.peakBuffered(), 1000u + 300u);  // memory bounded by window + batch
+  // keep_partial returns them
+  auto r2 = openEventSource(d.file("e.txt"));
+  o.keep_partial = true;
+  WindowSource ws2(*r2, o);
+  std::size_t total = 0;
+  while (ws2.next(w)) total += w.events.size();
+  EXPECT_EQ(total, 10500u);
+}
+
+TEST(IoWindow, CountWindowsWithOverlap) {
+  TempDir d;
+  const auto ev = celc::testing::randomEvents(5000, 240, 180, 8);
+  writeAedat2(d.file("e.aedat"), ev, {});
+  auto r = openEventSource(d.file("e.aedat"));
+  WindowOptions o;
+  o.events_per_window = 1000;
+  o.overlap = 0.5;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  std::size_t k = 0;
+  while (ws.next(w)) {
+    EXPECT_NEAR(w.events.front().t, ev[k * 500].t, 1e-9);
+    EXPECT_NEAR(w.events.back().t, ev[k * 500 + 999].t, 1e-9);
+    ++k;
+  }
+  EXPECT_EQ(k, 9u);  // starts 0, 500, ..., 4000
+}
+
+TEST(IoWindow, DurationWindowsHalfOpenWithRange) {
+  TempDir d;
+  // one event every 1 ms from t = 1.000 to 1.999
+  std::vector<Event> ev(1000);
+  for (int i = 0; i < 1000; ++i) ev[std::size_t(i)].t = 1.0 + 1e-3 * i, ev[std::size_t(i)].x = 1, ev[std::size_t(i)].y = 2;
+  writeEventsText(d.file("e.txt"), ev);
+  auto r = openEventSource(d.file("e.txt"));
+  WindowOptions o;
+  o.seconds_per_window = 0.1;
+  o.t_start = 1.2;
+  o.t_end = 1.6;
+  o.read_batch = 64;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  std::vector<std::size_t> counts;
+  while (ws.next(w)) {
+    for (const auto& e : w.events) {
+      EXPECT_GE(e.t, w.t0);
+      EXPECT_LT(e.t, w.t1);
+    }
+    counts.push_back(w.events.size());
+  }
+  // [1.2,1.3) [1.3,1.4) [1.4,1.5) [1.5,1.6): complete, since the stream goes past t_end
+  ASSERT_EQ(counts.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(double(counts[i]), 100.0, 1.0);
+  EXPECT_LE(ws.peakBuffered(), 100u + 64u);
+}
+
+TEST(IoWindow, DurationWindowsOverlapAndEmptyGap) {
+  TempDir d;
+  std::vector<Event> ev;
+  for (int i = 0; i < 100; ++i) ev.push_back({0.001 * i, 1, 1, true});
+  for (int i = 0; i < 100; ++i) ev.push_back({1.0 + 0.001 * i, 1, 1, true});  // gap 0.1 .. 1.0
+  writeEventsText(d.file("e.txt"), ev);
+  auto r = openEventSource(d.file("e.txt"));
+  WindowOptions o;
+  o.seconds_per_window = 0.05;
+  o.overlap = 0.5;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  int empty = 0, n = 0;
+  while (ws.next(w)) {
+    EXPECT_NEAR(w.t0, 0.025 * n, 1e-12);
+    empty += w.events.empty();
+    ++n;
+  }
+  EXPECT_GT(empty, 30);  // windows in the gap are returned, empty
+}
+
+TEST(IoWindow, InvalidOptions) {
+  TempDir d;
+  writeEventsText(d.file("e.txt"), celc::testing::randomEvents(10, 10, 10, 1));
+  auto r = openEventSource(d.file("e.txt"));
+  WindowOptions o;
+  EXPECT_THROW(WindowSource(*r, o), std::invalid_argument);  // neither N nor S
+  o.events_per_window = 10;
+  o.seconds_per_window = 1.0;
+  EXPECT_THROW(WindowSource(*r, o), std::invalid_argument);  // both
+  o.seconds_per_window = 0.0;
+  o.overlap = 1.0;
+  EXPECT_THROW(WindowSource(*r, o), std::invalid_argument);
+  o.overlap = 0.0;
+  o.t_start = 2.0, o.t_end = 1.0;
+  EXPECT_THROW(WindowSource(*r, o), std::invalid_argument);
+  o.t_start = std::nan("");
+  EXPECT_FALSE(o.validate().empty());
+}
+
+// ---- gyroscope over a window ------------------------------------------------------
+
+namespace {
+/// Samples of a linear-in-time rate w(t) = a + b t (IMU frame) every dt from t0 to t1.
+std::vector<ImuSample> linearGyro(const Vec3& a, const Vec3& b, double t0, double t1, double dt) {
+  std::vector<ImuSample> s;
+  for (double t = t0; t <= t1 + 1e-12; t += dt) {
+    ImuSample x;
+    x.t = t;
+    x.gyro = a + b * t;
+    s.push_back(x);
+  }
+  return s;
+}
+}  // namespace
+
+TEST(IoGyro, MeanOfLinearSignalIsExactInCameraFrameWithOffset) {
+  const Vec3 a(0.1, -0.2, 0.3), b(1.0, 0.5, -2.0);
+  const Mat3 R = so3::exp(Vec3(0.3, -0.2, 1.0));
+  const double off = 0.0031;
+  GyroTrack g(linearGyro(a, b, 0.0, 1.0, 0.005), R, off);
+  const double t0 = 0.2137, t1 = 0.4521;  // camera time
+  const GyroWindow w = g.window(t0, t1);
+  ASSERT_TRUE(w.ok());
+  // w_cam(t) = R (a + b (t - off)); its mean over [t0, t1) is at the midpoint
+  const Vec3 expect = R * (a + b * (0.5 * (t0 + t1) - off));
+  EXPECT_LT((w.mean_omega - expect).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(w.times.front(), t0);
+  EXPECT_DOUBLE_EQ(w.times.back(), t1);
+  EXPECT_LT((w.rates.front() - R * (a + b * (t0 - off))).norm(), 1e-12);  // interpolated end
+  EXPECT_LT((g.rateAt(0.3) - R * (a + b * (0.3 - off))).norm(), 1e-12);
+}
+
+TEST(IoGyro, MotionModelFromWindowMatchesConstantRate) {
+  const Vec3 w0(0.5, -1.0, 2.0);
+  GyroTrack g(linearGyro(w0, Vec3::Zero(), 0.0, 1.0, 0.001), Mat3::Identity(), 0.0);
+  const GyroWindow w = g.window(0.4, 0.45);
+  ASSERT_TRUE(w.ok());
+  const MotionModel m = w.motionModel(0.42);
+  const Mat3 expect = so3::exp(w0 * (0.45 - 0.42));
+  EXPECT_LT((m.rotation(0.45) - expect).norm(), 1e-9);
+}
+
+TEST(IoGyro, StatusInsteadOfGuess) {
+  GyroTrack empty({}, Mat3::Identity(), 0.0);
+  EXPECT_EQ(empty.window(0.0, 0.1).status, GyroStatus::NoSamples);
+  auto s = linearGyro(Vec3::Ones(), Vec3::Zero(), 1.0, 2.0, 0.005);
+  GyroTrack g(s, Mat3::Identity(), 0.0);
+  EXPECT_EQ(g.window(0.5, 0.6).status, GyroStatus::NotCovered);
+  EXPECT_EQ(g.window(1.95, 2.1).status, GyroStatus::NotCovered);
+  EXPECT_EQ(g.window(0.3, 0.2).status, GyroStatus::InvalidWindow);
+  EXPECT_EQ(g.window(std::nan(""), 0.2).status, GyroStatus::InvalidWindow);
+  EXPECT_EQ(toString(GyroStatus::NoSamples), "no_gyro");
+  // a 50 ms hole
+  std::vector<ImuSample> holed;
+  for (const auto& x : s)
+    if (x.t < 1.4 || x.t > 1.45) holed.push_back(x);
+  GyroTrack h(holed, Mat3::Identity(), 0.0);
+  EXPECT_EQ(h.window(1.3, 1.5).status, GyroStatus::Gap);
+  EXPECT_TRUE(h.window(1.1, 1.3).ok());
+}
+
+TEST(IoGyroConformance, Davis240WindowAtRest) {
+  const std::string p = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  SKIP_IF_NO_SHARED(p);
+  auto r = openEventSource(p);
+  GyroTrack g(r->readImu(), Mat3::Identity(), 0.0);
+  WindowOptions o;
+  o.events_per_window = 20000;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  int ok = 0;
+  while (ws.next(w)) {
+    const GyroWindow gw = g.window(w.t0, w.t1);
+    ok += gw.ok();
+    EXPECT_LT(gw.mean_omega.norm(), 5.0);  // hand-held: well below 5 rad/s
+  }
+  EXPECT_EQ(ok, 8);  // every full window is covered
+}
