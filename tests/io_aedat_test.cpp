@@ -481,3 +481,27 @@ TEST(IoAedatConformance, HeaderOnlyTruncatedIsReported) {
   SKIP_IF_NO_SHARED(p);
   EXPECT_IO_ERROR(openEventSource(p), "header_only_truncated.aedat: byte 599", "truncated");
 }
+
+/// Files larger than the readers' block buffers (text 4 MB, AEDAT 2.0 8 MB):
+/// lines and records straddling a refill, IMU samples split across blocks.
+TEST(IoAedat, LargeFilesCrossBufferBoundaries) {
+  TempDir d;
+  auto ev = celc::testing::randomEvents(1200000, 240, 180, 21, 1.0);  // 9.6 MB of AEDAT 2.0, ~26 MB of text
+  auto imu = celc::testing::randomImu(ev.front().t, ev.back().t, 22);
+  writeAedat2(d.file("big.aedat"), ev, imu);
+  auto r = openEventSource(d.file("big.aedat"));
+  expectSameEvents(readAllEvents(*r), ev);
+  expectSameImu(r->readImu(), imu, 0.51 / 32.8 * kDeg, 0.51 / 4096 * kG);
+  TextWriteOptions crlf;
+  crlf.crlf = true;
+  writeEventsText(d.file("big.txt"), ev, crlf);
+  auto rt = openEventSource(d.file("big.txt"));
+  const auto got = readAllEvents(*rt);
+  ASSERT_EQ(got.size(), ev.size());
+  for (std::size_t i = 0; i < ev.size(); ++i) {
+    ASSERT_NEAR(got[i].t, ev[i].t, 1e-9) << i;
+    ASSERT_EQ(got[i].x, ev[i].x) << i;
+    ASSERT_EQ(got[i].y, ev[i].y) << i;
+    ASSERT_EQ(got[i].on, ev[i].on) << i;
+  }
+}

@@ -217,6 +217,8 @@ TEST(IoTextBad, EmptyMissingBinaryAndHugeLine) {
   std::vector<Event> b;
   EXPECT_FALSE(r->next(b, 10));
   EXPECT_IO_ERROR(openEventSource(d.file("missing.txt")), "missing.txt", "cannot open");
+  std::filesystem::create_directories(d.file("nodir"));
+  EXPECT_IO_ERROR(openEventSource(d.file("nodir")), "nodir", "without events.txt");
   celc::testing::writeBytes(d.file("bin.dat"), std::string("\x01\x00\x02\x03", 4));
   EXPECT_IO_ERROR(openEventSource(d.file("bin.dat")), "byte 1", "binary");
   celc::testing::writeBytes(d.file("long.txt"), std::string(5u << 20, '1'));
