@@ -2,93 +2,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "yaml_section.hpp"
+
 #include <fstream>
 #include <set>
 #include <sstream>
 
 namespace celc {
-namespace {
+namespace detail {
 
-// A YAML map whose keys are read one by one; finish() rejects the rest.
-class Section {
- public:
-  Section(const YAML::Node& node, std::string origin, std::string path)
-      : node_(node), origin_(std::move(origin)), path_(std::move(path)) {
-    if (node_ && !node_.IsMap() && !node_.IsNull())
-      throw ConfigError(where(node_) + "'" + path_ + "' must be a map of keys");
-  }
-
-  template <typename T>
-  void get(const std::string& key, T& out) {
-    known_.insert(key);
-    if (!node_ || !node_.IsMap() || !node_[key]) return;
-    const YAML::Node v = node_[key];
-    try {
-      out = v.as<T>();
-    } catch (const YAML::Exception&) {
-      throw ConfigError(where(v) + "key '" + full(key) + "': expected " + typeName<T>() +
-                        ", got '" + scalarText(v) + "'");
-    }
-  }
-
-  void getVec3(const std::string& key, Vec3& out) {
-    std::vector<double> v{out.x(), out.y(), out.z()};
-    get(key, v);
-    if (v.size() != 3) throw ConfigError(where(node_[key]) + "key '" + full(key) + "': expected 3 numbers");
-    out = Vec3(v[0], v[1], v[2]);
-  }
-
-  void getVec2(const std::string& key, Vec2& out) {
-    std::vector<double> v{out.x(), out.y()};
-    get(key, v);
-    if (v.size() != 2) throw ConfigError(where(node_[key]) + "key '" + full(key) + "': expected 2 numbers [min, max]");
-    out = Vec2(v[0], v[1]);
-  }
-
-  Section sub(const std::string& key) {
-    known_.insert(key);
-    return Section(node_ && node_.IsMap() ? node_[key] : YAML::Node(), origin_, full(key));
-  }
-
-  void finish() const {
-    if (!node_ || !node_.IsMap()) return;
-    for (const auto& kv : node_) {
-      const std::string k = kv.first.as<std::string>();
-      if (!known_.count(k)) throw ConfigError(where(kv.first) + "unknown key '" + full(k) + "'");
-    }
-  }
-
-  std::string where(const YAML::Node& n) const {
-    const auto mark = n.Mark();
-    return origin_ + (mark.line >= 0 ? ":" + std::to_string(mark.line + 1) : std::string()) + ": ";
-  }
-
- private:
-  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  static std::string scalarText(const YAML::Node& n) {
-    if (n.IsScalar()) return n.Scalar();
-    return n.IsSequence() ? "a list" : (n.IsMap() ? "a map" : "null");
-  }
-  template <typename T>
-  static std::string typeName() {
-    if constexpr (std::is_same_v<T, bool>) return "true or false";
-    else if constexpr (std::is_integral_v<T>) return "an integer";
-    else if constexpr (std::is_floating_point_v<T>) return "a number";
-    else if constexpr (std::is_same_v<T, std::string>) return "a string";
-    else return "a list of numbers";
-  }
-
-  YAML::Node node_;
-  std::string origin_, path_;
-  std::set<std::string> known_;
-};
-
-template <typename Check>
-void checkValid(const std::string& origin, const std::string& section, const Check& errors) {
-  if (!errors.empty()) throw ConfigError(origin + ": section '" + section + "': " + errors);
-}
-
-void readSolver(Section s, SolverOptions& o) {
+void readSolverSection(Section s, SolverOptions& o) {
   Section l = s.sub("linear");
   l.get("max_rows", o.linear.max_rows);
   l.get("seed", o.linear.seed);
@@ -114,6 +37,48 @@ void readSolver(Section s, SolverOptions& o) {
   r.get("num_threads", o.refine.num_threads);
   r.finish();
   s.finish();
+}
+
+std::string solverYaml(const SolverOptions& o, const std::string& in) {
+  std::ostringstream y;
+  y.precision(17);
+  const auto& l = o.linear;
+  const auto& r = o.refine;
+  y << in << "solver:\n"
+    << in << "  linear:\n"
+    << in << "    max_rows: " << l.max_rows << "\n"
+    << in << "    seed: " << l.seed << "\n"
+    << in << "    max_iterations: " << l.max_iterations << "\n"
+    << in << "    huber_k: " << l.huber_k << "\n"
+    << in << "    tolerance: " << l.tolerance << "\n"
+    << in << "    grid_directions: " << l.grid_directions << "\n"
+    << in << "    grid_starts: " << l.grid_starts << "\n"
+    << in << "    grid_rows: " << l.grid_rows << "\n"
+    << in << "    min_clusters: " << l.min_clusters << "\n"
+    << in << "    min_cluster_events: " << l.min_cluster_events << "\n"
+    << in << "    max_sigma_ratio: " << l.max_sigma_ratio << "\n"
+    << in << "    min_parallax_ratio: " << l.min_parallax_ratio << "\n"
+    << in << "    min_parallax_px: " << l.min_parallax_px << "\n"
+    << in << "    resolve_sign: " << (l.resolve_sign ? "true" : "false") << "\n"
+    << in << "  refine:\n"
+    << in << "    huber_px: " << r.huber_px << "\n"
+    << in << "    max_iterations: " << r.max_iterations << "\n"
+    << in << "    max_events: " << r.max_events << "\n"
+    << in << "    seed: " << r.seed << "\n"
+    << in << "    function_tolerance: " << r.function_tolerance << "\n"
+    << in << "    num_threads: " << r.num_threads << "\n";
+  return y.str();
+}
+
+}  // namespace detail
+
+namespace {
+using detail::Section;
+
+
+template <typename Check>
+void checkValid(const std::string& origin, const std::string& section, const Check& errors) {
+  if (!errors.empty()) throw ConfigError(origin + ": section '" + section + "': " + errors);
 }
 
 void readScene(Section s, LineSceneOptions& o) {
@@ -168,7 +133,7 @@ SimulateConfig parseSimulateConfig(const std::string& yaml, const std::string& o
   SimulateConfig cfg;
   Section top(root, origin, "");
   readScene(top.sub("scene"), cfg.scene);
-  readSolver(top.sub("solver"), cfg.solver);
+  detail::readSolverSection(top.sub("solver"), cfg.solver);
   Section study = top.sub("study");
   study.get("trials", cfg.trials);
   study.get("seed", cfg.seed);
@@ -204,8 +169,6 @@ std::string toYaml(const SimulateConfig& c) {
   std::ostringstream y;
   y.precision(17);
   const auto& s = c.scene;
-  const auto& l = c.solver.linear;
-  const auto& r = c.solver.refine;
   y << "# celc " << CELC_VERSION << " effective configuration (units: s, px, m, rad)\n"
     << "scene:\n"
     << "  n_lines: " << s.n_lines << "\n  events_per_line: " << s.events_per_line
@@ -220,18 +183,7 @@ std::string toYaml(const SimulateConfig& c) {
     << "\n  camera: {width: " << s.camera.width << ", height: " << s.camera.height
     << ", fx: " << s.camera.fx << ", fy: " << s.camera.fy << ", cx: " << s.camera.cx
     << ", cy: " << s.camera.cy << "}\n"
-    << "solver:\n  linear:\n    max_rows: " << l.max_rows << "\n    seed: " << l.seed
-    << "\n    max_iterations: " << l.max_iterations << "\n    huber_k: " << l.huber_k
-    << "\n    tolerance: " << l.tolerance << "\n    grid_directions: " << l.grid_directions
-    << "\n    grid_starts: " << l.grid_starts << "\n    grid_rows: " << l.grid_rows
-    << "\n    min_clusters: " << l.min_clusters << "\n    min_cluster_events: "
-    << l.min_cluster_events << "\n    max_sigma_ratio: " << l.max_sigma_ratio
-    << "\n    min_parallax_ratio: " << l.min_parallax_ratio << "\n    min_parallax_px: "
-    << l.min_parallax_px << "\n    resolve_sign: " << (l.resolve_sign ? "true" : "false")
-    << "\n  refine:\n    huber_px: " << r.huber_px << "\n    max_iterations: "
-    << r.max_iterations << "\n    max_events: " << r.max_events << "\n    seed: " << r.seed
-    << "\n    function_tolerance: " << r.function_tolerance << "\n    num_threads: "
-    << r.num_threads << "\nstudy:\n  trials: " << c.trials << "\n  seed: " << c.seed
+    << detail::solverYaml(c.solver, "") << "study:\n  trials: " << c.trials << "\n  seed: " << c.seed
     << "\n  methods: [";
   for (size_t i = 0; i < c.methods.size(); ++i) y << (i ? ", " : "") << toString(c.methods[i]);
   y << "]\n";
