@@ -9,6 +9,9 @@ namespace celc::app {
 
 void registerSimulate(CLI::App& app);
 void registerSolve(CLI::App& app);
+void registerRun(CLI::App& app);
+void registerBatch(CLI::App& app);
+void registerTable(CLI::App& app);
 /// `celc info FILE|DIR` (cmd_info.cpp).
 void registerInfo(CLI::App& app);
 

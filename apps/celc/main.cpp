@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("celc ") + CELC_VERSION);
   // Subcommands, in the order `celc --help` lists them.
+  celc::app::registerRun(app);
+  celc::app::registerBatch(app);
+  celc::app::registerTable(app);
   celc::app::registerSimulate(app);
   celc::app::registerSolve(app);
   celc::app::registerInfo(app);

@@ -1,0 +1,65 @@
+// `celc run`: one recorded sequence cut into windows, every method per window.
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "run_common.hpp"
+
+namespace fs = std::filesystem;
+
+namespace celc::app {
+namespace {
+
+struct RunArgs {
+  RunOverrides o;
+  std::string input, outdir, calib, groundtruth, imu;
+};
+
+void runRun(const RunArgs& a) {
+  configureLogging(a.o.quiet, a.o.verbose);
+  SequenceJob job;
+  job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
+  job.config = buildRunConfig(a.o);
+  job.mode = outputMode(a.o);
+  job.threads = a.o.threads;
+  if (!a.o.shard.empty()) std::tie(job.shard_index, job.shard_count) = parseShard(a.o.shard);
+  const std::string name = fs::path(a.input).filename().string().empty()
+                               ? fs::path(a.input).parent_path().filename().string()
+                               : fs::path(a.input).stem().string();
+  job.outdir = a.outdir.empty() ? "celc_run_" + name : a.outdir;
+  job.title = "celc run " + name;
+  spdlog::info("run: {} -> {}", a.input, job.outdir);
+  Progress progress("run " + name, a.o.quiet);
+  const auto outcome = runSequence(job, [&](std::uint64_t windows, std::uint64_t events) {
+    progress.update(static_cast<int>(windows), -1, events);
+  });
+  progress.finish();
+  printSummary(job.title + " (" + job.outdir + "/summary.md)", outcome);
+}
+
+}  // namespace
+
+void registerRun(CLI::App& app) {
+  auto a = std::make_shared<RunArgs>();
+  auto* cmd = app.add_subcommand(
+      "run",
+      "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (events.txt, "
+      "imu.txt, groundtruth.txt, calib.yaml|calib.txt) or an events/aedat file with --calib "
+      "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
+      "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
+  cmd->add_option("input", a->input, "sequence directory or event file")->required();
+  cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");
+  cmd->add_option("--calib", a->calib, "calibration YAML (docs/calibration.md) or calib.txt")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--groundtruth", a->groundtruth, "poses `t px py pz qx qy qz qw` [s, m]")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--imu", a->imu, "IMU text file (when not in the sequence directory)")
+      ->check(CLI::ExistingFile);
+  addRunOptions(cmd, a->o);
+  cmd->callback([a]() { runRun(*a); });
+}
+
+}  // namespace celc::app

@@ -1,0 +1,106 @@
+#include "run_common.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <fmt/format.h>
+#include <iostream>
+#include <sstream>
+
+#include "celc/config/config.hpp"
+
+namespace celc::app {
+
+void addRunOptions(CLI::App* cmd, RunOverrides& o) {
+  cmd->add_option("-c,--config", o.config, "YAML configuration (see config/run.yaml)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--window-events", o.window_events,
+                  "events per window (the paper's fixed count; overrides windows.events)");
+  cmd->add_option("--window-seconds", o.window_seconds,
+                  "window length [s] instead of an event count (overrides windows.seconds)");
+  cmd->add_option("--methods", o.methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc");
+  cmd->add_option("--omega", o.omega,
+                  "assume this constant angular velocity wx,wy,wz [rad/s, camera frame] instead of "
+                  "the gyroscope (recordings without IMU)");
+  cmd->add_option("--motion-model", o.motion_model, "constant_twist or gyro_integrated");
+  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--set", o.sets,
+                  "override any configuration key, e.g. --set cluster.smoothness_deg=15 "
+                  "(repeatable; YAML values)");
+  cmd->add_option("--shard", o.shard, "K/N: process only windows with index % N == K-1");
+  cmd->add_flag("--force", o.force, "replace results already in the output folder");
+  cmd->add_flag("--resume", o.resume, "continue a run after its last finished window");
+  cmd->add_flag("-q,--quiet", o.quiet, "only warnings and errors on stderr");
+  cmd->add_flag("-v,--verbose", o.verbose, "debug logging");
+}
+
+void applySets(const std::vector<std::string>& sets, RunConfig& c) {
+  for (const std::string& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw std::runtime_error("--set '" + s + "': expected key.path=value");
+    std::stringstream path(s.substr(0, eq));
+    std::string part, yaml, indent;
+    std::vector<std::string> parts;
+    while (std::getline(path, part, '.')) parts.push_back(part);
+    for (size_t i = 0; i < parts.size(); ++i) {
+      yaml += indent + parts[i] + ":" + (i + 1 == parts.size() ? " " + s.substr(eq + 1) + "\n" : "\n");
+      indent += "  ";
+    }
+    applyRunConfig(yaml, "--set " + s, c);
+  }
+}
+
+RunConfig buildRunConfig(const RunOverrides& o) {
+  RunConfig c = o.config.empty() ? RunConfig{} : loadRunConfig(o.config);
+  if (o.window_events > 0) {
+    c.windows.events_per_window = o.window_events;
+    c.windows.seconds_per_window = 0.0;
+  }
+  if (o.window_seconds > 0) {
+    c.windows.seconds_per_window = o.window_seconds;
+    c.windows.events_per_window = 0;
+  }
+  if (!o.methods.empty()) c.methods = parseMethodList(o.methods);
+  if (!o.motion_model.empty()) c.motion = parseMotionModelKind(o.motion_model);
+  if (!o.omega.empty()) {
+    std::vector<double> w;
+    std::stringstream ss(o.omega);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      try {
+        w.push_back(std::stod(item));
+      } catch (const std::exception&) {
+        throw std::runtime_error("--omega '" + o.omega + "': expected wx,wy,wz [rad/s]");
+      }
+    }
+    if (w.size() != 3) throw std::runtime_error("--omega '" + o.omega + "': expected wx,wy,wz [rad/s]");
+    c.omega_source = OmegaSource::Fixed;
+    c.fixed_omega = Vec3(w[0], w[1], w[2]);
+  }
+  applySets(o.sets, c);
+  // Windows run in parallel: keep each window's clustering on one thread.
+  if (o.threads != 1) c.cluster.threads = 1;
+  if (const std::string err = c.validate(); !err.empty()) throw std::runtime_error("configuration: " + err);
+  return c;
+}
+
+OutputMode outputMode(const RunOverrides& o) {
+  if (o.force && o.resume) throw std::runtime_error("--force and --resume exclude each other");
+  return o.resume ? OutputMode::Resume : (o.force ? OutputMode::Force : OutputMode::Create);
+}
+
+void printSummary(const std::string& title, const SequenceOutcome& out) {
+  auto f = [](double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : std::string("-"); };
+  std::cout << "\n" << title << "\n\n"
+            << "| method | windows | ok | with gt | mean eps | median eps | mean phi [rad] | median phi [rad] | consistency R |\n"
+            << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& m : out.summaries)
+    std::cout << "| " << m.method << " | " << m.windows << " | " << m.ok << " | " << m.with_metrics
+              << " | " << f(m.eps_mean) << " | " << f(m.eps_median) << " | " << f(m.phi_mean) << " | "
+              << f(m.phi_median) << " | " << f(m.resultant_length) << " |\n";
+  for (const auto& n : out.notes) std::cout << "- " << n << "\n";
+  std::cout << std::flush;
+}
+
+}  // namespace celc::app

@@ -1,0 +1,54 @@
+#pragma once
+/// \file run_config.hpp
+/// The configuration of `celc run` / `celc batch`: one YAML schema (units in
+/// config/run.yaml) mapped onto the options of every stage. Unknown keys and
+/// wrong types are errors naming the file, the line and the key.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "celc/cluster/cluster.hpp"
+#include "celc/cluster/to_observations.hpp"
+#include "celc/eval/gt_velocity.hpp"
+#include "celc/io/event_reader.hpp"
+#include "celc/io/imu_window.hpp"
+#include "celc/io/window_source.hpp"
+#include "celc/solver/solver.hpp"
+
+namespace celc {
+
+/// Where a window's angular velocity comes from.
+enum class OmegaSource {
+  Gyro,   ///< the recording's gyroscope (imu.txt or the aedat IMU), the default
+  Fixed,  ///< a constant given in the configuration (recordings without IMU)
+};
+
+struct RunConfig {
+  io::ReaderOptions reader;
+  io::WindowOptions windows = [] {
+    io::WindowOptions w;
+    w.events_per_window = 30000;
+    return w;
+  }();
+  MotionModelKind motion = MotionModelKind::ConstantTwist;
+  OmegaSource omega_source = OmegaSource::Gyro;
+  Vec3 fixed_omega = Vec3::Zero();  ///< [rad/s], camera frame, with OmegaSource::Fixed
+  io::GyroWindowOptions gyro;
+  ClusterOptions cluster;
+  ObservationOptions observations;
+  SolverOptions solver;
+  std::vector<Method> methods = allMethods();
+  eval::GtVelocityOptions groundtruth;
+  std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)
+  std::string validate() const;
+};
+
+/// Applies a YAML document onto `config` (absent keys keep their values).
+/// Throws ConfigError / std::runtime_error naming the origin, line and key.
+void applyRunConfig(const std::string& yaml, const std::string& origin, RunConfig& config);
+/// Reads a file with applyRunConfig onto the defaults.
+RunConfig loadRunConfig(const std::string& path);
+/// The effective configuration as YAML (every key).
+std::string toYaml(const RunConfig& config);
+
+}  // namespace celc

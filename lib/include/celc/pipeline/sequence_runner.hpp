@@ -1,0 +1,98 @@
+#pragma once
+/// \file sequence_runner.hpp
+/// `celc run` on one recorded sequence: per window, the events, undistortion,
+/// clustering, boundary lines, the gyroscope for the window, every solver,
+/// then the ground-truth velocity and the metrics where poses exist.
+/// Windows are read in order by the calling thread, processed by a pool of
+/// workers, and handed to the sink in window order.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "celc/pipeline/run_config.hpp"
+
+namespace celc {
+
+/// What a run reads. `events` is an RPG / UZH-FPV sequence directory
+/// (events.txt, imu.txt, groundtruth.txt, calib.yaml or calib.txt inside) or a
+/// single file (events text or aedat); explicit paths override the directory's.
+struct RunInputs {
+  std::string events;
+  std::string calib;        ///< calibration YAML or calib.txt
+  std::string groundtruth;  ///< pose file `t px py pz qx qy qz qw` (optional)
+  std::string imu;          ///< IMU text file (optional; aedat files carry their own)
+};
+
+/// One method's outcome in one window.
+struct MethodRow {
+  Method method = Method::Celc;
+  SolverResult result;
+  bool has_metrics = false;
+  double eps = 0.0, phi = 0.0;  ///< |v_gt - v|, acos(v_gt . v) [rad] on unit vectors
+};
+
+/// Seconds spent per stage in one window (wall time of that window's worker).
+struct StageTimes {
+  double undistort = 0, cluster = 0, lines = 0, solve = 0, groundtruth = 0;
+};
+
+struct WindowRecord {
+  std::uint64_t index = 0;
+  double t0 = 0.0, t1 = 0.0;   ///< [s]
+  std::size_t n_events = 0;
+  int n_clusters = 0;          ///< clusters handed to the solvers
+  /// Empty when the window reached the solvers; else why no method ran
+  /// (`no_gyro`, `not_covered`, `gyro_gap`, `too_few_clusters`, `no_clusters`, ...).
+  std::string window_status;
+  std::vector<MethodRow> rows;  ///< one per configured method
+  bool has_gt = false;
+  Vec3 gt = Vec3::Zero();       ///< unit ground-truth direction (camera frame at t0)
+  double gt_speed = 0.0;        ///< [m/s]
+  StageTimes times;
+};
+
+/// Which windows to process (the others are read and skipped).
+struct WindowFilter {
+  std::int64_t after = -1;     ///< skip windows with index <= after (resume)
+  int shard_index = 0;         ///< process index % shard_count == shard_index
+  int shard_count = 1;
+};
+
+struct RunStats {
+  std::uint64_t windows_read = 0, windows_processed = 0;
+  std::uint64_t events_read = 0, events_processed = 0;
+  double seconds_total = 0.0, seconds_reading = 0.0;
+  StageTimes stage_seconds;  ///< summed over windows
+  std::uint64_t reader_warnings = 0;
+};
+
+class SequenceRunner {
+ public:
+  /// Opens the inputs and loads calibration, IMU and poses. Throws
+  /// io::IoError / ConfigError / std::runtime_error naming the file.
+  SequenceRunner(const RunInputs& inputs, const RunConfig& config);
+  ~SequenceRunner();
+
+  bool hasGroundTruth() const;
+  bool hasImu() const;
+  /// Human-readable description of what was opened (format, sensor, counts).
+  std::vector<std::string> describe() const;
+
+  /// Processes the windows; sink(record) is called on the calling thread in
+  /// window order. progress(windows_done, events_done) likewise.
+  RunStats run(int threads, const WindowFilter& filter,
+               const std::function<void(const WindowRecord&)>& sink,
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+
+  /// Processes one window's events (the per-window pipeline; thread-safe).
+  WindowRecord processWindow(std::uint64_t index, double t0, double t1,
+                             const std::vector<Event>& events) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace celc

@@ -1,0 +1,289 @@
+#include "celc/eval/run_tables.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace celc::eval {
+
+std::string windowsCsvHeader() {
+  return "window,t_start,t_end,n_events,n_clusters,method,status,vx,vy,vz,gt_vx,gt_vy,gt_vz,eps,phi,runtime_ms";
+}
+
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> f;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      f.push_back(cur);
+      cur.clear();
+    } else if (c != '\r') {
+      cur += c;
+    }
+  }
+  f.push_back(cur);
+  return f;
+}
+
+double toDouble(const std::string& s, const std::string& where, const char* col) {
+  double v = 0.0;
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size() || s.empty())
+    throw std::runtime_error(where + ": column '" + col + "' is not a number: '" + s + "'");
+  return v;
+}
+
+double median(std::vector<double> x) {
+  if (x.empty()) return NAN;
+  std::sort(x.begin(), x.end());
+  const size_t n = x.size();
+  return n % 2 ? x[n / 2] : 0.5 * (x[n / 2 - 1] + x[n / 2]);
+}
+
+double mean(const std::vector<double>& x) {
+  if (x.empty()) return NAN;
+  double s = 0;
+  for (double v : x) s += v;
+  return s / static_cast<double>(x.size());
+}
+
+std::string fmt(double x, int digits = 4) {
+  if (!std::isfinite(x)) return "-";
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << x;
+  return os.str();
+}
+
+}  // namespace
+
+std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate_truncated_tail) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const bool complete_last = !content.empty() && content.back() == '\n';
+  std::stringstream ss(content);
+  std::string line;
+  std::vector<WindowsCsvRow> rows;
+  size_t no = 0;
+  std::vector<std::string> lines;
+  while (std::getline(ss, line)) lines.push_back(line);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    no = i + 1;
+    std::string l = lines[i];
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    const std::string where = path + ":" + std::to_string(no);
+    if (no == 1) {
+      if (l != windowsCsvHeader())
+        throw std::runtime_error(where + ": not a celc windows.csv header");
+      continue;
+    }
+    if (l.empty()) continue;
+    const bool last = i + 1 == lines.size();
+    const auto f = split(l);
+    try {
+      if (f.size() != 16)
+        throw std::runtime_error(where + ": expected 16 columns, got " + std::to_string(f.size()));
+      WindowsCsvRow r;
+      r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
+      r.t_start = toDouble(f[1], where, "t_start");
+      r.t_end = toDouble(f[2], where, "t_end");
+      r.n_events = static_cast<std::int64_t>(toDouble(f[3], where, "n_events"));
+      r.n_clusters = static_cast<int>(toDouble(f[4], where, "n_clusters"));
+      r.method = f[5];
+      r.status = f[6];
+      if (r.method.empty() || r.status.empty()) throw std::runtime_error(where + ": empty method or status");
+      r.has_v = !f[7].empty();
+      if (r.has_v) r.v = Vec3(toDouble(f[7], where, "vx"), toDouble(f[8], where, "vy"), toDouble(f[9], where, "vz"));
+      r.has_gt = !f[10].empty();
+      if (r.has_gt)
+        r.gt = Vec3(toDouble(f[10], where, "gt_vx"), toDouble(f[11], where, "gt_vy"), toDouble(f[12], where, "gt_vz"));
+      r.has_metrics = !f[13].empty();
+      if (r.has_metrics) {
+        r.eps = toDouble(f[13], where, "eps");
+        r.phi = toDouble(f[14], where, "phi");
+      }
+      if (!f[15].empty()) r.runtime_ms = toDouble(f[15], where, "runtime_ms");
+      rows.push_back(r);
+    } catch (const std::runtime_error&) {
+      if (last && !complete_last && tolerate_truncated_tail) break;  // interrupted write
+      throw;
+    }
+  }
+  if (lines.empty()) throw std::runtime_error(path + ": empty file");
+  return rows;
+}
+
+std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows) {
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<const WindowsCsvRow*>> by;
+  for (const auto& r : rows) {
+    if (!by.count(r.method)) order.push_back(r.method);
+    by[r.method].push_back(&r);
+  }
+  std::vector<MethodSummary> out;
+  for (const auto& name : order) {
+    MethodSummary s;
+    s.method = name;
+    std::vector<double> eps, phi, rt;
+    Vec3 sum = Vec3::Zero();
+    std::vector<Vec3> dirs;
+    for (const WindowsCsvRow* r : by[name]) {
+      ++s.windows;
+      if (r->status != "ok") continue;
+      ++s.ok;
+      rt.push_back(r->runtime_ms);
+      if (r->has_v && r->v.norm() > 0) {
+        dirs.push_back(r->v.normalized());
+        sum += dirs.back();
+      }
+      if (!r->has_metrics) continue;
+      ++s.with_metrics;
+      eps.push_back(r->eps);
+      phi.push_back(r->phi);
+    }
+    s.eps_mean = mean(eps);
+    s.eps_median = median(eps);
+    s.phi_mean = mean(phi);
+    s.phi_median = median(phi);
+    s.runtime_ms_median = median(rt);
+    if (!dirs.empty()) {
+      s.resultant_length = sum.norm() / static_cast<double>(dirs.size());
+      const Vec3 m = sum.norm() > 0 ? Vec3(sum.normalized()) : dirs.front();
+      std::vector<double> ang;
+      for (const auto& d : dirs) ang.push_back(std::atan2(d.cross(m).norm(), d.dot(m)));
+      s.spread_median = median(ang);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::string summaryMarkdown(const std::string& title, const std::vector<MethodSummary>& methods,
+                            const std::vector<std::string>& notes) {
+  std::ostringstream o;
+  o << "# " << title << "\n\n";
+  for (const auto& n : notes) o << "- " << n << "\n";
+  if (!notes.empty()) o << "\n";
+  o << "| method | windows | ok | with ground truth | mean eps | median eps | mean phi [rad] | median phi [rad] | direction consistency R | median spread [rad] | median runtime [ms] |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& m : methods)
+    o << "| " << m.method << " | " << m.windows << " | " << m.ok << " | " << m.with_metrics << " | "
+      << fmt(m.eps_mean) << " | " << fmt(m.eps_median) << " | " << fmt(m.phi_mean) << " | "
+      << fmt(m.phi_median) << " | " << fmt(m.resultant_length, 3) << " | " << fmt(m.spread_median, 3)
+      << " | " << fmt(m.runtime_ms_median, 2) << " |\n";
+  o << "\neps = |v_gt - v|, phi = acos(v_gt . v) on unit vectors, over the windows with status ok "
+       "and ground truth. R = |mean of the unit estimates| over the ok windows (1: every window "
+       "gives the same direction); spread = angle of each estimate to their mean direction.\n";
+  return o.str();
+}
+
+std::string methodDisplayName(const std::string& m) {
+  if (m == "celc") return "CELC";
+  if (m == "celc_opt") return "CELC+opt";
+  if (m == "celc_ml") return "CELC+ML";
+  if (m == "ce3lc") return "CE3LC";
+  if (m == "npt") return "N-point";
+  return m;
+}
+
+namespace {
+// Columns: every method of any sequence, in order of first appearance.
+std::vector<std::string> columns(const std::vector<SequenceSummary>& seqs) {
+  std::vector<std::string> cols;
+  for (const auto& s : seqs)
+    for (const auto& m : s.methods)
+      if (std::find(cols.begin(), cols.end(), m.method) == cols.end()) cols.push_back(m.method);
+  return cols;
+}
+double valueOf(const SequenceSummary& s, const std::string& method, bool eps) {
+  for (const auto& m : s.methods)
+    if (m.method == method) return eps ? m.eps_mean : m.phi_mean;
+  return NAN;
+}
+// The method with the smallest finite value of a row.
+int best(const SequenceSummary& s, const std::vector<std::string>& cols, bool eps) {
+  int b = -1;
+  for (size_t i = 0; i < cols.size(); ++i) {
+    const double v = valueOf(s, cols[i], eps);
+    if (std::isfinite(v) && (b < 0 || v < valueOf(s, cols[static_cast<size_t>(b)], eps))) b = static_cast<int>(i);
+  }
+  return b;
+}
+std::string latexEscape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '_' || c == '&' || c == '%' || c == '#') o += '\\';
+    o += c;
+  }
+  return o;
+}
+}  // namespace
+
+std::string tableMarkdown(const std::vector<SequenceSummary>& seqs) {
+  const auto cols = columns(seqs);
+  std::ostringstream o;
+  o << "| sequence | error |";
+  for (const auto& c : cols) o << " " << methodDisplayName(c) << " |";
+  o << "\n|---|---|";
+  for (size_t i = 0; i < cols.size(); ++i) o << "---|";
+  o << "\n";
+  for (const auto& s : seqs)
+    for (bool eps : {true, false}) {
+      const int b = best(s, cols, eps);
+      o << "| " << s.label << " | " << (eps ? "eps [m/s]" : "phi [rad]") << " |";
+      for (size_t i = 0; i < cols.size(); ++i) {
+        const std::string v = fmt(valueOf(s, cols[i], eps));
+        o << " " << (static_cast<int>(i) == b ? "**" + v + "**" : v) << " |";
+      }
+      o << "\n";
+    }
+  return o.str();
+}
+
+std::string tableLatex(const std::vector<SequenceSummary>& seqs) {
+  const auto cols = columns(seqs);
+  std::ostringstream o;
+  o << "% celc table: mean errors over the windows with ground truth; best per row in bold\n"
+    << "\\begin{tabular}{ll" << std::string(cols.size(), 'c') << "}\n\\toprule\nSequence & Error";
+  for (const auto& c : cols) o << " & " << latexEscape(methodDisplayName(c));
+  o << " \\\\\n\\midrule\n";
+  for (size_t k = 0; k < seqs.size(); ++k) {
+    const auto& s = seqs[k];
+    for (bool eps : {true, false}) {
+      const int b = best(s, cols, eps);
+      o << (eps ? "\\multirow{2}{*}{" + latexEscape(s.label) + "}" : std::string()) << " & "
+        << (eps ? "$\\epsilon$ [m/s]" : "$\\phi$ [rad]");
+      for (size_t i = 0; i < cols.size(); ++i) {
+        const std::string v = fmt(valueOf(s, cols[i], eps));
+        o << " & " << (static_cast<int>(i) == b ? "\\textbf{" + v + "}" : v);
+      }
+      o << " \\\\\n";
+    }
+    if (k + 1 < seqs.size()) o << "\\midrule\n";
+  }
+  o << "\\bottomrule\n\\end{tabular}\n";
+  return o.str();
+}
+
+std::string tableCsv(const std::vector<SequenceSummary>& seqs) {
+  std::ostringstream o;
+  o << "sequence,method,windows,ok,with_metrics,eps_mean,eps_median,phi_mean,phi_median\n";
+  for (const auto& s : seqs)
+    for (const auto& m : s.methods) {
+      auto num = [&](double x) { return std::isfinite(x) ? fmt(x, 6) : std::string(); };
+      o << s.label << "," << m.method << "," << m.windows << "," << m.ok << "," << m.with_metrics
+        << "," << num(m.eps_mean) << "," << num(m.eps_median) << "," << num(m.phi_mean) << ","
+        << num(m.phi_median) << "\n";
+    }
+  return o.str();
+}
+
+}  // namespace celc::eval
