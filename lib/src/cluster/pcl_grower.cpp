@@ -1,0 +1,52 @@
+// Reference method: PCL normals (k nearest neighbours from a kd-tree) and
+// pcl::RegionGrowing with the same criteria as the grid grower.
+#include <pcl/features/normal_3d_omp.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/region_growing.h>
+
+#include <cmath>
+
+#include "cluster/internal.hpp"
+
+namespace celc::cluster_detail {
+
+Regions growPcl(const Group& g, const ClusterOptions& opt, int threads) {
+  Regions out;
+  const size_t n = g.size();
+  out.label.assign(n, -1);
+  if (n < 3) return out;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->resize(n);
+  for (size_t i = 0; i < n; ++i) (*cloud)[i] = pcl::PointXYZ(g.x[i], g.y[i], g.z[i]);
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(static_cast<unsigned>(threads));
+  ne.setInputCloud(cloud);
+  ne.setSearchMethod(tree);
+  ne.setKSearch(opt.neighbours);
+  ne.compute(*normals);
+
+  pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+  rg.setMinClusterSize(static_cast<pcl::uindex_t>(opt.min_cluster_size));
+  rg.setMaxClusterSize(static_cast<pcl::uindex_t>(opt.max_cluster_size));
+  rg.setSearchMethod(tree);
+  rg.setNumberOfNeighbours(static_cast<unsigned>(opt.neighbours));
+  rg.setInputCloud(cloud);
+  rg.setInputNormals(normals);
+  rg.setSmoothnessThreshold(static_cast<float>(opt.smoothness_deg * M_PI / 180.0));
+  rg.setCurvatureThreshold(static_cast<float>(opt.curvature_threshold));
+  std::vector<pcl::PointIndices> clusters;
+  rg.extract(clusters);
+  int id = 0;
+  for (const auto& c : clusters) {
+    for (const auto i : c.indices)
+      if (i >= 0 && static_cast<size_t>(i) < n) out.label[i] = id;
+    ++id;
+  }
+  out.count = id;
+  return out;
+}
+
+}  // namespace celc::cluster_detail
