@@ -43,6 +43,7 @@ std::string ClusterOptions::validate() const {
     err << "need 0 < c_min_px_per_s <= c_max_px_per_s; ";
   if (neighbours < 3 || neighbours > 1000) err << "neighbours must be in [3, 1000]; ";
   if (grid_radius_px < 1 || grid_radius_px > 5) err << "grid_radius_px must be in [1, 5]; ";
+  if (grow_radius_px < 1 || grow_radius_px > 5) err << "grow_radius_px must be in [1, 5]; ";
   if (!(time_radius_px > 0.0 && time_radius_px <= 100.0)) err << "time_radius_px must be in (0, 100]; ";
   if (min_neighbours < 3) err << "min_neighbours must be >= 3; ";
   if (!(smoothness_deg > 0.0 && smoothness_deg <= 90.0)) err << "smoothness_deg must be in (0, 90]; ";
@@ -71,9 +72,8 @@ bool validEvent(const Event& e) {
          e.y >= 0.0f && e.x < 4096.0f && e.y < 4096.0f;
 }
 
-/// Valid events split into groups, z = c * (t - t0).
-std::vector<Group> makeGroups(const std::vector<Event>& events, double t0, double c,
-                              bool separate) {
+/// Valid events split into groups, t relative to t0.
+std::vector<Group> makeGroups(const std::vector<Event>& events, double t0, bool separate) {
   std::vector<Group> groups(separate ? 2 : 1);
   if (separate) groups[1].on = false;
   for (size_t i = 0; i < events.size(); ++i) {
@@ -82,7 +82,7 @@ std::vector<Group> makeGroups(const std::vector<Event>& events, double t0, doubl
     Group& g = groups[separate && !e.on ? 1 : 0];
     g.x.push_back(e.x);
     g.y.push_back(e.y);
-    g.z.push_back(static_cast<float>(c * (e.t - t0)));
+    g.t.push_back(static_cast<float>(e.t - t0));
     g.event_index.push_back(static_cast<int>(i));
   }
   return groups;
@@ -94,14 +94,14 @@ struct PlaneFit {
   double rms = 0.0;
 };
 
-PlaneFit fitPlane(const Group& g, const std::vector<int>& idx) {
+PlaneFit fitPlane(const Group& g, double c, const std::vector<int>& idx) {
   PlaneFit f;
   if (idx.empty()) return f;
-  for (int i : idx) f.centroid += Vec3(g.x[i], g.y[i], g.z[i]);
+  for (int i : idx) f.centroid += Vec3(g.x[i], g.y[i], c * g.t[i]);
   f.centroid /= static_cast<double>(idx.size());
   Mat3 cov = Mat3::Zero();
   for (int i : idx) {
-    const Vec3 d = Vec3(g.x[i], g.y[i], g.z[i]) - f.centroid;
+    const Vec3 d = Vec3(g.x[i], g.y[i], c * g.t[i]) - f.centroid;
     cov += d * d.transpose();
   }
   cov /= static_cast<double>(idx.size());
@@ -133,11 +133,11 @@ double spatialExtent(const Group& g, const std::vector<int>& idx) {
 }
 
 /// Sequential RANSAC: extracts up to opt.max_split planes from a non-planar region.
-std::vector<std::vector<int>> splitPlanes(const Group& g, std::vector<int> idx,
+std::vector<std::vector<int>> splitPlanes(const Group& g, double c, std::vector<int> idx,
                                           const ClusterOptions& opt, std::mt19937& rng) {
   std::vector<std::vector<int>> parts;
   const double thr = opt.ransac_threshold_px;
-  auto pt = [&](int i) { return Vec3(g.x[i], g.y[i], g.z[i]); };
+  auto pt = [&](int i) { return Vec3(g.x[i], g.y[i], c * g.t[i]); };
   for (int part = 0; part < opt.max_split; ++part) {
     if (static_cast<int>(idx.size()) < opt.min_cluster_size) break;
     const size_t n = idx.size();
@@ -161,7 +161,7 @@ std::vector<std::vector<int>> splitPlanes(const Group& g, std::vector<int> idx,
     for (int i : idx)
       if (std::fabs(best_n.dot(pt(i) - best_p)) < thr) in.push_back(i);
     if (static_cast<int>(in.size()) < opt.min_cluster_size) break;
-    const PlaneFit f = fitPlane(g, in);
+    const PlaneFit f = fitPlane(g, c, in);
     in.clear();
     std::vector<int> rest;
     for (int i : idx) (std::fabs(f.normal.dot(pt(i) - f.centroid)) < thr ? in : rest).push_back(i);
@@ -179,14 +179,15 @@ struct GroupOutput {
   double ms_grow = 0.0, ms_post = 0.0;
 };
 
-GroupOutput processGroup(const std::vector<Event>& events, const Group& g, double c,
+GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
+                         const cluster_detail::GridIndex* index, double c,
                          const ClusterOptions& opt, int threads) {
   GroupOutput out;
   if (static_cast<int>(g.size()) < opt.min_cluster_size) return out;
   auto t_start = Clock::now();
-  const Regions regions = opt.method == ClusterMethod::Pcl
-                              ? cluster_detail::growPcl(g, opt, threads)
-                              : cluster_detail::growGrid(g, opt, threads);
+  const Regions regions = opt.method == ClusterMethod::Pcl || index == nullptr
+                              ? cluster_detail::growPcl(g, c, opt, threads)
+                              : cluster_detail::growGrid(*index, c, opt, threads);
   out.ms_grow = msSince(t_start);
   t_start = Clock::now();
   // Index lists of the regions large enough to matter.
@@ -245,16 +246,16 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g, doubl
     out.clusters.push_back(std::move(ev));
   };
   for (auto& idx : lists) {
-    const PlaneFit f = fitPlane(g, idx);
+    const PlaneFit f = fitPlane(g, c, idx);
     if (f.rms <= opt.max_plane_rms_px) {
       accept(std::move(idx), f);
       continue;
     }
-    auto parts = splitPlanes(g, std::move(idx), opt, rng);
+    auto parts = splitPlanes(g, c, std::move(idx), opt, rng);
     if (parts.size() > 1) ++out.n_split;
     bool any = false;
     for (auto& p : parts) {
-      const PlaneFit pf = fitPlane(g, p);
+      const PlaneFit pf = fitPlane(g, c, p);
       if (pf.rms <= opt.max_plane_rms_px) {
         accept(std::move(p), pf);
         any = true;
@@ -287,28 +288,13 @@ double estimateTimeScale(const std::vector<Event>& events, const ClusterOptions&
   for (const Event& e : events)
     if (validEvent(e)) t0 = std::min(t0, e.t), ++n_valid;
   if (n_valid < 50) return 0.0;
-  double c = initialTimeScale(events, opt);
-  const size_t stride = std::max<size_t>(1, n_valid / 20000);
-  std::vector<float> nx, ny, nz, cv;
-  for (int iter = 0; iter < 3; ++iter) {
-    std::vector<double> speeds;
-    for (const Group& g : makeGroups(events, t0, c, opt.separate_polarity)) {
-      cluster_detail::gridNormals(g, opt, static_cast<int>(stride), nx, ny, nz, cv);
-      for (size_t k = 0; k < nx.size(); ++k) {
-        if (cv[k] > opt.curvature_threshold) continue;
-        const double nxy = std::hypot(nx[k], ny[k]);
-        if (nxy > 1e-3) speeds.push_back(c * std::fabs(nz[k]) / nxy);
-      }
-    }
-    if (speeds.size() < 20) return iter == 0 ? 0.0 : c;
-    auto mid = speeds.begin() + speeds.size() / 2;
-    std::nth_element(speeds.begin(), mid, speeds.end());
-    const double next = std::clamp(*mid, opt.c_min_px_per_s, opt.c_max_px_per_s);
-    const bool converged = std::fabs(next - c) < 0.05 * c;
-    c = next;
-    if (converged) break;
-  }
-  return c;
+  const std::vector<Group> groups = makeGroups(events, t0, opt.separate_polarity);
+  std::vector<cluster_detail::GridIndex> indexes;
+  std::vector<const cluster_detail::GridIndex*> ptrs;
+  indexes.reserve(groups.size());
+  for (const Group& g : groups) indexes.emplace_back(g);
+  for (const auto& ix : indexes) ptrs.push_back(&ix);
+  return cluster_detail::estimateTimeScaleOnIndex(ptrs, initialTimeScale(events, opt), opt);
 }
 
 ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptions& opt) {
@@ -337,25 +323,38 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
     return res;
   }
   res.t0 = t0;
+  const std::vector<Group> groups = makeGroups(events, t0, opt.separate_polarity);
   auto t_c = Clock::now();
+  // Grid indexes: used by the grid grower and by the automatic time scale.
+  std::vector<cluster_detail::GridIndex> indexes;
+  std::vector<const cluster_detail::GridIndex*> ptrs;
+  const bool need_index = opt.method == ClusterMethod::Grid || opt.c_px_per_s <= 0.0;
+  if (need_index) {
+    indexes.reserve(groups.size());
+    for (const Group& g : groups) indexes.emplace_back(g);
+    for (const auto& ix : indexes) ptrs.push_back(&ix);
+  }
   double c = opt.c_px_per_s;
   if (c <= 0.0) {
-    c = estimateTimeScale(events, opt);
-    if (c <= 0.0) c = initialTimeScale(events, opt);
+    const double c0 = initialTimeScale(events, opt);
+    c = cluster_detail::estimateTimeScaleOnIndex(ptrs, c0, opt);
+    if (c <= 0.0) c = c0;
   }
   res.c_px_per_s = c;
   res.ms_time_scale = msSince(t_c);
 
-  const std::vector<Group> groups = makeGroups(events, t0, c, opt.separate_polarity);
   std::vector<GroupOutput> outs(groups.size());
+  auto indexOf = [&](size_t k) {
+    return opt.method == ClusterMethod::Grid ? &indexes[k] : nullptr;
+  };
   if (groups.size() == 2 && opt.threads >= 2) {
     const int per = std::max(1, opt.threads / 2);
-    std::thread other([&] { outs[1] = processGroup(events, groups[1], c, opt, per); });
-    outs[0] = processGroup(events, groups[0], c, opt, per);
+    std::thread other([&] { outs[1] = processGroup(events, groups[1], indexOf(1), c, opt, per); });
+    outs[0] = processGroup(events, groups[0], indexOf(0), c, opt, per);
     other.join();
   } else {
     for (size_t k = 0; k < groups.size(); ++k)
-      outs[k] = processGroup(events, groups[k], c, opt, opt.threads);
+      outs[k] = processGroup(events, groups[k], indexOf(k), c, opt, opt.threads);
   }
   // Clusters ordered by start time, labelled 0..K-1.
   struct Item {

@@ -10,153 +10,178 @@
 #include "cluster/internal.hpp"
 
 namespace celc::cluster_detail {
+
+GridIndex::GridIndex(const Group& g) {
+  const size_t n = g.size();
+  if (n == 0) return;
+  int xmin = 1 << 30, ymin = 1 << 30, xmax = -(1 << 30), ymax = -(1 << 30);
+  std::vector<int> pix(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int xi = static_cast<int>(std::lround(g.x[i])), yi = static_cast<int>(std::lround(g.y[i]));
+    xmin = std::min(xmin, xi), xmax = std::max(xmax, xi);
+    ymin = std::min(ymin, yi), ymax = std::max(ymax, yi);
+  }
+  w_ = xmax - xmin + 1;
+  h_ = ymax - ymin + 1;
+  for (size_t i = 0; i < n; ++i)
+    pix[i] = (static_cast<int>(std::lround(g.y[i])) - ymin) * w_ +
+             static_cast<int>(std::lround(g.x[i])) - xmin;
+  // Points in order of increasing time (usually already so).
+  std::vector<int> by_time(n);
+  std::iota(by_time.begin(), by_time.end(), 0);
+  if (!std::is_sorted(g.t.begin(), g.t.end()))
+    std::stable_sort(by_time.begin(), by_time.end(), [&](int a, int b) { return g.t[a] < g.t[b]; });
+  // Counting sort by pixel, stable: time ascending inside each bucket.
+  start_.assign(static_cast<size_t>(w_) * h_ + 1, 0);
+  for (size_t i = 0; i < n; ++i) ++start_[pix[i] + 1];
+  for (size_t p = 1; p < start_.size(); ++p) start_[p] += start_[p - 1];
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  point_.resize(n);
+  cells_.resize(n);
+  for (int i : by_time) {
+    const int k = fill[pix[i]]++;
+    point_[k] = i;
+    cells_[k] = {g.t[i], static_cast<int16_t>(pix[i] % w_), static_cast<int16_t>(pix[i] / w_)};
+  }
+}
+
 namespace {
 
-constexpr int kMaxPerPixel = 8;  // neighbours taken from one pixel at most (hot pixels)
-
-class GridIndex {
- public:
-  GridIndex(const Group& g, const ClusterOptions& opt)
-      : r_(opt.grid_radius_px), rt_(static_cast<float>(opt.time_radius_px)) {
-    const size_t n = g.size();
-    if (n == 0) return;
-    int xmin = 1 << 30, ymin = 1 << 30, xmax = -(1 << 30), ymax = -(1 << 30);
-    std::vector<int> xi(n), yi(n);
-    for (size_t i = 0; i < n; ++i) {
-      xi[i] = static_cast<int>(std::lround(g.x[i]));
-      yi[i] = static_cast<int>(std::lround(g.y[i]));
-      xmin = std::min(xmin, xi[i]);
-      xmax = std::max(xmax, xi[i]);
-      ymin = std::min(ymin, yi[i]);
-      ymax = std::max(ymax, yi[i]);
-    }
-    w_ = xmax - xmin + 1;
-    h_ = ymax - ymin + 1;
-    // Points in order of increasing z (usually already so).
-    std::vector<int> by_time(n);
-    std::iota(by_time.begin(), by_time.end(), 0);
-    if (!std::is_sorted(g.z.begin(), g.z.end()))
-      std::stable_sort(by_time.begin(), by_time.end(),
-                       [&](int a, int b) { return g.z[a] < g.z[b]; });
-    // Counting sort by pixel, stable: z ascending inside each bucket.
-    start_.assign(static_cast<size_t>(w_) * h_ + 1, 0);
-    for (size_t i = 0; i < n; ++i) ++start_[pixel(xi[i] - xmin, yi[i] - ymin) + 1];
-    for (size_t p = 1; p < start_.size(); ++p) start_[p] += start_[p - 1];
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    point_.resize(n);
-    px_.resize(n);
-    py_.resize(n);
-    z_.resize(n);
-    for (int i : by_time) {
-      const int k = fill[pixel(xi[i] - xmin, yi[i] - ymin)]++;
-      point_[k] = i;
-      px_[k] = xi[i] - xmin;
-      py_[k] = yi[i] - ymin;
-      z_[k] = g.z[i];
-    }
-  }
-
-  size_t size() const { return z_.size(); }
-  int point(int k) const { return point_[k]; }
-
-  /// Calls f(j) for every bucket position j in the neighbourhood of k (k included).
-  template <class F>
-  void forNeighbours(int k, F&& f) const {
-    const int x0 = px_[k], y0 = py_[k];
-    const float z = z_[k];
-    const float* zb = z_.data();
-    for (int y = std::max(0, y0 - r_); y <= std::min(h_ - 1, y0 + r_); ++y) {
-      for (int x = std::max(0, x0 - r_); x <= std::min(w_ - 1, x0 + r_); ++x) {
-        const size_t p = pixel(x, y);
-        const int b = start_[p], e = start_[p + 1];
-        if (b == e) continue;
-        const float* lo = std::lower_bound(zb + b, zb + e, z - rt_);
-        const float* hi = std::upper_bound(lo, zb + e, z + rt_);
-        if (hi - lo > kMaxPerPixel) {  // keep the ones nearest in time
-          const float* mid = std::lower_bound(lo, hi, z);
-          lo = std::max(lo, mid - kMaxPerPixel / 2);
-          hi = std::min(hi, lo + kMaxPerPixel);
-        }
-        for (const float* q = lo; q < hi; ++q) f(static_cast<int>(q - zb));
-      }
-    }
-  }
-
-  /// Plane normal and curvature of the neighbourhood of k; false if degenerate.
-  bool normal(int k, int min_neighbours, float* out_n, float* out_curv) const {
-    double s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
-    int cnt = 0;
-    const float x0 = static_cast<float>(px_[k]), y0 = static_cast<float>(py_[k]), z0 = z_[k];
-    forNeighbours(k, [&](int j) {
-      const double dx = px_[j] - x0, dy = py_[j] - y0, dz = z_[j] - z0;
-      s[0] += dx, s[1] += dy, s[2] += dz;
-      ss[0] += dx * dx, ss[1] += dx * dy, ss[2] += dx * dz;
-      ss[3] += dy * dy, ss[4] += dy * dz, ss[5] += dz * dz;
-      ++cnt;
-    });
-    if (cnt < min_neighbours) return false;
-    const double inv = 1.0 / cnt;
-    const double m0 = s[0] * inv, m1 = s[1] * inv, m2 = s[2] * inv;
-    Eigen::Matrix3d c;
-    c(0, 0) = ss[0] * inv - m0 * m0;
-    c(0, 1) = c(1, 0) = ss[1] * inv - m0 * m1;
-    c(0, 2) = c(2, 0) = ss[2] * inv - m0 * m2;
-    c(1, 1) = ss[3] * inv - m1 * m1;
-    c(1, 2) = c(2, 1) = ss[4] * inv - m1 * m2;
-    c(2, 2) = ss[5] * inv - m2 * m2;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-    es.computeDirect(c);
-    const Eigen::Vector3d ev = es.eigenvalues();  // ascending
-    const double sum = ev.sum();
-    // Degenerate: all points on one spot or one line (e.g. a single hot pixel).
-    if (!(sum > 1e-9) || ev(1) < 1e-3 * sum || ev(1) < 1e-4) return false;
-    const Eigen::Vector3d nrm = es.eigenvectors().col(0);
-    out_n[0] = static_cast<float>(nrm(0));
-    out_n[1] = static_cast<float>(nrm(1));
-    out_n[2] = static_cast<float>(nrm(2));
-    *out_curv = static_cast<float>(std::max(0.0, ev(0)) / sum);
-    return true;
-  }
-
- private:
-  size_t pixel(int x, int y) const { return static_cast<size_t>(y) * w_ + x; }
-  int r_ = 2;
-  float rt_ = 2.5f;
-  int w_ = 0, h_ = 0;
-  std::vector<int> start_, point_, px_, py_;
-  std::vector<float> z_;
-};
-
-template <class F>
-void parallelFor(int n, int threads, F&& f) {
-  threads = std::max(1, std::min(threads, n / 4096 + 1));
-  if (threads == 1) {
-    f(0, n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const int chunk = (n + threads - 1) / threads;
-  for (int t = 0; t < threads; ++t) {
-    const int b = t * chunk, e = std::min(n, b + chunk);
-    if (b < e) pool.emplace_back([&f, b, e] { f(b, e); });
-  }
-  for (auto& th : pool) th.join();
+/// Normal (eigenvector of the smallest eigenvalue) and curvature from the
+/// central moments of a neighbourhood; false when degenerate.
+bool normalFromCovariance(const Eigen::Matrix3d& cov, float* out_n, float* out_curv) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov);
+  const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+  const double sum = ev.sum();
+  // Degenerate: all points on one spot or one line (e.g. a single hot pixel).
+  if (!(sum > 1e-9) || ev(1) < 1e-3 * sum || ev(1) < 1e-4) return false;
+  const Eigen::Vector3d nrm = es.eigenvectors().col(0);
+  out_n[0] = static_cast<float>(nrm(0));
+  out_n[1] = static_cast<float>(nrm(1));
+  out_n[2] = static_cast<float>(nrm(2));
+  *out_curv = static_cast<float>(std::max(0.0, ev(0)) / sum);
+  return true;
 }
 
 }  // namespace
 
-Regions growGrid(const Group& g, const ClusterOptions& opt, int threads) {
+bool GridIndex::normal(int k, double c, const ClusterOptions& opt, float* out_n,
+                       float* out_curv) const {
+  float s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
+  int cnt = 0;
+  const Cell& c0 = cells_[k];
+  const float cf = static_cast<float>(c);
+  forNeighbours(k, opt.grid_radius_px, static_cast<float>(opt.time_radius_px / c), [&](int j) {
+    const Cell& q = cells_[j];
+    const float dx = static_cast<float>(q.x - c0.x), dy = static_cast<float>(q.y - c0.y);
+    const float dz = cf * (q.t - c0.t);
+    s[0] += dx, s[1] += dy, s[2] += dz;
+    ss[0] += dx * dx, ss[1] += dx * dy, ss[2] += dx * dz;
+    ss[3] += dy * dy, ss[4] += dy * dz, ss[5] += dz * dz;
+    ++cnt;
+  });
+  if (cnt < opt.min_neighbours) return false;
+  const double inv = 1.0 / cnt;
+  const double m0 = s[0] * inv, m1 = s[1] * inv, m2 = s[2] * inv;
+  Eigen::Matrix3d cov;
+  cov(0, 0) = ss[0] * inv - m0 * m0;
+  cov(0, 1) = cov(1, 0) = ss[1] * inv - m0 * m1;
+  cov(0, 2) = cov(2, 0) = ss[2] * inv - m0 * m2;
+  cov(1, 1) = ss[3] * inv - m1 * m1;
+  cov(1, 2) = cov(2, 1) = ss[4] * inv - m1 * m2;
+  cov(2, 2) = ss[5] * inv - m2 * m2;
+  return normalFromCovariance(cov, out_n, out_curv);
+}
+
+void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, float* nrm,
+                           float* curv) const {
+  const int r = opt.grid_radius_px;
+  const double tau = opt.time_radius_px / c;
+  const int n_pix = w_ * h_;
+  auto work = [&](int p_begin, int p_end) {
+    struct Nb {
+      int lo, hi, end;
+      double dx, dy;
+    };
+    std::vector<Nb> nb;
+    nb.reserve((2 * r + 1) * (2 * r + 1));
+    for (int p = p_begin; p < p_end; ++p) {
+      const int b = start_[p], e = start_[p + 1];
+      if (b == e) continue;
+      const int px = p % w_, py = p / w_;
+      nb.clear();
+      for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); ++y)
+        for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); ++x) {
+          const int q = y * w_ + x;
+          if (start_[q] != start_[q + 1])
+            nb.push_back({start_[q], start_[q], start_[q + 1], double(x - px), double(y - py)});
+        }
+      // Running sums over the events inside the windows: count, dx, dy, dx^2,
+      // dx dy, dy^2, t, t^2, dx t, dy t (t relative to this pixel's first event).
+      double S[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+      const double tb = cells_[b].t;
+      for (int k = b; k < e; ++k) {
+        const double tk = cells_[k].t;
+        for (Nb& q : nb) {
+          while (q.hi < q.end && cells_[q.hi].t <= tk + tau) {
+            const double t = cells_[q.hi].t - tb;
+            S[0] += 1, S[1] += q.dx, S[2] += q.dy, S[3] += q.dx * q.dx, S[4] += q.dx * q.dy;
+            S[5] += q.dy * q.dy, S[6] += t, S[7] += t * t, S[8] += q.dx * t, S[9] += q.dy * t;
+            ++q.hi;
+          }
+          while (q.lo < q.hi && cells_[q.lo].t < tk - tau) {
+            const double t = cells_[q.lo].t - tb;
+            S[0] -= 1, S[1] -= q.dx, S[2] -= q.dy, S[3] -= q.dx * q.dx, S[4] -= q.dx * q.dy;
+            S[5] -= q.dy * q.dy, S[6] -= t, S[7] -= t * t, S[8] -= q.dx * t, S[9] -= q.dy * t;
+            ++q.lo;
+          }
+        }
+        curv[k] = 2.0f;
+        const double n = S[0];
+        if (n < opt.min_neighbours) continue;
+        // Central moments of (dx, dy, c t).
+        const double mx = S[1] / n, my = S[2] / n, mt = S[6] / n;
+        Eigen::Matrix3d cov;
+        cov(0, 0) = S[3] / n - mx * mx;
+        cov(0, 1) = cov(1, 0) = S[4] / n - mx * my;
+        cov(1, 1) = S[5] / n - my * my;
+        cov(0, 2) = cov(2, 0) = c * (S[8] / n - mx * mt);
+        cov(1, 2) = cov(2, 1) = c * (S[9] / n - my * mt);
+        cov(2, 2) = c * c * (S[7] / n - mt * mt);
+        if (!normalFromCovariance(cov, &nrm[3 * static_cast<size_t>(k)], &curv[k])) curv[k] = 2.0f;
+      }
+    }
+  };
+  threads = std::max(1, std::min(threads, static_cast<int>(size() / 4096) + 1));
+  if (threads == 1) {
+    work(0, n_pix);
+    return;
+  }
+  // Split the pixels so that each worker gets about the same number of events.
+  std::vector<std::thread> pool;
+  int p0 = 0;
+  for (int t = 0; t < threads; ++t) {
+    const size_t target = size() * static_cast<size_t>(t + 1) / static_cast<size_t>(threads);
+    int p1 = t + 1 == threads
+                 ? n_pix
+                 : static_cast<int>(std::upper_bound(start_.begin(), start_.end(), static_cast<int>(target)) -
+                                    start_.begin()) - 1;
+    p1 = std::clamp(p1, p0, n_pix);
+    pool.emplace_back(work, p0, p1);
+    p0 = p1;
+  }
+  for (auto& th : pool) th.join();
+}
+
+Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads) {
   Regions out;
-  const int n = static_cast<int>(g.size());
+  const int n = static_cast<int>(index.size());
   out.label.assign(n, -1);
   if (n == 0) return out;
-  const GridIndex index(g, opt);
   // Normals and curvature in bucket order; curvature 2 marks "no normal".
   std::vector<float> nrm(3 * static_cast<size_t>(n), 0.0f), curv(n, 2.0f);
-  parallelFor(n, threads, [&](int b, int e) {
-    for (int k = b; k < e; ++k)
-      if (!index.normal(k, opt.min_neighbours, &nrm[3 * k], &curv[k])) curv[k] = 2.0f;
-  });
+  index.allNormals(c, opt, threads, nrm.data(), curv.data());
   // Seeds by increasing curvature: counting sort on the quantised curvature
   // (curvature of a valid normal is in [0, 1/3]).
   constexpr int kBins = 4096;
@@ -172,6 +197,7 @@ Regions growGrid(const Group& g, const ClusterOptions& opt, int threads) {
 
   const float cos_thr = static_cast<float>(std::cos(opt.smoothness_deg * M_PI / 180.0));
   const float curv_thr = static_cast<float>(opt.curvature_threshold);
+  const float grow_time_radius = static_cast<float>(opt.time_radius_px / c);
   std::vector<int> lab(n, -1), queue;
   queue.reserve(1024);
   int region = 0;
@@ -183,7 +209,7 @@ Regions growGrid(const Group& g, const ClusterOptions& opt, int threads) {
     for (size_t qi = 0; qi < queue.size(); ++qi) {
       const int cur = queue[qi];
       const float* nc = &nrm[3 * cur];
-      index.forNeighbours(cur, [&](int j) {
+      index.forNeighbours(cur, opt.grow_radius_px, grow_time_radius, [&](int j) {
         if (lab[j] != -1 || curv[j] > 1.0f) return;
         const float* nj = &nrm[3 * j];
         if (std::fabs(nc[0] * nj[0] + nc[1] * nj[1] + nc[2] * nj[2]) < cos_thr) return;
@@ -198,20 +224,32 @@ Regions growGrid(const Group& g, const ClusterOptions& opt, int threads) {
   return out;
 }
 
-void gridNormals(const Group& g, const ClusterOptions& opt, int stride, std::vector<float>& nx,
-                 std::vector<float>& ny, std::vector<float>& nz, std::vector<float>& curvature) {
-  nx.clear(), ny.clear(), nz.clear(), curvature.clear();
-  if (g.size() == 0) return;
-  const GridIndex index(g, opt);
-  stride = std::max(1, stride);
-  for (size_t k = 0; k < index.size(); k += static_cast<size_t>(stride)) {
-    float n[3] = {0, 0, 0}, c = 2.0f;
-    if (!index.normal(static_cast<int>(k), opt.min_neighbours, n, &c)) n[0] = n[1] = n[2] = 0.0f;
-    nx.push_back(n[0]);
-    ny.push_back(n[1]);
-    nz.push_back(n[2]);
-    curvature.push_back(c);
+double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, double c0,
+                                const ClusterOptions& opt) {
+  size_t total = 0;
+  for (const GridIndex* ix : indexes) total += ix->size();
+  if (total == 0) return 0.0;
+  const size_t stride = std::max<size_t>(1, total / 4000);  // about 4000 sampled planes
+  double c = c0;
+  for (int iter = 0; iter < 4; ++iter) {
+    std::vector<double> speeds;
+    for (const GridIndex* ix : indexes) {
+      for (size_t k = stride / 2; k < ix->size(); k += stride) {
+        float n[3], cv = 2.0f;
+        if (!ix->normal(static_cast<int>(k), c, opt, n, &cv) || cv > opt.curvature_threshold) continue;
+        const double nxy = std::hypot(n[0], n[1]);
+        if (nxy > 1e-3) speeds.push_back(c * std::fabs(n[2]) / nxy);
+      }
+    }
+    if (speeds.size() < 20) return iter == 0 ? 0.0 : c;
+    auto mid = speeds.begin() + speeds.size() / 2;
+    std::nth_element(speeds.begin(), mid, speeds.end());
+    const double next = std::clamp(*mid, opt.c_min_px_per_s, opt.c_max_px_per_s);
+    const bool converged = std::fabs(next - c) < 0.05 * c;
+    c = next;
+    if (converged) break;
   }
+  return c;
 }
 
 }  // namespace celc::cluster_detail

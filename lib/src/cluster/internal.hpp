@@ -1,15 +1,18 @@
 #pragma once
 /// \file internal.hpp
 /// Shared pieces of the clustering methods (not a public header).
+#include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
 
 namespace celc::cluster_detail {
 
-/// The points of one group (one polarity, or all events) in (x, y, c*(t - t0)).
+/// The events of one group (one polarity, or all events).
 struct Group {
-  std::vector<float> x, y, z;   ///< [px]
+  std::vector<float> x, y;      ///< [px]
+  std::vector<float> t;         ///< time since the window's first event [s]
   std::vector<int> event_index; ///< index into the caller's event vector
   bool on = true;
   size_t size() const { return x.size(); }
@@ -21,18 +24,74 @@ struct Regions {
   int count = 0;
 };
 
-/// Own region grower: neighbours from a (2r+1)^2 pixel window and a c*t range.
-/// `threads` workers estimate the normals.
-Regions growGrid(const Group& g, const ClusterOptions& opt, int threads);
+/// Events of a group bucketed per pixel, sorted by time inside each bucket.
+/// Neighbours of an event: the events of the (2r+1)^2 pixels around it whose
+/// time lies within +-time_radius (a binary search per pixel; at most
+/// kMaxPerPixel per pixel, the nearest in time).
+class GridIndex {
+ public:
+  static constexpr int kMaxPerPixel = 8;
+  struct Cell {
+    float t;         ///< [s] since t0
+    int16_t x, y;    ///< pixel relative to the group's bounding box
+  };
+  explicit GridIndex(const Group& g);
+  size_t size() const { return cells_.size(); }
+  int point(int k) const { return point_[k]; }  ///< group index of bucket position k
+  const Cell& cell(int k) const { return cells_[k]; }
 
-/// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree.
-Regions growPcl(const Group& g, const ClusterOptions& opt, int threads);
+  template <class F>
+  void forNeighbours(int k, int r, float time_radius, F&& f) const {
+    const Cell& c0 = cells_[k];
+    const Cell* base = cells_.data();
+    auto less_t = [](const Cell& a, float t) { return a.t < t; };
+    auto t_less = [](float t, const Cell& a) { return t < a.t; };
+    const int ylo = std::max(0, c0.y - r), yhi = std::min(h_ - 1, c0.y + r);
+    const int xlo = std::max(0, c0.x - r), xhi = std::min(w_ - 1, c0.x + r);
+    for (int y = ylo; y <= yhi; ++y) {
+      const int* row = &start_[static_cast<size_t>(y) * w_];
+      for (int x = xlo; x <= xhi; ++x) {
+        const int b = row[x], e = row[x + 1];
+        if (b == e) continue;
+        const Cell* lo = std::lower_bound(base + b, base + e, c0.t - time_radius, less_t);
+        const Cell* hi = std::upper_bound(lo, base + e, c0.t + time_radius, t_less);
+        if (hi - lo > kMaxPerPixel) {  // keep the ones nearest in time (hot pixels)
+          const Cell* mid = std::lower_bound(lo, hi, c0.t, less_t);
+          lo = std::max(lo, mid - kMaxPerPixel / 2);
+          hi = std::min(hi, lo + kMaxPerPixel);
+        }
+        for (const Cell* q = lo; q < hi; ++q) f(static_cast<int>(q - base));
+      }
+    }
+  }
 
-/// Local plane normals of a group with the grid neighbourhoods (used by the
-/// automatic time scale). normal = (0,0,0) where invalid. Only every
-/// `stride`-th point is a query point; the output has one entry per query.
-void gridNormals(const Group& g, const ClusterOptions& opt, int stride,
-                 std::vector<float>& nx, std::vector<float>& ny, std::vector<float>& nz,
-                 std::vector<float>& curvature);
+  /// Plane normal of the neighbourhood of k in (x, y, c*t) and its curvature
+  /// lambda_min / sum(lambda); false when degenerate (too few neighbours, all on
+  /// one spot or one line).
+  bool normal(int k, double c, const ClusterOptions& opt, float* out_n, float* out_curv) const;
+
+  /// The same for every event at once (no per-pixel cap), in O(events x window
+  /// pixels) by sliding time windows: per pixel, its events in time order, and
+  /// per neighbouring pixel two pointers that add and remove events from running
+  /// moment sums. nrm: 3 per event, curvature 2 where degenerate.
+  void allNormals(double c, const ClusterOptions& opt, int threads, float* nrm, float* curv) const;
+
+ private:
+  int w_ = 0, h_ = 0;
+  std::vector<int> start_;   ///< w*h + 1 bucket starts
+  std::vector<int> point_;   ///< bucket position -> group index
+  std::vector<Cell> cells_;  ///< in bucket order
+};
+
+/// Own region grower on the grid index (normals with `threads` workers).
+Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads);
+
+/// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree, points (x, y, c*t).
+Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads);
+
+/// Median normal-flow speed [px/s] of sampled local planes, iterated from c0;
+/// 0 when fewer than 20 usable planes.
+double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, double c0,
+                                const ClusterOptions& opt);
 
 }  // namespace celc::cluster_detail

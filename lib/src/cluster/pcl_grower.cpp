@@ -12,14 +12,14 @@
 
 namespace celc::cluster_detail {
 
-Regions growPcl(const Group& g, const ClusterOptions& opt, int threads) {
+Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads) {
   Regions out;
   const size_t n = g.size();
   out.label.assign(n, -1);
   if (n < 3) return out;
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->resize(n);
-  for (size_t i = 0; i < n; ++i) (*cloud)[i] = pcl::PointXYZ(g.x[i], g.y[i], g.z[i]);
+  for (size_t i = 0; i < n; ++i) (*cloud)[i] = pcl::PointXYZ(g.x[i], g.y[i], static_cast<float>(c * g.t[i]));
   pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(static_cast<unsigned>(threads));

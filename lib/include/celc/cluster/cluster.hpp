@@ -49,14 +49,15 @@ struct ClusterOptions {
   bool separate_polarity = true;  ///< cluster ON and OFF events separately (paper)
 
   // Neighbourhoods.
-  int neighbours = 16;          ///< Pcl: k nearest for normals and growing; Grid: at most k used for growing
-  int grid_radius_px = 2;       ///< Grid: pixel window half size [px] (2 -> 5x5 pixels)
-  double time_radius_px = 2.5;  ///< Grid: time range +-time_radius_px / c [px of c*t]
-  int min_neighbours = 5;       ///< fewer neighbours: no normal, the event cannot join a region
+  int neighbours = 16;          ///< Pcl: k nearest neighbours for normals and growing [events]
+  int grid_radius_px = 2;       ///< Grid: normals from a (2r+1)^2 pixel window [px] (2 -> 5x5)
+  int grow_radius_px = 1;       ///< Grid: growing visits a (2r+1)^2 pixel window [px] (1 -> 3x3)
+  double time_radius_px = 2.5;  ///< Grid: time range +-time_radius_px / c [s], i.e. in c*t units [px]
+  int min_neighbours = 5;       ///< Grid: fewer neighbours -> no normal, the event joins no region
 
   // Region growing.
-  double smoothness_deg = 12.0;       ///< max angle between neighbouring normals [deg]
-  double curvature_threshold = 0.08;  ///< max curvature of a point grown from [-] (0..1/3)
+  double smoothness_deg = 20.0;       ///< max angle between neighbouring normals [deg]
+  double curvature_threshold = 0.15;  ///< max curvature of a point grown from [-] (0..1/3)
   int min_cluster_size = 60;          ///< [events]
   int max_cluster_size = 2000000;     ///< [events]
 
