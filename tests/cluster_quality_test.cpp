@@ -49,7 +49,7 @@ TEST(ClusterQuality, ProbeGrid) {
   const char* e = getenv("PROBE");
   if (!e) GTEST_SKIP();
   ClusterOptions co;
-  sscanf(e, "%d %lf %lf %lf %lf", &co.grid_radius_px, &co.time_radius_px, &co.smoothness_deg, &co.curvature_threshold, &co.max_plane_rms_px);
+  sscanf(e, "%d %lf %lf %lf %lf %lf", &co.grid_radius_px, &co.time_radius_px, &co.smoothness_deg, &co.curvature_threshold, &co.max_plane_rms_px, &co.grow_time_radius_px);
   if (getenv("PCL")) co.method = ClusterMethod::Pcl;
   for (unsigned seed = 1; seed <= 5; ++seed) {
     LabelledWindowOptions wo;

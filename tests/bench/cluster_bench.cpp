@@ -98,13 +98,24 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method) {
   opt.threads = 2;
   celc::ClusterResult r;
   long long peak_extra = 0;
+  double cpu_ms = 0.0;
+  auto cpuNow = [] {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return 1e3 * (u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-3 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  };
   for (auto _ : state) {
+    const double cpu0 = cpuNow();
     const long long before = g_current.load();
     g_peak.store(before);
     r = celc::clusterEvents(w.events, opt);
     peak_extra = std::max(peak_extra, g_peak.load() - before);
     benchmark::DoNotOptimize(r.labels.data());
+    cpu_ms += cpuNow() - cpu0;
   }
+  // CPU time of all threads per window: on a shared machine, wall time / 2 cores
+  // cannot be better than cpu_ms / 2.
+  state.counters["cpu_ms_all_threads"] = cpu_ms / static_cast<double>(state.iterations());
   const double n = static_cast<double>(w.events.size());
   state.counters["events_per_s"] =
       benchmark::Counter(n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
@@ -115,6 +126,10 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method) {
   state.counters["clusters"] = static_cast<double>(r.clusters.size());
   state.counters["recovered"] = recoveredShare(w, r);
   state.counters["c_px_per_s"] = r.c_px_per_s;
+  state.counters["ms_index_c"] = r.ms_time_scale;
+  state.counters["ms_normals"] = r.ms_normals;
+  state.counters["ms_grow"] = r.ms_grow;
+  state.counters["ms_post"] = r.ms_post;
 }
 
 void BM_ClusterGrid(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Grid); }

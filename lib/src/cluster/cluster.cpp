@@ -42,9 +42,13 @@ std::string ClusterOptions::validate() const {
   if (!(c_min_px_per_s > 0.0 && c_max_px_per_s >= c_min_px_per_s && std::isfinite(c_max_px_per_s)))
     err << "need 0 < c_min_px_per_s <= c_max_px_per_s; ";
   if (neighbours < 3 || neighbours > 1000) err << "neighbours must be in [3, 1000]; ";
+  if (!(pcl_normal_radius_px >= 0.0 && pcl_normal_radius_px <= 50.0))
+    err << "pcl_normal_radius_px must be in [0, 50]; ";
   if (grid_radius_px < 1 || grid_radius_px > 5) err << "grid_radius_px must be in [1, 5]; ";
   if (grow_radius_px < 1 || grow_radius_px > 5) err << "grow_radius_px must be in [1, 5]; ";
   if (!(time_radius_px > 0.0 && time_radius_px <= 100.0)) err << "time_radius_px must be in (0, 100]; ";
+  if (!(grow_time_radius_px > 0.0 && grow_time_radius_px <= 100.0))
+    err << "grow_time_radius_px must be in (0, 100]; ";
   if (min_neighbours < 3) err << "min_neighbours must be >= 3; ";
   if (!(smoothness_deg > 0.0 && smoothness_deg <= 90.0)) err << "smoothness_deg must be in (0, 90]; ";
   if (!(curvature_threshold > 0.0 && curvature_threshold <= 1.0))
@@ -56,6 +60,7 @@ std::string ClusterOptions::validate() const {
   if (max_split < 1 || max_split > 64) err << "max_split must be in [1, 64]; ";
   if (!(min_time_span_s >= 0.0)) err << "min_time_span_s must be >= 0; ";
   if (!(min_extent_px >= 0.0)) err << "min_extent_px must be >= 0; ";
+  if (!(min_density_per_px2 >= 0.0)) err << "min_density_per_px2 must be >= 0; ";
   if (threads < 1 || threads > 256) err << "threads must be in [1, 256]; ";
   return err.str();
 }
@@ -92,6 +97,7 @@ struct PlaneFit {
   Vec3 centroid = Vec3::Zero();
   Vec3 normal = Vec3::UnitZ();
   double rms = 0.0;
+  double area = 0.0;  ///< 12 sqrt(l1 l2) [px^2]: the area of a uniform rectangle with these variances
 };
 
 PlaneFit fitPlane(const Group& g, double c, const std::vector<int>& idx) {
@@ -108,6 +114,7 @@ PlaneFit fitPlane(const Group& g, double c, const std::vector<int>& idx) {
   Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
   f.normal = es.eigenvectors().col(0).normalized();
   f.rms = std::sqrt(std::max(0.0, es.eigenvalues()(0)));
+  f.area = 12.0 * std::sqrt(std::max(0.0, es.eigenvalues()(1)) * std::max(0.0, es.eigenvalues()(2)));
   return f;
 }
 
@@ -176,7 +183,7 @@ struct GroupOutput {
   std::vector<std::vector<int>> clusters;  // event indices
   std::vector<ClusterStats> stats;
   int n_regions = 0, n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
-  double ms_grow = 0.0, ms_post = 0.0;
+  double ms_normals = 0.0, ms_grow = 0.0, ms_post = 0.0;
 };
 
 GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
@@ -188,7 +195,8 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
   const Regions regions = opt.method == ClusterMethod::Pcl || index == nullptr
                               ? cluster_detail::growPcl(g, c, opt, threads)
                               : cluster_detail::growGrid(*index, c, opt, threads);
-  out.ms_grow = msSince(t_start);
+  out.ms_normals = regions.ms_normals;
+  out.ms_grow = msSince(t_start) - regions.ms_normals;
   t_start = Clock::now();
   // Index lists of the regions large enough to matter.
   std::vector<int> sizes(regions.count, 0);
@@ -222,7 +230,9 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
       t_hi = std::max(t_hi, events[g.event_index[i]].t);
     }
     const double extent = spatialExtent(g, idx);
-    if (t_hi - t_lo < opt.min_time_span_s || extent < opt.min_extent_px) {
+    const double density = static_cast<double>(idx.size()) / std::max(f.area, 1.0);
+    if (t_hi - t_lo < opt.min_time_span_s || extent < opt.min_extent_px ||
+        density < opt.min_density_per_px2) {
       ++out.n_rejected_small;
       return;
     }
@@ -234,6 +244,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
     s.plane_normal = f.normal;
     s.centroid = f.centroid;
     s.plane_rms_px = f.rms;
+    s.density_per_px2 = density;
     s.extent_px = extent;
     const double nxy = f.normal.head<2>().norm();
     s.speed_px_per_s = nxy > 1e-9 ? c * std::fabs(f.normal.z()) / nxy : 0.0;
@@ -331,7 +342,14 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   const bool need_index = opt.method == ClusterMethod::Grid || opt.c_px_per_s <= 0.0;
   if (need_index) {
     indexes.reserve(groups.size());
-    for (const Group& g : groups) indexes.emplace_back(g);
+    if (groups.size() == 2 && opt.threads >= 2) {
+      indexes.emplace_back(Group{});
+      std::thread other([&] { indexes[0] = cluster_detail::GridIndex(groups[0]); });
+      indexes.emplace_back(groups[1]);
+      other.join();
+    } else {
+      for (const Group& g : groups) indexes.emplace_back(g);
+    }
     for (const auto& ix : indexes) ptrs.push_back(&ix);
   }
   double c = opt.c_px_per_s;
@@ -367,6 +385,7 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
     res.n_split += o.n_split;
     res.n_rejected_planar += o.n_rejected_planar;
     res.n_rejected_small += o.n_rejected_small;
+    res.ms_normals += o.ms_normals;
     res.ms_grow += o.ms_grow;
     res.ms_post += o.ms_post;
     for (size_t k = 0; k < o.stats.size(); ++k) items.push_back({&o.stats[k], &o.clusters[k]});

@@ -3,6 +3,7 @@
 // around it whose c*t lies within +-time_radius_px (a binary search per pixel).
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <thread>
@@ -99,6 +100,15 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
   const int r = opt.grid_radius_px;
   const double tau = opt.time_radius_px / c;
   const int n_pix = w_ * h_;
+  // Prefix sums of t and t^2 (t relative to the window start) over the cells, so
+  // that the moments of any run of a bucket are two differences.
+  const size_t n = size();
+  std::vector<double> p1(n + 1, 0.0), p2(n + 1, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    const double t = cells_[k].t;
+    p1[k + 1] = p1[k] + t;
+    p2[k + 1] = p2[k] + t * t;
+  }
   auto work = [&](int p_begin, int p_end) {
     struct Nb {
       int lo, hi, end;
@@ -117,38 +127,30 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
           if (start_[q] != start_[q + 1])
             nb.push_back({start_[q], start_[q], start_[q + 1], double(x - px), double(y - py)});
         }
-      // Running sums over the events inside the windows: count, dx, dy, dx^2,
-      // dx dy, dy^2, t, t^2, dx t, dy t (t relative to this pixel's first event).
-      double S[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-      const double tb = cells_[b].t;
       for (int k = b; k < e; ++k) {
         const double tk = cells_[k].t;
+        // Sums over the neighbourhood: count, dx, dy, dx^2, dx dy, dy^2, t, t^2, dx t, dy t.
+        double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0, s9 = 0;
         for (Nb& q : nb) {
-          while (q.hi < q.end && cells_[q.hi].t <= tk + tau) {
-            const double t = cells_[q.hi].t - tb;
-            S[0] += 1, S[1] += q.dx, S[2] += q.dy, S[3] += q.dx * q.dx, S[4] += q.dx * q.dy;
-            S[5] += q.dy * q.dy, S[6] += t, S[7] += t * t, S[8] += q.dx * t, S[9] += q.dy * t;
-            ++q.hi;
-          }
-          while (q.lo < q.hi && cells_[q.lo].t < tk - tau) {
-            const double t = cells_[q.lo].t - tb;
-            S[0] -= 1, S[1] -= q.dx, S[2] -= q.dy, S[3] -= q.dx * q.dx, S[4] -= q.dx * q.dy;
-            S[5] -= q.dy * q.dy, S[6] -= t, S[7] -= t * t, S[8] -= q.dx * t, S[9] -= q.dy * t;
-            ++q.lo;
-          }
+          while (q.hi < q.end && cells_[q.hi].t <= tk + tau) ++q.hi;
+          while (q.lo < q.hi && cells_[q.lo].t < tk - tau) ++q.lo;
+          const double m = q.hi - q.lo;
+          const double T = p1[q.hi] - p1[q.lo], TT = p2[q.hi] - p2[q.lo];
+          s0 += m, s1 += q.dx * m, s2 += q.dy * m, s3 += q.dx * q.dx * m;
+          s4 += q.dx * q.dy * m, s5 += q.dy * q.dy * m, s6 += T, s7 += TT;
+          s8 += q.dx * T, s9 += q.dy * T;
         }
         curv[k] = 2.0f;
-        const double n = S[0];
-        if (n < opt.min_neighbours) continue;
+        if (s0 < opt.min_neighbours) continue;
         // Central moments of (dx, dy, c t).
-        const double mx = S[1] / n, my = S[2] / n, mt = S[6] / n;
+        const double mx = s1 / s0, my = s2 / s0, mt = s6 / s0;
         Eigen::Matrix3d cov;
-        cov(0, 0) = S[3] / n - mx * mx;
-        cov(0, 1) = cov(1, 0) = S[4] / n - mx * my;
-        cov(1, 1) = S[5] / n - my * my;
-        cov(0, 2) = cov(2, 0) = c * (S[8] / n - mx * mt);
-        cov(1, 2) = cov(2, 1) = c * (S[9] / n - my * mt);
-        cov(2, 2) = c * c * (S[7] / n - mt * mt);
+        cov(0, 0) = s3 / s0 - mx * mx;
+        cov(0, 1) = cov(1, 0) = s4 / s0 - mx * my;
+        cov(1, 1) = s5 / s0 - my * my;
+        cov(0, 2) = cov(2, 0) = c * (s8 / s0 - mx * mt);
+        cov(1, 2) = cov(2, 1) = c * (s9 / s0 - my * mt);
+        cov(2, 2) = c * c * std::max(0.0, s7 / s0 - mt * mt);
         if (!normalFromCovariance(cov, &nrm[3 * static_cast<size_t>(k)], &curv[k])) curv[k] = 2.0f;
       }
     }
@@ -181,45 +183,53 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
   if (n == 0) return out;
   // Normals and curvature in bucket order; curvature 2 marks "no normal".
   std::vector<float> nrm(3 * static_cast<size_t>(n), 0.0f), curv(n, 2.0f);
+  const auto t_normals = std::chrono::steady_clock::now();
   index.allNormals(c, opt, threads, nrm.data(), curv.data());
-  // Seeds by increasing curvature: counting sort on the quantised curvature
-  // (curvature of a valid normal is in [0, 1/3]).
-  constexpr int kBins = 4096;
-  std::vector<int> bin_start(kBins + 1, 0);
-  auto binOf = [&](float c) { return std::min(kBins - 1, static_cast<int>(c * 3.0f * kBins)); };
-  int n_valid = 0;
-  for (int k = 0; k < n; ++k)
-    if (curv[k] <= 1.0f) ++bin_start[binOf(curv[k]) + 1], ++n_valid;
-  for (int b = 0; b < kBins; ++b) bin_start[b + 1] += bin_start[b];
-  std::vector<int> seeds(n_valid);
-  for (int k = 0; k < n; ++k)
-    if (curv[k] <= 1.0f) seeds[bin_start[binOf(curv[k])]++] = k;
-
+  out.ms_normals =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_normals).count();
+  // Region growing with pcl::RegionGrowing's criteria (smooth mode): a region
+  // spreads from point i to a neighbour j when |n_i . n_j| >= cos(smoothness)
+  // and continues from j only when j's curvature is below the threshold. The
+  // low-curvature points a region reaches are therefore exactly a connected
+  // component of the graph "low-curvature neighbours with similar normals",
+  // found here with union-find in one sweep; each high-curvature point then
+  // joins the region of its first low-curvature neighbour with a similar
+  // normal (PCL gives it to the region that reaches it first).
   const float cos_thr = static_cast<float>(std::cos(opt.smoothness_deg * M_PI / 180.0));
   const float curv_thr = static_cast<float>(opt.curvature_threshold);
-  const float grow_time_radius = static_cast<float>(opt.time_radius_px / c);
-  std::vector<int> lab(n, -1), queue;
-  queue.reserve(1024);
-  int region = 0;
-  for (int s : seeds) {
-    if (lab[s] != -1) continue;
-    lab[s] = region;
-    queue.clear();
-    queue.push_back(s);
-    for (size_t qi = 0; qi < queue.size(); ++qi) {
-      const int cur = queue[qi];
-      const float* nc = &nrm[3 * cur];
-      index.forNeighbours(cur, opt.grow_radius_px, grow_time_radius, [&](int j) {
-        if (lab[j] != -1 || curv[j] > 1.0f) return;
-        const float* nj = &nrm[3 * j];
-        if (std::fabs(nc[0] * nj[0] + nc[1] * nj[1] + nc[2] * nj[2]) < cos_thr) return;
-        lab[j] = region;
-        if (curv[j] < curv_thr) queue.push_back(j);
-      });
+  std::vector<int> parent(n), attach(n, -1);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto similar = [&](int a, int b) {
+    const float* na = &nrm[3 * static_cast<size_t>(a)];
+    const float* nb = &nrm[3 * static_cast<size_t>(b)];
+    return std::fabs(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) >= cos_thr;
+  };
+  index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, [&](int k, int j) {
+    const bool lk = curv[k] < curv_thr, lj = curv[j] < curv_thr;
+    if (lk && lj) {
+      if (similar(k, j)) {
+        const int rk = find(k), rj = find(j);
+        if (rk != rj) parent[std::max(rk, rj)] = std::min(rk, rj);
+      }
+    } else if (lk != lj) {
+      const int hi = lk ? j : k, lo = lk ? k : j;  // high- and low-curvature point
+      if (curv[hi] <= 1.0f && attach[hi] < 0 && similar(hi, lo)) attach[hi] = lo;
     }
-    ++region;
+  });
+  std::vector<int> region_of(n, -1);
+  int region = 0;
+  for (int k = 0; k < n; ++k) {
+    int root = -1;
+    if (curv[k] < curv_thr) root = find(k);
+    else if (attach[k] >= 0) root = find(attach[k]);
+    if (root < 0) continue;
+    if (region_of[root] < 0) region_of[root] = region++;
+    out.label[index.point(k)] = region_of[root];
   }
-  for (int k = 0; k < n; ++k) out.label[index.point(k)] = lab[k];
   out.count = region;
   return out;
 }

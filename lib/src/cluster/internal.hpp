@@ -22,6 +22,7 @@ struct Group {
 struct Regions {
   std::vector<int> label;
   int count = 0;
+  double ms_normals = 0.0;  ///< part of the time spent on normals [ms]
 };
 
 /// Events of a group bucketed per pixel, sorted by time inside each bucket.
@@ -61,6 +62,36 @@ class GridIndex {
           hi = std::min(hi, lo + kMaxPerPixel);
         }
         for (const Cell* q = lo; q < hi; ++q) f(static_cast<int>(q - base));
+      }
+    }
+  }
+
+  /// Calls f(k, j) once for every unordered pair of neighbours k < j (bucket
+  /// positions), pixel by pixel with sliding time windows (two pointers per
+  /// neighbouring pixel that comes at or after k's pixel; no per-pixel cap).
+  template <class F>
+  void sweepPairs(int r, double time_radius, F&& f) const {
+    struct Nb {
+      int lo, hi, end;
+    };
+    std::vector<Nb> nb;
+    for (int p = 0; p < w_ * h_; ++p) {
+      const int b = start_[p], e = start_[p + 1];
+      if (b == e) continue;
+      const int px = p % w_, py = p / w_;
+      nb.clear();
+      for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); ++y)
+        for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); ++x) {
+          const int q = y * w_ + x;
+          if (q >= p && start_[q] != start_[q + 1]) nb.push_back({start_[q], start_[q], start_[q + 1]});
+        }
+      for (int k = b; k < e; ++k) {
+        const double tk = cells_[k].t;
+        for (Nb& q : nb) {
+          while (q.hi < q.end && cells_[q.hi].t <= tk + time_radius) ++q.hi;
+          while (q.lo < q.hi && cells_[q.lo].t < tk - time_radius) ++q.lo;
+          for (int j = std::max(q.lo, k + 1); j < q.hi; ++j) f(k, j);
+        }
       }
     }
   }

@@ -1,6 +1,7 @@
 // Reference method: PCL normals (k nearest neighbours from a kd-tree) and
 // pcl::RegionGrowing with the same criteria as the grid grower.
 #include <pcl/features/normal_3d_omp.h>
+#include <pcl/filters/radius_outlier_removal.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
@@ -25,10 +26,23 @@ Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(static_cast<unsigned>(threads));
   ne.setInputCloud(cloud);
   ne.setSearchMethod(tree);
-  ne.setKSearch(opt.neighbours);
+  if (opt.pcl_normal_radius_px > 0.0)
+    ne.setRadiusSearch(opt.pcl_normal_radius_px);
+  else
+    ne.setKSearch(opt.neighbours);
   ne.compute(*normals);
 
+  // Isolated events (fewer than min_neighbours within the normal radius) take no
+  // part: their normals are noise and kNN growth would bridge lines through them.
+  pcl::IndicesPtr kept(new pcl::Indices);
+  pcl::RadiusOutlierRemoval<pcl::PointXYZ> ror;
+  ror.setInputCloud(cloud);
+  ror.setRadiusSearch(opt.pcl_normal_radius_px > 0.0 ? opt.pcl_normal_radius_px : 2.0 * opt.grid_radius_px);
+  ror.setMinNeighborsInRadius(opt.min_neighbours);
+  ror.filter(*kept);
+
   pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+  rg.setIndices(kept);
   rg.setMinClusterSize(static_cast<pcl::uindex_t>(opt.min_cluster_size));
   rg.setMaxClusterSize(static_cast<pcl::uindex_t>(opt.max_cluster_size));
   rg.setSearchMethod(tree);

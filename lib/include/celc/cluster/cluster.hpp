@@ -49,10 +49,14 @@ struct ClusterOptions {
   bool separate_polarity = true;  ///< cluster ON and OFF events separately (paper)
 
   // Neighbourhoods.
-  int neighbours = 16;          ///< Pcl: k nearest neighbours for normals and growing [events]
+  int neighbours = 30;          ///< Pcl: k nearest neighbours for growing (and normals if pcl_normal_radius_px = 0) [events]
+  /// Pcl: normals from all points within this radius in (x, y, c*t) [px]; 0 = k nearest.
+  /// k nearest on a surface ~1 px thick gives curvatures above any useful threshold.
+  double pcl_normal_radius_px = 3.0;
   int grid_radius_px = 2;       ///< Grid: normals from a (2r+1)^2 pixel window [px] (2 -> 5x5)
   int grow_radius_px = 1;       ///< Grid: growing visits a (2r+1)^2 pixel window [px] (1 -> 3x3)
-  double time_radius_px = 2.5;  ///< Grid: time range +-time_radius_px / c [s], i.e. in c*t units [px]
+  double time_radius_px = 2.5;  ///< Grid, normals: time range +-time_radius_px / c [s], i.e. in c*t units [px]
+  double grow_time_radius_px = 1.5;  ///< Grid, growing: time range in c*t units [px]
   int min_neighbours = 5;       ///< Grid: fewer neighbours -> no normal, the event joins no region
 
   // Region growing.
@@ -65,8 +69,11 @@ struct ClusterOptions {
   double max_plane_rms_px = 1.5;   ///< max RMS distance to the cluster's plane [px]
   double ransac_threshold_px = 1.5;  ///< inlier distance when splitting [px]
   int max_split = 4;               ///< at most this many planes extracted from one region
-  double min_time_span_s = 0.0;    ///< minimum duration of a cluster [s]
+  double min_time_span_s = 0.0005; ///< minimum duration of a cluster [s]
   double min_extent_px = 5.0;      ///< minimum spatial extent of a cluster [px]
+  /// Minimum density on the cluster's plane [events/px^2], area = 12 sqrt(l1 l2) from the
+  /// two largest eigenvalues of its (x, y, c*t) covariance: rejects sparse noise "planes".
+  double min_density_per_px2 = 0.25;
 
   int threads = 2;  ///< worker threads (normals; the two polarities)
   unsigned seed = 1;  ///< RANSAC seed (results are deterministic)
@@ -92,6 +99,7 @@ struct ClusterStats {
   Vec3 plane_normal = Vec3::UnitZ();  ///< unit normal in (x, y, c*t)
   Vec3 centroid = Vec3::Zero();       ///< (x [px], y [px], c*(t - t0) [px])
   double plane_rms_px = 0.0;          ///< RMS distance to the plane [px]
+  double density_per_px2 = 0.0;       ///< events per px^2 of the plane (see min_density_per_px2)
   double extent_px = 0.0;             ///< spatial extent (largest pixel-space spread) [px]
   /// Normal-flow speed of the plane [px/s]: c * |n_t| / |(n_x, n_y)|.
   double speed_px_per_s = 0.0;
@@ -107,8 +115,9 @@ struct ClusterResult {
   int n_regions = 0;               ///< regions grown before the checks
   int n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
   double t0 = 0.0;                 ///< time origin of c*t [s] (first event)
-  /// Timings [ms]: time scale estimate, normals + growing, checks, whole call.
-  double ms_time_scale = 0.0, ms_grow = 0.0, ms_post = 0.0, ms_total = 0.0;
+  /// Timings [ms]: grid index + time scale estimate, normals, growing, checks,
+  /// whole call (per-group phases summed over the groups, which may run in parallel).
+  double ms_time_scale = 0.0, ms_normals = 0.0, ms_grow = 0.0, ms_post = 0.0, ms_total = 0.0;
 };
 
 /// Clusters the events of one window. Events need not be sorted; events with
