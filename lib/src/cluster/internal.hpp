@@ -68,7 +68,8 @@ class GridIndex {
 
   /// Calls f(k, j) once for every unordered pair of neighbours k < j (bucket
   /// positions), pixel by pixel with sliding time windows (two pointers per
-  /// neighbouring pixel that comes at or after k's pixel; no per-pixel cap).
+  /// neighbouring pixel that comes at or after k's pixel), at most
+  /// kMaxPerPixel partners j per pixel (the earliest in the window).
   template <class F>
   void sweepPairs(int r, double time_radius, F&& f) const {
     struct Nb {
@@ -90,7 +91,9 @@ class GridIndex {
         for (Nb& q : nb) {
           while (q.hi < q.end && cells_[q.hi].t <= tk + time_radius) ++q.hi;
           while (q.lo < q.hi && cells_[q.lo].t < tk - time_radius) ++q.lo;
-          for (int j = std::max(q.lo, k + 1); j < q.hi; ++j) f(k, j);
+          // At most kMaxPerPixel partners per pixel (a hot pixel would be quadratic).
+          const int j0 = std::max(q.lo, k + 1), j1 = std::min(q.hi, j0 + kMaxPerPixel);
+          for (int j = j0; j < j1; ++j) f(k, j);
         }
       }
     }
