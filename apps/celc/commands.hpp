@@ -7,6 +7,8 @@
 
 namespace celc::app {
 
+/// `celc cluster EVENTS`: clustering of an event file's windows (cmd_cluster.cpp).
+void registerCluster(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);
