@@ -188,13 +188,14 @@ struct GroupOutput {
 
 GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
                          const cluster_detail::GridIndex* index, double c,
-                         const ClusterOptions& opt, int threads) {
+                         const ClusterOptions& opt, int threads,
+                         cluster_detail::GridNormals* normals = nullptr) {
   GroupOutput out;
   if (static_cast<int>(g.size()) < opt.min_cluster_size) return out;
   auto t_start = Clock::now();
   const Regions regions = opt.method == ClusterMethod::Pcl || index == nullptr
                               ? cluster_detail::growPcl(g, c, opt, threads)
-                              : cluster_detail::growGrid(*index, c, opt, threads);
+                              : cluster_detail::growGrid(*index, c, opt, threads, normals);
   out.ms_normals = regions.ms_normals;
   out.ms_grow = msSince(t_start) - regions.ms_normals;
   t_start = Clock::now();
@@ -367,9 +368,22 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   };
   if (groups.size() == 2 && opt.threads >= 2) {
     const int per = std::max(1, opt.threads / 2);
-    std::thread other([&] { outs[1] = processGroup(events, groups[1], indexOf(1), c, opt, per); });
-    outs[0] = processGroup(events, groups[0], indexOf(0), c, opt, per);
+    // Grid: normals (the largest part) group after group with all threads, split
+    // by event count; then growing and checks of the two groups in parallel.
+    std::vector<cluster_detail::GridNormals> normals(2);
+    double ms_normals = 0.0;
+    if (opt.method == ClusterMethod::Grid) {
+      for (size_t k = 0; k < 2; ++k) {
+        if (static_cast<int>(groups[k].size()) < opt.min_cluster_size) continue;
+        normals[k] = cluster_detail::computeGridNormals(indexes[k], c, opt, opt.threads);
+        ms_normals += normals[k].ms;
+      }
+    }
+    std::thread other(
+        [&] { outs[1] = processGroup(events, groups[1], indexOf(1), c, opt, per, &normals[1]); });
+    outs[0] = processGroup(events, groups[0], indexOf(0), c, opt, per, &normals[0]);
     other.join();
+    outs[0].ms_normals += ms_normals;
   } else {
     for (size_t k = 0; k < groups.size(); ++k)
       outs[k] = processGroup(events, groups[k], indexOf(k), c, opt, opt.threads);

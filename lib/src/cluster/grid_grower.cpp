@@ -176,17 +176,33 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
   for (auto& th : pool) th.join();
 }
 
-Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads) {
+GridNormals computeGridNormals(const GridIndex& index, double c, const ClusterOptions& opt,
+                               int threads) {
+  GridNormals g;
+  const size_t n = index.size();
+  g.nrm.assign(3 * n, 0.0f);
+  g.curv.assign(n, 2.0f);
+  const auto t0 = std::chrono::steady_clock::now();
+  if (n > 0) index.allNormals(c, opt, threads, g.nrm.data(), g.curv.data());
+  g.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return g;
+}
+
+Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads,
+                 GridNormals* normals) {
   Regions out;
   const int n = static_cast<int>(index.size());
   out.label.assign(n, -1);
   if (n == 0) return out;
   // Normals and curvature in bucket order; curvature 2 marks "no normal".
-  std::vector<float> nrm(3 * static_cast<size_t>(n), 0.0f), curv(n, 2.0f);
-  const auto t_normals = std::chrono::steady_clock::now();
-  index.allNormals(c, opt, threads, nrm.data(), curv.data());
-  out.ms_normals =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_normals).count();
+  GridNormals own;
+  if (normals == nullptr || normals->curv.size() != static_cast<size_t>(n)) {
+    own = computeGridNormals(index, c, opt, threads);
+    normals = &own;
+    out.ms_normals = own.ms;
+  }
+  const std::vector<float>& nrm = normals->nrm;
+  const std::vector<float>& curv = normals->curv;
   // Region growing with pcl::RegionGrowing's criteria (smooth mode): a region
   // spreads from point i to a neighbour j when |n_i . n_j| >= cos(smoothness)
   // and continues from j only when j's curvature is below the threshold. The
@@ -208,7 +224,8 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
     const float* nb = &nrm[3 * static_cast<size_t>(b)];
     return std::fabs(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) >= cos_thr;
   };
-  index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, [&](int k, int j) {
+  auto valid = [&](int k) { return curv[k] <= 1.0f; };  // pairs with an invalid k change nothing
+  index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, valid, [&](int k, int j) {
     const bool lk = curv[k] < curv_thr, lj = curv[j] < curv_thr;
     if (lk && lj) {
       if (similar(k, j)) {

@@ -70,8 +70,9 @@ class GridIndex {
   /// positions), pixel by pixel with sliding time windows (two pointers per
   /// neighbouring pixel that comes at or after k's pixel), at most
   /// kMaxPerPixel partners j per pixel (the earliest in the window).
-  template <class F>
-  void sweepPairs(int r, double time_radius, F&& f) const {
+  /// Events k with active(k) false get no pairs (their windows still slide).
+  template <class A, class F>
+  void sweepPairs(int r, double time_radius, A&& active, F&& f) const {
     struct Nb {
       int lo, hi, end;
     };
@@ -88,9 +89,11 @@ class GridIndex {
         }
       for (int k = b; k < e; ++k) {
         const double tk = cells_[k].t;
+        const bool act = active(k);
         for (Nb& q : nb) {
           while (q.hi < q.end && cells_[q.hi].t <= tk + time_radius) ++q.hi;
           while (q.lo < q.hi && cells_[q.lo].t < tk - time_radius) ++q.lo;
+          if (!act) continue;
           // At most kMaxPerPixel partners per pixel (a hot pixel would be quadratic).
           const int j0 = std::max(q.lo, k + 1), j1 = std::min(q.hi, j0 + kMaxPerPixel);
           for (int j = j0; j < j1; ++j) f(k, j);
@@ -117,8 +120,17 @@ class GridIndex {
   std::vector<Cell> cells_;  ///< in bucket order
 };
 
-/// Own region grower on the grid index (normals with `threads` workers).
-Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads);
+/// Normals (3 per event) and curvatures (2 = none) in bucket order.
+struct GridNormals {
+  std::vector<float> nrm, curv;
+  double ms = 0.0;  ///< wall time [ms]
+};
+GridNormals computeGridNormals(const GridIndex& index, double c, const ClusterOptions& opt, int threads);
+
+/// Own region grower on the grid index; normals computed here with `threads`
+/// workers unless given (then they are consumed).
+Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads,
+                 GridNormals* normals = nullptr);
 
 /// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree, points (x, y, c*t).
 Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads);
