@@ -9,11 +9,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
+#include "celc/cluster/cluster_yaml.hpp"
 #include "celc/cluster/dump.hpp"
 #include "commands.hpp"
 
@@ -72,20 +74,30 @@ struct ClusterArgs {
   double curvature = ClusterOptions{}.curvature_threshold;
   int min_cluster_size = ClusterOptions{}.min_cluster_size;
   double max_plane_rms_px = ClusterOptions{}.max_plane_rms_px;
+  std::string config;
   bool quiet = false, verbose = false;
 };
 
-void run(const ClusterArgs& a) {
+void run(const ClusterArgs& a, const CLI::App& cmd) {
   configureLogging(a.quiet, a.verbose);
   ClusterOptions opt;
-  opt.method = parseClusterMethod(a.method);
-  opt.c_px_per_s = a.c;
-  opt.separate_polarity = !a.merge_polarity;
-  opt.threads = a.threads;
-  opt.smoothness_deg = a.smoothness_deg;
-  opt.curvature_threshold = a.curvature;
-  opt.min_cluster_size = a.min_cluster_size;
-  opt.max_plane_rms_px = a.max_plane_rms_px;
+  LineFitOptions lines;
+  if (!a.config.empty()) {  // the config file first, then options given on the command line
+    std::ifstream in(a.config);
+    if (!in) throw std::runtime_error(a.config + ": cannot open");
+    std::stringstream text;
+    text << in.rdbuf();
+    applyClusterYaml(text.str(), a.config, opt, &lines);
+  }
+  auto given = [&](const char* name) { return a.config.empty() || cmd.count(name) > 0; };
+  if (given("--method")) opt.method = parseClusterMethod(a.method);
+  if (given("--c")) opt.c_px_per_s = a.c;
+  if (cmd.count("--merge-polarity") > 0) opt.separate_polarity = false;
+  if (given("--threads")) opt.threads = a.threads;
+  if (given("--smoothness-deg")) opt.smoothness_deg = a.smoothness_deg;
+  if (given("--curvature")) opt.curvature_threshold = a.curvature;
+  if (given("--min-cluster-size")) opt.min_cluster_size = a.min_cluster_size;
+  if (given("--max-plane-rms")) opt.max_plane_rms_px = a.max_plane_rms_px;
   if (const std::string err = opt.validate(); !err.empty())
     throw std::runtime_error("invalid clustering options: " + err);
   const size_t limit = a.max_windows > 0 ? a.max_windows * a.window_events : 0;
@@ -112,6 +124,7 @@ void run(const ClusterArgs& a) {
       d.width = a.width;
       d.height = a.height;
       d.title = name;
+      d.lines = lines;
       writeClusterPng(base + ".png", ev, r, d);
       writeClusterPly(base + ".ply", ev, r);
       spdlog::debug("wrote {}.png / .ply", base);
@@ -151,9 +164,12 @@ void registerCluster(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-plane-rms", args->max_plane_rms_px, "max RMS plane distance of a cluster [px]")
       ->capture_default_str();
+  cmd->add_option("-c,--config", args->config,
+                  "YAML with 'cluster:' and 'lines:' sections (config/cluster.yaml); command-line "
+                  "options given explicitly override it");
   cmd->add_flag("-q,--quiet", args->quiet, "warnings and errors only");
   cmd->add_flag("-v,--verbose", args->verbose, "debug output");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, cmd] { run(*args, *cmd); });
 }
 
 }  // namespace celc::app
