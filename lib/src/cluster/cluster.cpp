@@ -81,6 +81,12 @@ bool validEvent(const Event& e) {
 std::vector<Group> makeGroups(const std::vector<Event>& events, double t0, bool separate) {
   std::vector<Group> groups(separate ? 2 : 1);
   if (separate) groups[1].on = false;
+  size_t n_on = 0;
+  for (const Event& e : events) n_on += e.on ? 1 : 0;
+  for (Group& g : groups) {
+    const size_t n = separate ? (g.on ? n_on : events.size() - n_on) : events.size();
+    g.x.reserve(n), g.y.reserve(n), g.t.reserve(n), g.event_index.reserve(n);
+  }
   for (size_t i = 0; i < events.size(); ++i) {
     const Event& e = events[i];
     if (!validEvent(e)) continue;

@@ -134,6 +134,7 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
         for (Nb& q : nb) {
           while (q.hi < q.end && cells_[q.hi].t <= tk + tau) ++q.hi;
           while (q.lo < q.hi && cells_[q.lo].t < tk - tau) ++q.lo;
+          if (q.lo == q.hi) continue;
           const double m = q.hi - q.lo;
           const double T = p1[q.hi] - p1[q.lo], TT = p2[q.hi] - p2[q.lo];
           s0 += m, s1 += q.dx * m, s2 += q.dy * m, s3 += q.dx * q.dx * m;
