@@ -56,7 +56,7 @@ struct ClusterOptions {
   int grid_radius_px = 2;       ///< Grid: normals from a (2r+1)^2 pixel window [px] (2 -> 5x5)
   int grow_radius_px = 1;       ///< Grid: growing visits a (2r+1)^2 pixel window [px] (1 -> 3x3)
   double time_radius_px = 2.5;  ///< Grid, normals: time range +-time_radius_px / c [s], i.e. in c*t units [px]
-  double grow_time_radius_px = 1.5;  ///< Grid, growing: time range in c*t units [px]
+  double grow_time_radius_px = 2.5;  ///< Grid, growing: time range in c*t units [px]
   int min_neighbours = 5;       ///< Grid: fewer neighbours -> no normal, the event joins no region
 
   // Region growing.
