@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <thread>
 
@@ -103,43 +104,55 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
   // Prefix sums of t and t^2 (t relative to the window start) over the cells, so
   // that the moments of any run of a bucket are two differences.
   const size_t n = size();
-  std::vector<double> p1(n + 1, 0.0), p2(n + 1, 0.0);
+  struct Prefix {
+    double t, tt;
+  };
+  std::vector<Prefix> pre(n + 1, Prefix{0.0, 0.0});
+  std::vector<float> ts(n + 1, std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < n; ++k) ts[k] = cells_[k].t;
   for (size_t k = 0; k < n; ++k) {
     const double t = cells_[k].t;
-    p1[k + 1] = p1[k] + t;
-    p2[k + 1] = p2[k] + t * t;
+    pre[k + 1] = {pre[k].t + t, pre[k].tt + t * t};
   }
   auto work = [&](int p_begin, int p_end) {
-    struct Nb {
-      int lo, hi, end;
-      double dx, dy;
-    };
-    std::vector<Nb> nb;
-    nb.reserve((2 * r + 1) * (2 * r + 1));
+    constexpr int kMaxNb = 121;  // (2 * 5 + 1)^2, grid_radius_px <= 5
+    int lo[kMaxNb], hi[kMaxNb], end[kMaxNb];
+    double dx[kMaxNb], dy[kMaxNb], dxx[kMaxNb], dxy[kMaxNb], dyy[kMaxNb];
+    double M[kMaxNb], T[kMaxNb], TT[kMaxNb];
     for (int p = p_begin; p < p_end; ++p) {
       const int b = start_[p], e = start_[p + 1];
       if (b == e) continue;
       const int px = p % w_, py = p / w_;
-      nb.clear();
+      int m = 0;
       for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); ++y)
         for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); ++x) {
           const int q = y * w_ + x;
-          if (start_[q] != start_[q + 1])
-            nb.push_back({start_[q], start_[q], start_[q + 1], double(x - px), double(y - py)});
+          if (start_[q] == start_[q + 1]) continue;
+          lo[m] = hi[m] = start_[q];
+          end[m] = start_[q + 1];
+          dx[m] = x - px, dy[m] = y - py;
+          dxx[m] = dx[m] * dx[m], dxy[m] = dx[m] * dy[m], dyy[m] = dy[m] * dy[m];
+          ++m;
         }
       for (int k = b; k < e; ++k) {
-        const double tk = cells_[k].t;
+        const float tk = cells_[k].t;
+        const float t_hi = static_cast<float>(tk + tau), t_lo = static_cast<float>(tk - tau);
+        for (int i = 0; i < m; ++i) {
+          int h = hi[i], l = lo[i];
+          const int en = end[i];
+          while (h < en && ts[h] <= t_hi) ++h;
+          while (l < h && ts[l] < t_lo) ++l;
+          hi[i] = h, lo[i] = l;
+          M[i] = h - l;
+          T[i] = pre[h].t - pre[l].t;
+          TT[i] = pre[h].tt - pre[l].tt;
+        }
         // Sums over the neighbourhood: count, dx, dy, dx^2, dx dy, dy^2, t, t^2, dx t, dy t.
         double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0, s9 = 0;
-        for (Nb& q : nb) {
-          while (q.hi < q.end && cells_[q.hi].t <= tk + tau) ++q.hi;
-          while (q.lo < q.hi && cells_[q.lo].t < tk - tau) ++q.lo;
-          if (q.lo == q.hi) continue;
-          const double m = q.hi - q.lo;
-          const double T = p1[q.hi] - p1[q.lo], TT = p2[q.hi] - p2[q.lo];
-          s0 += m, s1 += q.dx * m, s2 += q.dy * m, s3 += q.dx * q.dx * m;
-          s4 += q.dx * q.dy * m, s5 += q.dy * q.dy * m, s6 += T, s7 += TT;
-          s8 += q.dx * T, s9 += q.dy * T;
+        for (int i = 0; i < m; ++i) {
+          s0 += M[i], s1 += dx[i] * M[i], s2 += dy[i] * M[i], s3 += dxx[i] * M[i];
+          s4 += dxy[i] * M[i], s5 += dyy[i] * M[i], s6 += T[i], s7 += TT[i];
+          s8 += dx[i] * T[i], s9 += dy[i] * T[i];
         }
         curv[k] = 2.0f;
         if (s0 < opt.min_neighbours) continue;
