@@ -49,6 +49,7 @@ std::string ClusterOptions::validate() const {
   if (!(time_radius_px > 0.0 && time_radius_px <= 100.0)) err << "time_radius_px must be in (0, 100]; ";
   if (!(grow_time_radius_px > 0.0 && grow_time_radius_px <= 100.0))
     err << "grow_time_radius_px must be in (0, 100]; ";
+  if (!(normal_reuse_px >= 0.0 && normal_reuse_px <= 2.0)) err << "normal_reuse_px must be in [0, 2]; ";
   if (min_neighbours < 3) err << "min_neighbours must be >= 3; ";
   if (!(smoothness_deg > 0.0 && smoothness_deg <= 90.0)) err << "smoothness_deg must be in (0, 90]; ";
   if (!(curvature_threshold > 0.0 && curvature_threshold <= 1.0))

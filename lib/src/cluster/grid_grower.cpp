@@ -100,6 +100,7 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
                            float* curv) const {
   const int r = opt.grid_radius_px;
   const double tau = opt.time_radius_px / c;
+  const float reuse_dt = static_cast<float>(opt.normal_reuse_px / c);
   const int n_pix = w_ * h_;
   // Prefix sums of t and t^2 (t relative to the window start) over the cells, so
   // that the moments of any run of a bucket are two differences.
@@ -134,8 +135,17 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
           dxx[m] = dx[m] * dx[m], dxy[m] = dx[m] * dy[m], dyy[m] = dy[m] * dy[m];
           ++m;
         }
+      int last = -1;  // last event of this pixel whose normal was computed
       for (int k = b; k < e; ++k) {
         const float tk = cells_[k].t;
+        // An event right after one of the same pixel shares its neighbourhood
+        // (within reuse_dt): take its normal instead of recomputing it.
+        if (last >= 0 && tk - cells_[last].t <= reuse_dt) {
+          std::copy_n(&nrm[3 * static_cast<size_t>(last)], 3, &nrm[3 * static_cast<size_t>(k)]);
+          curv[k] = curv[last];
+          continue;
+        }
+        last = k;
         const float t_hi = static_cast<float>(tk + tau), t_lo = static_cast<float>(tk - tau);
         for (int i = 0; i < m; ++i) {
           int h = hi[i], l = lo[i];

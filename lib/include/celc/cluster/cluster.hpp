@@ -57,6 +57,9 @@ struct ClusterOptions {
   int grow_radius_px = 1;       ///< Grid: growing visits a (2r+1)^2 pixel window [px] (1 -> 3x3)
   double time_radius_px = 2.5;  ///< Grid, normals: time range +-time_radius_px / c [s], i.e. in c*t units [px]
   double grow_time_radius_px = 2.5;  ///< Grid, growing: time range in c*t units [px]
+  /// Grid: an event within normal_reuse_px / c seconds after the previous event of
+  /// its pixel whose normal was computed reuses that normal [px of c*t]; 0 = never.
+  double normal_reuse_px = 0.25;
   int min_neighbours = 5;       ///< Grid: fewer neighbours -> no normal, the event joins no region
 
   // Region growing.
