@@ -14,6 +14,8 @@ void registerBatch(CLI::App& app);
 void registerTable(CLI::App& app);
 /// `celc info FILE|DIR` (cmd_info.cpp).
 void registerInfo(CLI::App& app);
+/// `celc cluster EVENTS`: clustering of an event file's windows (cmd_cluster.cpp).
+void registerCluster(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   celc::app::registerSimulate(app);
   celc::app::registerSolve(app);
   celc::app::registerInfo(app);
+  celc::app::registerCluster(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -14,6 +14,7 @@ std::string LineFitOptions::validate() const {
     err << "interval_fraction must be in [0, 0.5]; ";
   if (min_events < 2) err << "min_events must be >= 2; ";
   if (!(max_rms_px > 0.0)) err << "max_rms_px must be > 0; ";
+  if (!(min_length_px >= 0.0)) err << "min_length_px must be >= 0; ";
   return err.str();
 }
 
@@ -50,6 +51,10 @@ FittedLine fitLine(const std::vector<Vec3>& bearings, const std::vector<double>&
   double t_sum = 0.0;
   for (double t : times) t_sum += t;
   out.line.t = times.empty() ? 0.0 : t_sum / static_cast<double>(times.size());
+  if (!times.empty()) {
+    out.t_first = *std::min_element(times.begin(), times.end());
+    out.t_last = *std::max_element(times.begin(), times.end());
+  }
   // Residuals and extent in pixels.
   const Vec2 nrm(-dir.y(), dir.x());
   double ss = 0.0, lo = 1e300, hi = -1e300;
@@ -62,6 +67,13 @@ FittedLine fitLine(const std::vector<Vec3>& bearings, const std::vector<double>&
   out.rms_px = std::sqrt(ss / static_cast<double>(pts.size()));
   out.length_px = hi - lo;
   out.status = LineFitStatus::Ok;
+  out.rms_ok = true;  // no thresholds here; fitClusterLines applies LineFitOptions
+  out.length_ok = true;
+  // Non-finite input (NaN bearings) must not pass as a line.
+  if (!out.line.normal.allFinite() || !std::isfinite(out.rms_px)) {
+    out.status = LineFitStatus::PoorFit;
+    out.rms_ok = out.length_ok = false;
+  }
   return out;
 }
 
@@ -73,26 +85,35 @@ FittedLine fitInterval(const std::vector<double>& times, const std::vector<Vec3>
                        double t0, double t1, double centre, double focal_px,
                        const LineFitOptions& opt) {
   const double step = 0.5 * (t1 - t0) * (centre > t0 ? 1.0 : -1.0);
-  for (;;) {
+  bool slid = false;
+  // Bounded: the distance to the centre halves no slower than by `step`, but
+  // with huge timestamps t0 + step may round to t0 (the cap stops that).
+  for (int iter = 0;; ++iter) {
     const auto b = std::lower_bound(times.begin(), times.end(), t0) - times.begin();
     const auto e = std::lower_bound(times.begin(), times.end(), t1) - times.begin();
     const bool reached_centre = t0 <= centre && centre <= t1;
-    if (e - b >= opt.min_events || reached_centre || step == 0.0) {
+    if (e - b >= opt.min_events || reached_centre || step == 0.0 || iter >= 200 ||
+        t0 + step == t0) {
       FittedLine f;
       if (e - b >= opt.min_events) {
         f = fitLine(std::vector<Vec3>(bearings.begin() + b, bearings.begin() + e),
                     std::vector<double>(times.begin() + b, times.begin() + e), focal_px);
-        if (f.status == LineFitStatus::Ok && f.rms_px > opt.max_rms_px)
-          f.status = LineFitStatus::PoorFit;
+        if (f.status == LineFitStatus::Ok) {
+          f.rms_ok = f.rms_px <= opt.max_rms_px;
+          f.length_ok = f.length_px >= opt.min_length_px;
+          if (!f.rms_ok || !f.length_ok) f.status = LineFitStatus::PoorFit;
+        }
       } else {
         f.n_events = static_cast<int>(e - b);
       }
       f.t_begin = t0;
       f.t_end = t1;
+      f.slid = slid;
       return f;
     }
     t0 += step;
     t1 += step;
+    slid = true;
   }
 }
 }  // namespace
@@ -101,6 +122,7 @@ ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector
                              double focal_px, const LineFitOptions& opt) {
   ClusterLines out;
   if (times.size() < 2 || times.size() != bearings.size()) return out;
+  if (!(focal_px > 0.0) || !std::is_sorted(times.begin(), times.end())) return out;
   const double ts = times.front(), te = times.back(), tm = 0.5 * (ts + te);
   const double len = opt.interval_fraction > 0.0 ? opt.interval_fraction * (te - ts)
                                                  : std::min(opt.interval_s, 0.5 * (te - ts));

@@ -21,19 +21,30 @@ struct LineFitOptions {
   double interval_fraction = 0.0;
   int min_events = 8;               ///< events an interval needs; it slides toward the centre otherwise
   double max_rms_px = 3.0;          ///< a fit with a larger RMS point-line distance [px] is flagged
+  /// A fit whose points extend less than this along the line [px] is flagged
+  /// (its direction is ill-defined).
+  double min_length_px = 3.0;
   std::string validate() const;     ///< empty when valid
 };
 
+/// Ok; TooFewEvents (the interval, slid to the centre, still held fewer than
+/// min_events); PoorFit (RMS residual above max_rms_px or length below
+/// min_length_px: see FittedLine::rms_ok / length_ok).
 enum class LineFitStatus { Ok, TooFewEvents, PoorFit };
 std::string toString(LineFitStatus status);
 
 struct FittedLine {
-  TimedLine line;            ///< plane normal (unit) and time [s]
-  double t_begin = 0.0;      ///< interval actually used [s]
+  TimedLine line;            ///< plane normal (unit) and time [s] (mean time of the events used)
+  double t_begin = 0.0;      ///< interval actually used [s] (after sliding), half-open [t_begin, t_end)
   double t_end = 0.0;
+  double t_first = 0.0;      ///< time of the first event used [s]
+  double t_last = 0.0;       ///< time of the last event used [s]
+  bool slid = false;         ///< the interval was moved toward the centre (too few events at the end)
   int n_events = 0;
   double rms_px = 0.0;       ///< RMS point-to-line distance [px]
   double length_px = 0.0;    ///< extent of the points along the line [px]
+  bool rms_ok = false;       ///< rms_px <= max_rms_px
+  bool length_ok = false;    ///< length_px >= min_length_px
   LineFitStatus status = LineFitStatus::TooFewEvents;
 };
 
@@ -48,7 +59,8 @@ struct ClusterLines {
 FittedLine fitLine(const std::vector<Vec3>& bearings, const std::vector<double>& times,
                    double focal_px);
 
-/// Fits l1, l2 and l3 of a cluster. `times` must be sorted ascending.
+/// Fits l1, l2 and l3 of a cluster. `times` must be sorted ascending (otherwise,
+/// or with focal_px <= 0, every line is returned with status TooFewEvents).
 ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector<Vec3>& bearings,
                              double focal_px, const LineFitOptions& options);
 

@@ -1,0 +1,175 @@
+// celc cluster EVENTS: clusters windows of an event file and reports, per
+// window, what came out; with --dump DIR also a PNG and a PLY per window.
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "celc/cluster/cluster.hpp"
+#include "celc/cluster/cluster_yaml.hpp"
+#include "celc/cluster/dump.hpp"
+#include "commands.hpp"
+
+namespace celc::app {
+namespace {
+
+// ---------------------------------------------------------------------------
+// TEMPORARY minimal reader for `t x y p` text files ('#' comments, CRLF
+// tolerated). To be replaced by the io module's event reader when it lands.
+std::vector<Event> readEventsTxtMinimal(const std::string& path, size_t max_events) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::vector<Event> events;
+  std::string line;
+  size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const char* p = line.c_str();
+    char* end = nullptr;
+    double v[4];
+    for (int k = 0; k < 4; ++k) {
+      errno = 0;
+      v[k] = std::strtod(p, &end);
+      if (end == p || errno == ERANGE || !std::isfinite(v[k]))
+        throw std::runtime_error(path + ":" + std::to_string(line_no) +
+                                 ": expected 't x y p' (4 numbers), got '" + line.substr(0, 60) + "'");
+      p = end;
+    }
+    while (*p == ' ' || *p == '\t') ++p;
+    if (*p != '\0')
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": trailing text after 't x y p'");
+    if (v[1] < 0 || v[2] < 0 || v[1] > 65535 || v[2] > 65535 || (v[3] != 0 && v[3] != 1 && v[3] != -1))
+      throw std::runtime_error(path + ":" + std::to_string(line_no) +
+                               ": pixel out of range or polarity not 0/1/-1");
+    events.push_back({v[0], static_cast<float>(v[1]), static_cast<float>(v[2]), v[3] > 0});
+    if (max_events > 0 && events.size() >= max_events) break;
+  }
+  return events;
+}
+// ---------------------------------------------------------------------------
+
+struct ClusterArgs {
+  std::string events;
+  size_t window_events = 30000;
+  std::string dump;
+  std::string method = "grid";
+  double c = 0.0;
+  bool merge_polarity = false;
+  int threads = 2;
+  size_t max_windows = 0;
+  int width = 0, height = 0;
+  double smoothness_deg = ClusterOptions{}.smoothness_deg;
+  double curvature = ClusterOptions{}.curvature_threshold;
+  int min_cluster_size = ClusterOptions{}.min_cluster_size;
+  double max_plane_rms_px = ClusterOptions{}.max_plane_rms_px;
+  std::string config;
+  bool quiet = false, verbose = false;
+};
+
+void run(const ClusterArgs& a, const CLI::App& cmd) {
+  configureLogging(a.quiet, a.verbose);
+  ClusterOptions opt;
+  LineFitOptions lines;
+  if (!a.config.empty()) {  // the config file first, then options given on the command line
+    std::ifstream in(a.config);
+    if (!in) throw std::runtime_error(a.config + ": cannot open");
+    std::stringstream text;
+    text << in.rdbuf();
+    applyClusterYaml(text.str(), a.config, opt, &lines);
+  }
+  auto given = [&](const char* name) { return a.config.empty() || cmd.count(name) > 0; };
+  if (given("--method")) opt.method = parseClusterMethod(a.method);
+  if (given("--c")) opt.c_px_per_s = a.c;
+  if (cmd.count("--merge-polarity") > 0) opt.separate_polarity = false;
+  if (given("--threads")) opt.threads = a.threads;
+  if (given("--smoothness-deg")) opt.smoothness_deg = a.smoothness_deg;
+  if (given("--curvature")) opt.curvature_threshold = a.curvature;
+  if (given("--min-cluster-size")) opt.min_cluster_size = a.min_cluster_size;
+  if (given("--max-plane-rms")) opt.max_plane_rms_px = a.max_plane_rms_px;
+  if (const std::string err = opt.validate(); !err.empty())
+    throw std::runtime_error("invalid clustering options: " + err);
+  const size_t limit = a.max_windows > 0 ? a.max_windows * a.window_events : 0;
+  const std::vector<Event> all = readEventsTxtMinimal(a.events, limit);
+  spdlog::info("{}: {} events", a.events, all.size());
+  if (!a.dump.empty()) std::filesystem::create_directories(a.dump);
+  std::cout << "window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms\n";
+  size_t window = 0;
+  for (size_t b = 0; b < all.size(); b += a.window_events, ++window) {
+    if (a.max_windows > 0 && window >= a.max_windows) break;
+    const size_t e = std::min(all.size(), b + a.window_events);
+    const std::vector<Event> ev(all.begin() + static_cast<long>(b), all.begin() + static_cast<long>(e));
+    const ClusterResult r = clusterEvents(ev, opt);
+    char row[256];
+    std::snprintf(row, sizeof row, "%zu,%.6f,%.6f,%zu,%s,%.1f,%zu,%d,%.1f", window, ev.front().t,
+                  ev.back().t, ev.size(), toString(r.status).c_str(), r.c_px_per_s, r.clusters.size(),
+                  r.n_clustered, r.ms_total);
+    std::cout << row << "\n";
+    if (!a.dump.empty()) {
+      char name[64];
+      std::snprintf(name, sizeof name, "window_%05zu", window);
+      const std::string base = (std::filesystem::path(a.dump) / name).string();
+      ClusterDumpOptions d;
+      d.width = a.width;
+      d.height = a.height;
+      d.title = name;
+      d.lines = lines;
+      writeClusterPng(base + ".png", ev, r, d);
+      writeClusterPly(base + ".ply", ev, r);
+      spdlog::debug("wrote {}.png / .ply", base);
+    }
+  }
+}
+
+}  // namespace
+
+void registerCluster(CLI::App& app) {
+  auto args = std::make_shared<ClusterArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "cluster",
+      "Space-time clustering of an event file's windows into line clusters; prints one CSV row "
+      "per window (window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms)");
+  cmd->add_option("EVENTS", args->events, "events.txt: 't x y p' per line (s, px, px, 0/1), '#' comments")
+      ->required();
+  cmd->add_option("--window-events", args->window_events, "events per window [events]")
+      ->capture_default_str()
+      ->check(CLI::Range(size_t{1}, size_t{100000000}));
+  cmd->add_option("--dump", args->dump, "directory for window_NNNNN.png (x-y and x-t views) and .ply");
+  cmd->add_option("--method", args->method, "grid (fast, default) or pcl (PCL region growing reference)")
+      ->capture_default_str();
+  cmd->add_option("--c", args->c, "time scale c [px/s] of the points (x, y, c t); 0 = automatic")
+      ->capture_default_str();
+  cmd->add_flag("--merge-polarity", args->merge_polarity, "cluster ON and OFF events together");
+  cmd->add_option("--threads", args->threads, "worker threads")->capture_default_str();
+  cmd->add_option("--max-windows", args->max_windows, "stop after this many windows (0 = all)")
+      ->capture_default_str();
+  cmd->add_option("--width", args->width, "sensor width for the PNG [px] (0 = from the events)");
+  cmd->add_option("--height", args->height, "sensor height for the PNG [px] (0 = from the events)");
+  cmd->add_option("--smoothness-deg", args->smoothness_deg, "max angle between neighbouring normals [deg]")
+      ->capture_default_str();
+  cmd->add_option("--curvature", args->curvature, "max curvature of a point a region grows from [-]")
+      ->capture_default_str();
+  cmd->add_option("--min-cluster-size", args->min_cluster_size, "smallest cluster [events]")
+      ->capture_default_str();
+  cmd->add_option("--max-plane-rms", args->max_plane_rms_px, "max RMS plane distance of a cluster [px]")
+      ->capture_default_str();
+  cmd->add_option("-c,--config", args->config,
+                  "YAML with 'cluster:' and 'lines:' sections (config/cluster.yaml); command-line "
+                  "options given explicitly override it");
+  cmd->add_flag("-q,--quiet", args->quiet, "warnings and errors only");
+  cmd->add_flag("-v,--verbose", args->verbose, "debug output");
+  cmd->callback([args, cmd] { run(*args, *cmd); });
+}
+
+}  // namespace celc::app

@@ -1,0 +1,135 @@
+#pragma once
+/// \file cluster.hpp
+/// Space-time clustering of the events of one window into line clusters.
+///
+/// Each event becomes the point (x, y, c*t) [px, px, px]: pixel coordinates
+/// and time scaled by a speed c [px/s] (relative to the window's first event).
+/// A straight edge moving over the image triggers events on a smooth surface
+/// in this space (a plane for constant image motion), so regions of
+/// consistent local plane normals are line clusters. c makes time comparable
+/// to pixels: with c close to the edges' image speed the event surfaces lean
+/// at about 45 degrees and neighbourhoods are isotropic.
+///
+/// Region growing criteria (both methods, as pcl::RegionGrowing): seeds are
+/// taken in order of increasing curvature; a neighbour joins the region when
+/// the angle between its normal and the current point's normal is below
+/// `smoothness_deg`; it is grown from further only when its curvature
+/// (lambda_min / (lambda_0 + lambda_1 + lambda_2) of its neighbourhood's
+/// covariance) is below `curvature_threshold`.
+///
+/// After growing, every cluster is checked: a plane is fitted (PCA) to its
+/// points; a cluster whose RMS plane distance exceeds `max_plane_rms_px` is
+/// split by sequential RANSAC plane extraction (two lines merged into one
+/// region), and what is still not planar is rejected; clusters smaller than
+/// `min_cluster_size` events, shorter than `min_time_span_s` or spatially
+/// shorter than `min_extent_px` are dropped. Their events become noise (-1).
+#include <string>
+#include <vector>
+
+#include "celc/types.hpp"
+
+namespace celc {
+
+enum class ClusterMethod {
+  Grid,  ///< own region grower; neighbours from a pixel window and a time range (fast, default)
+  Pcl,   ///< reference: pcl::NormalEstimationOMP (k nearest, kd-tree) + pcl::RegionGrowing
+};
+/// "grid" / "pcl".
+ClusterMethod parseClusterMethod(const std::string& name);
+std::string toString(ClusterMethod method);
+
+struct ClusterOptions {
+  ClusterMethod method = ClusterMethod::Grid;
+  /// Time scale c [px/s]: points are (x, y, c*t). 0 = automatic (median normal-flow
+  /// speed of a first pass, see ClusterResult::c_px_per_s).
+  double c_px_per_s = 0.0;
+  /// Automatic c is clamped to [c_min, c_max] [px/s].
+  double c_min_px_per_s = 20.0;
+  double c_max_px_per_s = 20000.0;
+  bool separate_polarity = true;  ///< cluster ON and OFF events separately (paper)
+
+  // Neighbourhoods.
+  int neighbours = 30;          ///< Pcl: k nearest neighbours for growing (and normals if pcl_normal_radius_px = 0) [events]
+  /// Pcl: normals from all points within this radius in (x, y, c*t) [px]; 0 = k nearest.
+  /// k nearest on a surface ~1 px thick gives curvatures above any useful threshold.
+  double pcl_normal_radius_px = 3.0;
+  int grid_radius_px = 2;       ///< Grid: normals from a (2r+1)^2 pixel window [px] (2 -> 5x5)
+  int grow_radius_px = 1;       ///< Grid: growing visits a (2r+1)^2 pixel window [px] (1 -> 3x3)
+  double time_radius_px = 2.5;  ///< Grid, normals: time range +-time_radius_px / c [s], i.e. in c*t units [px]
+  double grow_time_radius_px = 2.5;  ///< Grid, growing: time range in c*t units [px]
+  /// Grid: an event within normal_reuse_px / c seconds after the previous event of
+  /// its pixel whose normal was computed reuses that normal [px of c*t]; 0 = never.
+  double normal_reuse_px = 0.25;
+  int min_neighbours = 5;       ///< Grid: fewer neighbours -> no normal, the event joins no region
+
+  // Region growing.
+  double smoothness_deg = 20.0;       ///< max angle between neighbouring normals [deg]
+  double curvature_threshold = 0.15;  ///< max curvature of a point grown from [-] (0..1/3)
+  int min_cluster_size = 60;          ///< [events]
+  int max_cluster_size = 2000000;     ///< [events]
+
+  // Checks after growing.
+  double max_plane_rms_px = 1.5;   ///< max RMS distance to the cluster's plane [px]
+  double ransac_threshold_px = 1.5;  ///< inlier distance when splitting [px]
+  int max_split = 4;               ///< at most this many planes extracted from one region
+  double min_time_span_s = 0.0005; ///< minimum duration of a cluster [s]
+  double min_extent_px = 5.0;      ///< minimum spatial extent of a cluster [px]
+  /// Minimum density on the cluster's plane [events/px^2], area = 12 sqrt(l1 l2) from the
+  /// two largest eigenvalues of its (x, y, c*t) covariance: rejects sparse noise "planes".
+  double min_density_per_px2 = 0.25;
+
+  int threads = 2;  ///< worker threads (normals; the two polarities)
+  unsigned seed = 1;  ///< RANSAC seed (results are deterministic)
+
+  std::string validate() const;  ///< empty when valid, else what is wrong
+};
+
+enum class ClusterStatus {
+  Ok,              ///< at least one cluster
+  EmptyWindow,     ///< no events
+  TooFewEvents,    ///< fewer valid events than min_cluster_size
+  NoClusters,      ///< events, but no region passed the checks (all noise)
+  InvalidOptions,  ///< options.validate() failed; see ClusterResult::message
+};
+std::string toString(ClusterStatus status);
+
+/// Per-cluster statistics; the plane is fitted in (x, y, c*t) [px].
+struct ClusterStats {
+  int id = -1;             ///< label used in ClusterResult::labels
+  int size = 0;            ///< events
+  bool on = true;          ///< polarity (true for every cluster when polarities are merged and mixed)
+  double t_begin = 0.0, t_end = 0.0;  ///< first and last event time [s]
+  Vec3 plane_normal = Vec3::UnitZ();  ///< unit normal in (x, y, c*t)
+  Vec3 centroid = Vec3::Zero();       ///< (x [px], y [px], c*(t - t0) [px])
+  double plane_rms_px = 0.0;          ///< RMS distance to the plane [px]
+  double density_per_px2 = 0.0;       ///< events per px^2 of the plane (see min_density_per_px2)
+  double extent_px = 0.0;             ///< spatial extent (largest pixel-space spread) [px]
+  /// Normal-flow speed of the plane [px/s]: c * |n_t| / |(n_x, n_y)|.
+  double speed_px_per_s = 0.0;
+};
+
+struct ClusterResult {
+  ClusterStatus status = ClusterStatus::EmptyWindow;
+  std::string message;             ///< reason when not Ok
+  std::vector<int> labels;         ///< per input event: cluster id (index into clusters) or -1
+  std::vector<ClusterStats> clusters;
+  double c_px_per_s = 0.0;         ///< time scale actually used [px/s]
+  int n_events = 0, n_clustered = 0;
+  int n_regions = 0;               ///< regions grown before the checks
+  int n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
+  double t0 = 0.0;                 ///< time origin of c*t [s] (first event)
+  /// Timings [ms]: grid index + time scale estimate, normals, growing, checks,
+  /// whole call (per-group phases summed over the groups, which may run in parallel).
+  double ms_time_scale = 0.0, ms_normals = 0.0, ms_grow = 0.0, ms_post = 0.0, ms_total = 0.0;
+};
+
+/// Clusters the events of one window. Events need not be sorted; events with
+/// non-finite fields or pixels outside [0, 4096) get label -1. Never throws on data; returns a status.
+ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptions& options);
+
+/// Estimates c [px/s] from the data: the median normal-flow speed of local
+/// planes fitted with a first guess of c (iterated twice). Returns 0 when
+/// there are too few events to say.
+double estimateTimeScale(const std::vector<Event>& events, const ClusterOptions& options);
+
+}  // namespace celc

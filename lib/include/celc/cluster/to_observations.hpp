@@ -1,0 +1,44 @@
+#pragma once
+/// \file to_observations.hpp
+/// From a clustered window to what the solvers see: per cluster its events as
+/// undistorted bearings (sorted by time) and its fitted boundary lines l1, l2, l3.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "celc/cluster/cluster.hpp"
+#include "celc/lines/line_fit.hpp"
+#include "celc/solver/observations.hpp"
+
+namespace celc {
+
+/// Pixel (x right, y down) -> undistorted bearing (x, y, 1), e.g.
+/// [&](const Vec2& p) { return camera.bearing(p); }.
+using BearingFunction = std::function<Vec3(const Vec2&)>;
+
+struct ObservationOptions {
+  LineFitOptions lines;      ///< l1 / l2 / l3 fitting (interval, minimum events, quality)
+  int min_events = 20;       ///< clusters with fewer usable events are skipped
+  std::string validate() const;  ///< empty when valid
+};
+
+/// What happened to each cluster.
+struct ObservationReport {
+  int n_clusters = 0;         ///< clusters in the ClusterResult
+  int n_used = 0;             ///< clusters turned into observations
+  int n_too_few_events = 0;   ///< skipped: fewer than min_events usable events
+  int n_line_fit_failed = 0;  ///< skipped: l1 or l3 not Ok (too few events, poor fit, l3 not after l1)
+  std::vector<int> used_ids;         ///< ClusterResult ids of the clusters used, in output order
+  std::vector<ClusterLines> lines;   ///< fitted lines of every used cluster (quality, timestamps)
+};
+
+/// Builds the solver input of a window. Clusters keep their ClusterResult id in
+/// ClusterObservation::id. Events whose bearing is not finite are left out.
+/// `focal_px` converts normalised distances to pixels (fit thresholds are in px)
+/// and is stored in WindowObservations::focal_px. Never throws on data.
+WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
+                                  const BearingFunction& bearing, double focal_px,
+                                  const ObservationOptions& options,
+                                  ObservationReport* report = nullptr);
+
+}  // namespace celc

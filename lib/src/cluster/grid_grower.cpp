@@ -1,0 +1,306 @@
+// Fast region grower: events bucketed per pixel and sorted by c*t inside each
+// bucket, so the neighbours of an event are the events of the (2r+1)^2 pixels
+// around it whose c*t lies within +-time_radius_px (a binary search per pixel).
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <thread>
+
+#include "cluster/internal.hpp"
+
+namespace celc::cluster_detail {
+
+GridIndex::GridIndex(const Group& g) {
+  const size_t n = g.size();
+  if (n == 0) return;
+  int xmin = 1 << 30, ymin = 1 << 30, xmax = -(1 << 30), ymax = -(1 << 30);
+  std::vector<int> pix(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int xi = static_cast<int>(std::lround(g.x[i])), yi = static_cast<int>(std::lround(g.y[i]));
+    xmin = std::min(xmin, xi), xmax = std::max(xmax, xi);
+    ymin = std::min(ymin, yi), ymax = std::max(ymax, yi);
+  }
+  w_ = xmax - xmin + 1;
+  h_ = ymax - ymin + 1;
+  for (size_t i = 0; i < n; ++i)
+    pix[i] = (static_cast<int>(std::lround(g.y[i])) - ymin) * w_ +
+             static_cast<int>(std::lround(g.x[i])) - xmin;
+  // Points in order of increasing time (usually already so).
+  std::vector<int> by_time(n);
+  std::iota(by_time.begin(), by_time.end(), 0);
+  if (!std::is_sorted(g.t.begin(), g.t.end()))
+    std::stable_sort(by_time.begin(), by_time.end(), [&](int a, int b) { return g.t[a] < g.t[b]; });
+  // Counting sort by pixel, stable: time ascending inside each bucket.
+  start_.assign(static_cast<size_t>(w_) * h_ + 1, 0);
+  for (size_t i = 0; i < n; ++i) ++start_[pix[i] + 1];
+  for (size_t p = 1; p < start_.size(); ++p) start_[p] += start_[p - 1];
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  point_.resize(n);
+  cells_.resize(n);
+  for (int i : by_time) {
+    const int k = fill[pix[i]]++;
+    point_[k] = i;
+    cells_[k] = {g.t[i], static_cast<int16_t>(pix[i] % w_), static_cast<int16_t>(pix[i] / w_)};
+  }
+}
+
+namespace {
+
+/// Normal (eigenvector of the smallest eigenvalue) and curvature from the
+/// central moments of a neighbourhood; false when degenerate.
+bool normalFromCovariance(const Eigen::Matrix3d& cov, float* out_n, float* out_curv) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov);
+  const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+  const double sum = ev.sum();
+  // Degenerate: all points on one spot or one line (e.g. a single hot pixel).
+  if (!(sum > 1e-9) || ev(1) < 1e-3 * sum || ev(1) < 1e-4) return false;
+  const Eigen::Vector3d nrm = es.eigenvectors().col(0);
+  out_n[0] = static_cast<float>(nrm(0));
+  out_n[1] = static_cast<float>(nrm(1));
+  out_n[2] = static_cast<float>(nrm(2));
+  *out_curv = static_cast<float>(std::max(0.0, ev(0)) / sum);
+  return true;
+}
+
+}  // namespace
+
+bool GridIndex::normal(int k, double c, const ClusterOptions& opt, float* out_n,
+                       float* out_curv) const {
+  float s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
+  int cnt = 0;
+  const Cell& c0 = cells_[k];
+  const float cf = static_cast<float>(c);
+  forNeighbours(k, opt.grid_radius_px, static_cast<float>(opt.time_radius_px / c), [&](int j) {
+    const Cell& q = cells_[j];
+    const float dx = static_cast<float>(q.x - c0.x), dy = static_cast<float>(q.y - c0.y);
+    const float dz = cf * (q.t - c0.t);
+    s[0] += dx, s[1] += dy, s[2] += dz;
+    ss[0] += dx * dx, ss[1] += dx * dy, ss[2] += dx * dz;
+    ss[3] += dy * dy, ss[4] += dy * dz, ss[5] += dz * dz;
+    ++cnt;
+  });
+  if (cnt < opt.min_neighbours) return false;
+  const double inv = 1.0 / cnt;
+  const double m0 = s[0] * inv, m1 = s[1] * inv, m2 = s[2] * inv;
+  Eigen::Matrix3d cov;
+  cov(0, 0) = ss[0] * inv - m0 * m0;
+  cov(0, 1) = cov(1, 0) = ss[1] * inv - m0 * m1;
+  cov(0, 2) = cov(2, 0) = ss[2] * inv - m0 * m2;
+  cov(1, 1) = ss[3] * inv - m1 * m1;
+  cov(1, 2) = cov(2, 1) = ss[4] * inv - m1 * m2;
+  cov(2, 2) = ss[5] * inv - m2 * m2;
+  return normalFromCovariance(cov, out_n, out_curv);
+}
+
+void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, float* nrm,
+                           float* curv) const {
+  const int r = opt.grid_radius_px;
+  const double tau = opt.time_radius_px / c;
+  const float reuse_dt = static_cast<float>(opt.normal_reuse_px / c);
+  const int n_pix = w_ * h_;
+  // Prefix sums of t and t^2 (t relative to the window start) over the cells, so
+  // that the moments of any run of a bucket are two differences.
+  const size_t n = size();
+  struct Prefix {
+    double t, tt;
+  };
+  std::vector<Prefix> pre(n + 1, Prefix{0.0, 0.0});
+  std::vector<float> ts(n + 1, std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < n; ++k) ts[k] = cells_[k].t;
+  for (size_t k = 0; k < n; ++k) {
+    const double t = cells_[k].t;
+    pre[k + 1] = {pre[k].t + t, pre[k].tt + t * t};
+  }
+  auto work = [&](int p_begin, int p_end) {
+    constexpr int kMaxNb = 121;  // (2 * 5 + 1)^2, grid_radius_px <= 5
+    int lo[kMaxNb], hi[kMaxNb], end[kMaxNb];
+    double dx[kMaxNb], dy[kMaxNb], dxx[kMaxNb], dxy[kMaxNb], dyy[kMaxNb];
+    double M[kMaxNb], T[kMaxNb], TT[kMaxNb];
+    for (int p = p_begin; p < p_end; ++p) {
+      const int b = start_[p], e = start_[p + 1];
+      if (b == e) continue;
+      const int px = p % w_, py = p / w_;
+      int m = 0;
+      for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); ++y)
+        for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); ++x) {
+          const int q = y * w_ + x;
+          if (start_[q] == start_[q + 1]) continue;
+          lo[m] = hi[m] = start_[q];
+          end[m] = start_[q + 1];
+          dx[m] = x - px, dy[m] = y - py;
+          dxx[m] = dx[m] * dx[m], dxy[m] = dx[m] * dy[m], dyy[m] = dy[m] * dy[m];
+          ++m;
+        }
+      int last = -1;  // last event of this pixel whose normal was computed
+      for (int k = b; k < e; ++k) {
+        const float tk = cells_[k].t;
+        // An event right after one of the same pixel shares its neighbourhood
+        // (within reuse_dt): take its normal instead of recomputing it.
+        if (last >= 0 && tk - cells_[last].t <= reuse_dt) {
+          std::copy_n(&nrm[3 * static_cast<size_t>(last)], 3, &nrm[3 * static_cast<size_t>(k)]);
+          curv[k] = curv[last];
+          continue;
+        }
+        last = k;
+        const float t_hi = static_cast<float>(tk + tau), t_lo = static_cast<float>(tk - tau);
+        for (int i = 0; i < m; ++i) {
+          int h = hi[i], l = lo[i];
+          const int en = end[i];
+          while (h < en && ts[h] <= t_hi) ++h;
+          while (l < h && ts[l] < t_lo) ++l;
+          hi[i] = h, lo[i] = l;
+          M[i] = h - l;
+          T[i] = pre[h].t - pre[l].t;
+          TT[i] = pre[h].tt - pre[l].tt;
+        }
+        // Sums over the neighbourhood: count, dx, dy, dx^2, dx dy, dy^2, t, t^2, dx t, dy t.
+        double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0, s9 = 0;
+        for (int i = 0; i < m; ++i) {
+          s0 += M[i], s1 += dx[i] * M[i], s2 += dy[i] * M[i], s3 += dxx[i] * M[i];
+          s4 += dxy[i] * M[i], s5 += dyy[i] * M[i], s6 += T[i], s7 += TT[i];
+          s8 += dx[i] * T[i], s9 += dy[i] * T[i];
+        }
+        curv[k] = 2.0f;
+        if (s0 < opt.min_neighbours) continue;
+        // Central moments of (dx, dy, c t).
+        const double mx = s1 / s0, my = s2 / s0, mt = s6 / s0;
+        Eigen::Matrix3d cov;
+        cov(0, 0) = s3 / s0 - mx * mx;
+        cov(0, 1) = cov(1, 0) = s4 / s0 - mx * my;
+        cov(1, 1) = s5 / s0 - my * my;
+        cov(0, 2) = cov(2, 0) = c * (s8 / s0 - mx * mt);
+        cov(1, 2) = cov(2, 1) = c * (s9 / s0 - my * mt);
+        cov(2, 2) = c * c * std::max(0.0, s7 / s0 - mt * mt);
+        if (!normalFromCovariance(cov, &nrm[3 * static_cast<size_t>(k)], &curv[k])) curv[k] = 2.0f;
+      }
+    }
+  };
+  threads = std::max(1, std::min(threads, static_cast<int>(size() / 4096) + 1));
+  if (threads == 1) {
+    work(0, n_pix);
+    return;
+  }
+  // Split the pixels so that each worker gets about the same number of events.
+  std::vector<std::thread> pool;
+  int p0 = 0;
+  for (int t = 0; t < threads; ++t) {
+    const size_t target = size() * static_cast<size_t>(t + 1) / static_cast<size_t>(threads);
+    int p1 = t + 1 == threads
+                 ? n_pix
+                 : static_cast<int>(std::upper_bound(start_.begin(), start_.end(), static_cast<int>(target)) -
+                                    start_.begin()) - 1;
+    p1 = std::clamp(p1, p0, n_pix);
+    pool.emplace_back(work, p0, p1);
+    p0 = p1;
+  }
+  for (auto& th : pool) th.join();
+}
+
+GridNormals computeGridNormals(const GridIndex& index, double c, const ClusterOptions& opt,
+                               int threads) {
+  GridNormals g;
+  const size_t n = index.size();
+  g.nrm.assign(3 * n, 0.0f);
+  g.curv.assign(n, 2.0f);
+  const auto t0 = std::chrono::steady_clock::now();
+  if (n > 0) index.allNormals(c, opt, threads, g.nrm.data(), g.curv.data());
+  g.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return g;
+}
+
+Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads,
+                 GridNormals* normals) {
+  Regions out;
+  const int n = static_cast<int>(index.size());
+  out.label.assign(n, -1);
+  if (n == 0) return out;
+  // Normals and curvature in bucket order; curvature 2 marks "no normal".
+  GridNormals own;
+  if (normals == nullptr || normals->curv.size() != static_cast<size_t>(n)) {
+    own = computeGridNormals(index, c, opt, threads);
+    normals = &own;
+    out.ms_normals = own.ms;
+  }
+  const std::vector<float>& nrm = normals->nrm;
+  const std::vector<float>& curv = normals->curv;
+  // Region growing with pcl::RegionGrowing's criteria (smooth mode): a region
+  // spreads from point i to a neighbour j when |n_i . n_j| >= cos(smoothness)
+  // and continues from j only when j's curvature is below the threshold. The
+  // low-curvature points a region reaches are therefore exactly a connected
+  // component of the graph "low-curvature neighbours with similar normals",
+  // found here with union-find in one sweep; each high-curvature point then
+  // joins the region of its first low-curvature neighbour with a similar
+  // normal (PCL gives it to the region that reaches it first).
+  const float cos_thr = static_cast<float>(std::cos(opt.smoothness_deg * M_PI / 180.0));
+  const float curv_thr = static_cast<float>(opt.curvature_threshold);
+  std::vector<int> parent(n), attach(n, -1);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto similar = [&](int a, int b) {
+    const float* na = &nrm[3 * static_cast<size_t>(a)];
+    const float* nb = &nrm[3 * static_cast<size_t>(b)];
+    return std::fabs(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) >= cos_thr;
+  };
+  auto valid = [&](int k) { return curv[k] <= 1.0f; };  // pairs with an invalid k change nothing
+  index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, valid, [&](int k, int j) {
+    const bool lk = curv[k] < curv_thr, lj = curv[j] < curv_thr;
+    if (lk && lj) {
+      if (similar(k, j)) {
+        const int rk = find(k), rj = find(j);
+        if (rk != rj) parent[std::max(rk, rj)] = std::min(rk, rj);
+      }
+    } else if (lk != lj) {
+      const int hi = lk ? j : k, lo = lk ? k : j;  // high- and low-curvature point
+      if (curv[hi] <= 1.0f && attach[hi] < 0 && similar(hi, lo)) attach[hi] = lo;
+    }
+  });
+  std::vector<int> region_of(n, -1);
+  int region = 0;
+  for (int k = 0; k < n; ++k) {
+    int root = -1;
+    if (curv[k] < curv_thr) root = find(k);
+    else if (attach[k] >= 0) root = find(attach[k]);
+    if (root < 0) continue;
+    if (region_of[root] < 0) region_of[root] = region++;
+    out.label[index.point(k)] = region_of[root];
+  }
+  out.count = region;
+  return out;
+}
+
+double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, double c0,
+                                const ClusterOptions& opt) {
+  size_t total = 0;
+  for (const GridIndex* ix : indexes) total += ix->size();
+  if (total == 0) return 0.0;
+  const size_t stride = std::max<size_t>(1, total / 4000);  // about 4000 sampled planes
+  double c = c0;
+  for (int iter = 0; iter < 4; ++iter) {
+    std::vector<double> speeds;
+    for (const GridIndex* ix : indexes) {
+      for (size_t k = stride / 2; k < ix->size(); k += stride) {
+        float n[3], cv = 2.0f;
+        if (!ix->normal(static_cast<int>(k), c, opt, n, &cv) || cv > opt.curvature_threshold) continue;
+        const double nxy = std::hypot(n[0], n[1]);
+        if (nxy > 1e-3) speeds.push_back(c * std::fabs(n[2]) / nxy);
+      }
+    }
+    if (speeds.size() < 20) return iter == 0 ? 0.0 : c;
+    auto mid = speeds.begin() + speeds.size() / 2;
+    std::nth_element(speeds.begin(), mid, speeds.end());
+    const double next = std::clamp(*mid, opt.c_min_px_per_s, opt.c_max_px_per_s);
+    const bool converged = std::fabs(next - c) < 0.05 * c;
+    c = next;
+    if (converged) break;
+  }
+  return c;
+}
+
+}  // namespace celc::cluster_detail

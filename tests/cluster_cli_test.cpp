@@ -1,0 +1,93 @@
+// `celc cluster` end to end: a real ECD slice (skipped when absent) and bad input.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string out;
+};
+
+CliRun runCelc(const std::string& args) {
+  const std::string cmd = std::string(CELC_BINARY) + " " + args + " 2>&1";
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) r.out += buf;
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("celc_cluster_cli_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(ClusterCli, ClustersAnEcdSliceAndDumps) {
+  const fs::path slice = fs::path(CELC_SOURCE_DIR "/../shared/data/ecd_slices/shapes_translation/events.txt");
+  if (!fs::exists(slice)) GTEST_SKIP() << "shared data absent: " << slice;
+  const fs::path dir = tempDir("dump");
+  const CliRun r = runCelc("cluster " + slice.string() + " --window-events 15000 --dump " + dir.string() + " -q");
+  ASSERT_EQ(r.status, 0) << r.out;
+  // Two windows of 15000 events, both with clusters.
+  EXPECT_NE(r.out.find("\n0,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\n1,"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("no_clusters"), std::string::npos) << r.out;
+  for (const char* f : {"window_00000.png", "window_00000.ply", "window_00001.png", "window_00001.ply"})
+    EXPECT_GT(fs::file_size(dir / f), 1000u) << f;
+  std::ifstream ply(dir / "window_00000.ply");
+  std::string line;
+  int vertices = -1, rows = 0, labelled = 0;
+  bool header = true;
+  while (std::getline(ply, line)) {
+    if (header) {
+      if (line.rfind("element vertex ", 0) == 0) vertices = std::stoi(line.substr(15));
+      if (line == "end_header") header = false;
+      continue;
+    }
+    std::istringstream in(line);
+    double x, y, z, t;
+    int label;
+    ASSERT_TRUE(in >> x >> y >> z >> t >> label) << line;
+    ++rows;
+    labelled += label >= 0;
+  }
+  EXPECT_EQ(vertices, 15000);
+  EXPECT_EQ(rows, 15000);
+  EXPECT_GT(labelled, 5000);  // shapes_translation: most events lie on swept edges
+}
+
+TEST(ClusterCli, MalformedLineNamesFileAndLine) {
+  const fs::path dir = tempDir("bad");
+  const fs::path f = dir / "events.txt";
+  std::ofstream(f) << "# t x y p\r\n0.1 10 20 1\r\n0.2 11 twenty 0\r\n";
+  const CliRun r = runCelc("cluster " + f.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find(f.string() + ":3:"), std::string::npos) << r.out;
+  const CliRun missing = runCelc("cluster " + (dir / "nope.txt").string());
+  EXPECT_NE(missing.status, 0);
+  EXPECT_NE(missing.out.find("cannot open"), std::string::npos) << missing.out;
+}
+
+TEST(ClusterCli, EmptyFileIsNotAnError) {
+  const fs::path dir = tempDir("empty");
+  const fs::path f = dir / "events.txt";
+  std::ofstream(f) << "# nothing\n";
+  const CliRun r = runCelc("cluster " + f.string());
+  EXPECT_EQ(r.status, 0) << r.out;
+}
+
+}  // namespace

@@ -1,0 +1,305 @@
+// Clustering quality on labelled synthetic windows (celc::generateLabelledWindow),
+// boundary-line accuracy through toObservations, and degenerate windows.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "celc/cluster/cluster.hpp"
+#include "celc/cluster/synthetic.hpp"
+#include "celc/cluster/to_observations.hpp"
+
+namespace celc {
+namespace {
+
+struct Score {
+  int lines = 0, recovered = 0;
+  int noise = 0, noise_clustered = 0;
+  int clustered = 0;
+};
+
+// A true line is recovered when one cluster holds >= 80% of its events with purity >= 0.9.
+Score score(const LabelledWindow& w, const ClusterResult& r) {
+  Score s;
+  s.lines = w.n_lines();
+  std::vector<int> cluster_size(r.clusters.size(), 0), line_size(w.n_lines(), 0);
+  std::map<std::pair<int, int>, int> joint;  // (line, cluster) -> events
+  for (size_t i = 0; i < w.events.size(); ++i) {
+    const int c = r.labels[i], l = w.labels[i];
+    if (c >= 0) ++cluster_size[c], ++s.clustered;
+    if (l < 0) {
+      ++s.noise;
+      if (c >= 0) ++s.noise_clustered;
+      continue;
+    }
+    ++line_size[l];
+    if (c >= 0) ++joint[{l, c}];
+  }
+  for (int l = 0; l < w.n_lines(); ++l) {
+    bool ok = false;
+    for (const auto& [key, n] : joint)
+      ok = ok || (key.first == l && n >= 0.8 * line_size[l] && n >= 0.9 * cluster_size[key.second]);
+    s.recovered += ok ? 1 : 0;
+  }
+  return s;
+}
+
+LabelledWindow window(unsigned seed, int n_events = 30000) {
+  LabelledWindowOptions o;
+  o.seed = seed;
+  o.n_events = n_events;
+  return generateLabelledWindow(o);
+}
+
+// Over 5 windows of 8 lines (30k events, 10% noise, 0.7 px pixel noise), at
+// least 90% of the true lines are recovered; of the clustered events at most
+// 2% are noise (noise events lying on a line's surface are indistinguishable
+// from it), and at most 10% of all noise events end in a cluster.
+void checkQuality(ClusterMethod method, unsigned n_seeds) {
+  int lines = 0, recovered = 0, noise = 0, noise_clustered = 0, clustered = 0;
+  for (unsigned seed = 1; seed <= n_seeds; ++seed) {
+    const LabelledWindow w = window(seed);
+    ClusterOptions opt;
+    opt.method = method;
+    const ClusterResult r = clusterEvents(w.events, opt);
+    ASSERT_EQ(r.status, ClusterStatus::Ok) << r.message;
+    ASSERT_EQ(r.labels.size(), w.events.size());
+    const Score s = score(w, r);
+    lines += s.lines, recovered += s.recovered, noise += s.noise;
+    noise_clustered += s.noise_clustered, clustered += s.clustered;
+  }
+  EXPECT_GE(recovered, 0.9 * lines) << recovered << " of " << lines << " lines";
+  EXPECT_LE(noise_clustered, 0.02 * clustered);
+  EXPECT_LE(noise_clustered, 0.10 * noise);
+}
+
+TEST(ClusterQuality, GridRecoversLines) { checkQuality(ClusterMethod::Grid, 5); }
+
+TEST(ClusterQuality, PclRecoversLines) { checkQuality(ClusterMethod::Pcl, 2); }
+
+TEST(ClusterQuality, StatsDescribeClusters) {
+  const LabelledWindow w = window(3);
+  const ClusterResult r = clusterEvents(w.events, ClusterOptions{});
+  ASSERT_EQ(r.status, ClusterStatus::Ok);
+  int total = 0;
+  for (size_t k = 0; k < r.clusters.size(); ++k) {
+    const ClusterStats& s = r.clusters[k];
+    EXPECT_EQ(s.id, static_cast<int>(k));
+    EXPECT_GE(s.size, ClusterOptions{}.min_cluster_size);
+    EXPECT_LE(s.plane_rms_px, ClusterOptions{}.max_plane_rms_px);
+    EXPECT_LE(s.t_begin, s.t_end);
+    if (k > 0) {
+      EXPECT_LE(r.clusters[k - 1].t_begin, s.t_begin);  // ordered by start time
+    }
+    total += s.size;
+  }
+  EXPECT_EQ(total, r.n_clustered);
+  EXPECT_EQ(static_cast<int>(std::count_if(r.labels.begin(), r.labels.end(),
+                                           [](int l) { return l >= 0; })),
+            r.n_clustered);
+  // Every cluster has one polarity (clustered separately by default).
+  for (size_t i = 0; i < w.events.size(); ++i)
+    if (r.labels[i] >= 0) {
+      EXPECT_EQ(w.events[i].on, r.clusters[r.labels[i]].on);
+    }
+}
+
+// The median normal-flow speed of the true lines (per event, from the generator's
+// geometry) against the automatic c.
+TEST(ClusterQuality, AutomaticTimeScaleMatchesLineSpeeds) {
+  for (unsigned seed : {2u, 4u}) {
+    const LabelledWindow w = window(seed);
+    std::vector<double> speeds;
+    const double dt = 1e-3;
+    for (size_t i = 0; i < w.events.size(); i += 7) {
+      const int l = w.labels[i];
+      if (l < 0) continue;
+      const double t = w.events[i].t;
+      // Line in pixels at t and t + dt: l_px = K^-T l_norm.
+      auto pixelLine = [&](double tt) {
+        const Vec3 n = w.lineNormal(l, tt);
+        const CameraModel& c = w.camera;
+        Vec3 lp(n.x() / c.fx, n.y() / c.fy, n.z() - n.x() * c.cx / c.fx - n.y() * c.cy / c.fy);
+        return Vec3(lp / lp.head<2>().norm());
+      };
+      const Vec3 a = pixelLine(t), b = pixelLine(t + dt);
+      const Vec3 p(w.events[i].x, w.events[i].y, 1.0);
+      const double da = a.dot(p), db = b.dot(p) * (a.head<2>().dot(b.head<2>()) < 0 ? -1.0 : 1.0);
+      speeds.push_back(std::fabs(db - da) / dt);
+    }
+    std::nth_element(speeds.begin(), speeds.begin() + speeds.size() / 2, speeds.end());
+    const double truth = speeds[speeds.size() / 2];
+    const double c = estimateTimeScale(w.events, ClusterOptions{});
+    // c only sets the aspect of space-time neighbourhoods: within a factor 2 is
+    // plenty (the estimate runs high on these windows: pixel noise and rounding
+    // spread the event surface along x-y more than along t).
+    EXPECT_GT(c, truth / 2.0) << "true median speed " << truth;
+    EXPECT_LT(c, truth * 2.0) << "true median speed " << truth;
+    RecordProperty("c_over_true_speed_seed" + std::to_string(seed), std::to_string(c / truth));
+  }
+}
+
+TEST(ClusterQuality, FixedTimeScaleIsUsed) {
+  const LabelledWindow w = window(4);
+  ClusterOptions opt;
+  opt.c_px_per_s = 80.0;
+  const ClusterResult r = clusterEvents(w.events, opt);
+  EXPECT_EQ(r.c_px_per_s, 80.0);
+  EXPECT_GE(score(w, r).recovered, 7);
+}
+
+TEST(ClusterQuality, MergedPolaritiesStillSeparateLines) {
+  int lines = 0, recovered = 0;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const LabelledWindow w = window(seed);
+    ClusterOptions opt;
+    opt.separate_polarity = false;
+    const ClusterResult r = clusterEvents(w.events, opt);
+    const Score s = score(w, r);
+    lines += s.lines, recovered += s.recovered;
+  }
+  EXPECT_GE(recovered, 0.85 * lines);
+}
+
+// Boundary lines of the clusters against the true image lines at the fitted
+// lines' times. Bounds: angle between fitted and true plane normals < 0.5 deg
+// in the median and < 3 deg for 95% of the lines (0.7 px event noise, 5 ms
+// intervals, about 40-400 events per interval).
+TEST(ClusterQuality, BoundaryLinesMatchTrueLines) {
+  std::vector<double> errors;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const LabelledWindow w = window(seed);
+    const ClusterResult r = clusterEvents(w.events, ClusterOptions{});
+    ASSERT_EQ(r.status, ClusterStatus::Ok);
+    ObservationReport rep;
+    const WindowObservations obs =
+        toObservations(w.events, r, [&](const Vec2& p) { return w.camera.bearing(p); },
+                       w.camera.focal(), ObservationOptions{}, &rep);
+    EXPECT_EQ(rep.n_used, static_cast<int>(obs.clusters.size()));
+    EXPECT_GE(rep.n_used, 7);
+    for (const ClusterObservation& c : obs.clusters) {
+      // The cluster's true line: the majority label of its events.
+      std::map<int, int> votes;
+      for (size_t i = 0; i < w.events.size(); ++i)
+        if (r.labels[i] == c.id) ++votes[w.labels[i]];
+      const int line = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) {
+                         return a.second < b.second;
+                       })->first;
+      ASSERT_GE(line, 0);
+      EXPECT_TRUE(std::is_sorted(c.times.begin(), c.times.end()));
+      for (const TimedLine* l : {&c.l1, &c.l3}) {
+        const double cosang = std::fabs(l->normal.dot(w.lineNormal(line, l->t)));
+        errors.push_back(std::acos(std::min(1.0, cosang)) * 180.0 / M_PI);
+      }
+    }
+  }
+  ASSERT_GE(errors.size(), 60u);
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2], p95 = errors[errors.size() * 95 / 100];
+  RecordProperty("l1_l3_error_median_deg", std::to_string(median));
+  RecordProperty("l1_l3_error_p95_deg", std::to_string(p95));
+  RecordProperty("l1_l3_error_max_deg", std::to_string(errors.back()));
+  EXPECT_LT(median, 0.5);
+  EXPECT_LT(p95, 3.0);
+}
+
+// ---- degenerate windows: a status, never a crash --------------------------
+
+TEST(ClusterDegenerate, EmptyWindow) {
+  const ClusterResult r = clusterEvents({}, ClusterOptions{});
+  EXPECT_EQ(r.status, ClusterStatus::EmptyWindow);
+  EXPECT_TRUE(r.labels.empty());
+  EXPECT_TRUE(r.clusters.empty());
+}
+
+TEST(ClusterDegenerate, TooFewEvents) {
+  std::vector<Event> ev(10, Event{0.0, 5.0f, 5.0f, true});
+  const ClusterResult r = clusterEvents(ev, ClusterOptions{});
+  EXPECT_EQ(r.status, ClusterStatus::TooFewEvents);
+  EXPECT_EQ(r.labels, std::vector<int>(10, -1));
+}
+
+TEST(ClusterDegenerate, AllNoise) {
+  LabelledWindowOptions o;
+  o.noise_fraction = 1.0;
+  o.n_events = 20000;
+  const LabelledWindow w = generateLabelledWindow(o);
+  for (ClusterMethod m : {ClusterMethod::Grid, ClusterMethod::Pcl}) {
+    ClusterOptions opt;
+    opt.method = m;
+    const ClusterResult r = clusterEvents(w.events, opt);
+    EXPECT_EQ(r.status, ClusterStatus::NoClusters) << toString(m);
+    EXPECT_EQ(r.n_clustered, 0);
+  }
+}
+
+TEST(ClusterDegenerate, OnePixelFiringRepeatedly) {
+  std::vector<Event> ev;
+  for (int i = 0; i < 20000; ++i) ev.push_back({i * 1e-5, 100.0f, 50.0f, (i % 2) == 0});
+  EXPECT_EQ(clusterEvents(ev, ClusterOptions{}).status, ClusterStatus::NoClusters);
+  // PCL's radius searches are quadratic on one pixel: a shorter burst for it.
+  ev.resize(3000);
+  ClusterOptions pcl;
+  pcl.method = ClusterMethod::Pcl;
+  EXPECT_EQ(clusterEvents(ev, pcl).status, ClusterStatus::NoClusters);
+  // A hot pixel inside a real window does not destroy the lines.
+  LabelledWindow w = window(2);
+  for (int i = 0; i < 5000; ++i) w.events.push_back({i * 2e-5, 30.0f, 30.0f, true}), w.labels.push_back(-1);
+  const ClusterResult r = clusterEvents(w.events, ClusterOptions{});
+  EXPECT_GE(score(w, r).recovered, 7);
+}
+
+TEST(ClusterDegenerate, DuplicateTimestamps) {
+  // Every event of a window at one time: no cluster spans time.
+  LabelledWindow w = window(1, 5000);
+  for (Event& e : w.events) e.t = 1.0;
+  const ClusterResult r = clusterEvents(w.events, ClusterOptions{});
+  EXPECT_EQ(r.status, ClusterStatus::NoClusters);
+  // Each event duplicated (same time, same pixel): the lines are still found.
+  LabelledWindow d = window(2, 15000);
+  std::vector<Event> ev;
+  std::vector<int> lab;
+  for (size_t i = 0; i < d.events.size(); ++i)
+    for (int k = 0; k < 2; ++k) ev.push_back(d.events[i]), lab.push_back(d.labels[i]);
+  d.events = ev;
+  d.labels = lab;
+  const ClusterResult rd = clusterEvents(d.events, ClusterOptions{});
+  EXPECT_GE(score(d, rd).recovered, 7);
+}
+
+TEST(ClusterDegenerate, NonFiniteAndOutOfRangeEvents) {
+  LabelledWindow w = window(5, 10000);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  w.events.push_back({std::numeric_limits<double>::quiet_NaN(), 10.0f, 10.0f, true});
+  w.events.push_back({0.01, nan, 10.0f, true});
+  w.events.push_back({0.01, -5.0f, 10.0f, false});
+  w.events.push_back({0.01, 1e9f, 1e9f, false});
+  const ClusterResult r = clusterEvents(w.events, ClusterOptions{});
+  EXPECT_EQ(r.status, ClusterStatus::Ok);
+  for (size_t i = w.events.size() - 4; i < w.events.size(); ++i) EXPECT_EQ(r.labels[i], -1);
+}
+
+TEST(ClusterDegenerate, InvalidOptions) {
+  ClusterOptions opt;
+  opt.smoothness_deg = -1.0;
+  EXPECT_FALSE(opt.validate().empty());
+  const ClusterResult r = clusterEvents(window(1, 2000).events, opt);
+  EXPECT_EQ(r.status, ClusterStatus::InvalidOptions);
+  EXPECT_NE(r.message.find("smoothness_deg"), std::string::npos);
+  EXPECT_THROW(parseClusterMethod("kmeans"), std::invalid_argument);
+  EXPECT_EQ(parseClusterMethod("pcl"), ClusterMethod::Pcl);
+}
+
+TEST(ClusterDegenerate, ObservationsFromNothing) {
+  const ClusterResult r = clusterEvents({}, ClusterOptions{});
+  ObservationReport rep;
+  const WindowObservations obs = toObservations(
+      {}, r, [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 200.0, ObservationOptions{}, &rep);
+  EXPECT_TRUE(obs.clusters.empty());
+  EXPECT_EQ(rep.n_used, 0);
+}
+
+}  // namespace
+}  // namespace celc
