@@ -7,6 +7,8 @@
 
 namespace celc::app {
 
+/// `celc synth SCENE.yaml -o DIR`: the rendering event simulator (cmd_synth.cpp).
+void registerSynth(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

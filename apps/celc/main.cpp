@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("celc ") + CELC_VERSION);
   // Subcommands, in the order `celc --help` lists them.
+  celc::app::registerSynth(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,331 @@
+#include "celc/sim/render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace celc::sim {
+
+namespace {
+constexpr int64_t kNever = std::numeric_limits<int64_t>::min();
+constexpr size_t kStepsPerChunk = 64;
+
+inline uint64_t splitmix64(uint64_t& state) {
+  uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+/// Uniform in (0, 1].
+inline double uniform01(uint64_t& state) {
+  return (static_cast<double>(splitmix64(state) >> 11) + 1.0) * (1.0 / 9007199254740992.0);
+}
+inline bool eventLess(const SimEvent& a, const SimEvent& b) {
+  if (a.t_us != b.t_us) return a.t_us < b.t_us;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+}  // namespace
+
+std::string RenderOptions::validate() const {
+  std::ostringstream e;
+  auto pos = [](double x) { return x > 0.0 && std::isfinite(x); };
+  if (!pos(contrast_on) || !pos(contrast_off)) e << "contrast thresholds must be > 0; ";
+  if (!(contrast_sigma >= 0.0) || !std::isfinite(contrast_sigma)) e << "contrast_sigma must be >= 0; ";
+  if (!(refractory >= 0.0) || !(refractory < 10.0)) e << "refractory must be in [0, 10) s; ";
+  if (!(noise_rate >= 0.0) || !(noise_rate <= 1e5)) e << "noise_rate must be in [0, 1e5] Hz; ";
+  if (!pos(log_eps)) e << "log_eps must be > 0; ";
+  if (!pos(max_step_px)) e << "max_step_px must be > 0; ";
+  if (!pos(max_step) || !pos(min_step) || min_step > max_step)
+    e << "steps must satisfy 0 < min_step <= max_step; ";
+  if (!pos(smoothing_px) || smoothing_px > 100.0) e << "smoothing_px must be in (0, 100]; ";
+  if (threads < 1 || threads > 64) e << "threads must be in [1, 64]; ";
+  return e.str();
+}
+
+std::vector<double> pixelBearings(const CameraModel& camera) {
+  std::vector<double> b(2 * static_cast<size_t>(camera.width) * camera.height);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Vec3 d = camera.bearing(Vec2(x, y));
+      const size_t i = static_cast<size_t>(y) * camera.width + x;
+      b[2 * i] = d.x();
+      b[2 * i + 1] = d.y();
+    }
+  return b;
+}
+
+std::vector<float> renderLogImage(const Scene& scene, const CameraModel& camera,
+                                  const RigidPose& T_world_cam, double log_eps,
+                                  double smoothing_px) {
+  std::vector<CameraPlane> cp;
+  for (const auto& pl : scene.planes) cp.push_back(toCameraFrame(pl, T_world_cam));
+  const std::vector<double> b = pixelBearings(camera);
+  std::vector<float> L(b.size() / 2);
+  for (size_t i = 0; i < L.size(); ++i)
+    L[i] = static_cast<float>(std::log(
+        log_eps +
+        shadePixel(scene, cp, b[2 * i], b[2 * i + 1], camera.fx, camera.fy, smoothing_px, false)
+            .intensity));
+  return L;
+}
+
+struct RenderEventSimulator::Impl {
+  Scene scene;
+  CameraModel camera;
+  Trajectory trajectory;
+  RenderOptions opt;
+  double t = 0.0;
+  RenderStats stats;
+  std::vector<double> bearings;
+  std::vector<float> L, ref, cp, cm;
+  std::vector<int64_t> last_us;
+  std::vector<uint16_t> skip;  ///< steps the pixel may still skip without shading
+  std::vector<double> noise_next;
+  std::vector<uint64_t> rng;
+  std::vector<Vec2> speed_samples;  ///< pixels where the image speed is measured
+
+  Impl(const Scene& s, const CameraModel& c, const Trajectory& tr, const RenderOptions& o)
+      : scene(s), camera(c), trajectory(tr), opt(o) {}
+
+  std::vector<CameraPlane> planesAt(double time) const {
+    const RigidPose T = trajectory.pose(time);
+    std::vector<CameraPlane> out;
+    out.reserve(scene.planes.size());
+    for (const auto& pl : scene.planes) out.push_back(toCameraFrame(pl, T));
+    return out;
+  }
+
+  double speed(double time) const {
+    const double h = 1e-4;
+    const RigidPose T0 = trajectory.pose(time), T1 = trajectory.pose(time + h);
+    const std::vector<CameraPlane> cps = planesAt(time);
+    double vmax = 0.0;
+    for (const Vec2& px : speed_samples) {
+      const Vec3 d = camera.bearing(px);
+      Vec3 X;
+      if (frontHit(scene, cps, d.x(), d.y(), T0, X) < 0) continue;
+      const Vec3 c0 = T0.R.transpose() * (X - T0.p), c1 = T1.R.transpose() * (X - T1.p);
+      if (!(c0.z() > 1e-6) || !(c1.z() > 1e-6)) continue;
+      vmax = std::max(vmax, (camera.project(c1) - camera.project(c0)).norm() / h);
+    }
+    return vmax;
+  }
+
+  double stepAt(double time) const {
+    const double v = speed(time);
+    double dt = v > 0.0 ? opt.max_step_px / v : opt.max_step;
+    return std::clamp(dt, opt.min_step, opt.max_step);
+  }
+
+  struct BandOutput {
+    std::vector<SimEvent> events;
+    std::vector<size_t> step_end;  ///< events[.. step_end[s]] belong to steps <= s
+    int64_t on = 0, off = 0, noise = 0, dropped = 0, shaded = 0;
+  };
+
+  void runBand(int y0, int y1, double t_begin, const std::vector<double>& steps,
+               const std::vector<std::vector<CameraPlane>>& planes, BandOutput& out) {
+    const int W = camera.width;
+    const int64_t refr_us = std::llround(opt.refractory * 1e6);
+    const double noise_rate = opt.noise_rate;
+    const double skip_scale = 1.0 / (2.0 * opt.max_step_px);
+    struct Crossing {
+      double t;
+      bool on;
+      bool noise;
+    };
+    std::vector<Crossing> cross;
+    double ta = t_begin;
+    for (size_t s = 0; s < steps.size(); ++s) {
+      const double tb = steps[s];
+      const double dt = tb - ta;
+      const std::vector<CameraPlane>& cps = planes[s];
+      for (int y = y0; y < y1; ++y) {
+        for (int x = 0; x < W; ++x) {
+          const size_t i = static_cast<size_t>(y) * W + x;
+          const double bx = bearings[2 * i], by = bearings[2 * i + 1];
+          const float L0 = L[i];
+          float L1 = L0;
+          if (skip[i] > 0) {
+            --skip[i];
+          } else {
+            const PixelSample ps = shadePixel(scene, cps, bx, by, camera.fx, camera.fy,
+                                              opt.smoothing_px, false);
+            L1 = std::log(static_cast<float>(opt.log_eps) + ps.intensity);
+            ++out.shaded;
+            if (opt.skip_static) {
+              const double n = std::floor((ps.free_px - 0.5 * opt.smoothing_px) * skip_scale) - 1.0;
+              skip[i] = static_cast<uint16_t>(std::clamp(n, 0.0, 65535.0));
+            }
+          }
+          const bool has_noise = noise_rate > 0.0 && noise_next[i] <= tb;
+          if (L1 == L0 && !has_noise) continue;
+          L[i] = L1;
+          cross.clear();
+          float r = ref[i];
+          const double dL = static_cast<double>(L1) - L0;
+          if (L1 >= r + cp[i]) {
+            while (L1 >= r + cp[i]) {
+              r += cp[i];
+              cross.push_back({ta + (r - L0) / dL * dt, true, false});
+            }
+          } else if (L1 <= r - cm[i]) {
+            while (L1 <= r - cm[i]) {
+              r -= cm[i];
+              cross.push_back({ta + (r - L0) / dL * dt, false, false});
+            }
+          }
+          ref[i] = r;
+          const size_t n_signal = cross.size();
+          if (has_noise) {
+            while (noise_next[i] <= tb) {
+              const bool on = (splitmix64(rng[i]) >> 63) != 0;
+              cross.push_back({noise_next[i], on, true});
+              noise_next[i] += -std::log(uniform01(rng[i])) / noise_rate;
+            }
+            std::inplace_merge(cross.begin(), cross.begin() + n_signal, cross.end(),
+                               [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
+          }
+          if (cross.empty()) continue;
+          int label = -1;
+          if (n_signal > 0)
+            label = shadePixel(scene, cps, bx, by, camera.fx, camera.fy, opt.smoothing_px, true)
+                        .edge;
+          for (const Crossing& c : cross) {
+            const int64_t tu = std::llround(c.t * 1e6);
+            if (refr_us > 0 && last_us[i] != kNever && tu - last_us[i] < refr_us) {
+              ++out.dropped;
+              continue;
+            }
+            last_us[i] = tu;
+            SimEvent e;
+            e.t_us = tu;
+            e.x = static_cast<uint16_t>(x);
+            e.y = static_cast<uint16_t>(y);
+            e.on = c.on;
+            e.label = c.noise ? -1 : label;
+            out.events.push_back(e);
+            if (c.on) ++out.on; else ++out.off;
+            if (c.noise) ++out.noise;
+          }
+        }
+      }
+      out.step_end.push_back(out.events.size());
+      ta = tb;
+    }
+  }
+};
+
+RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel& camera,
+                                           const Trajectory& trajectory,
+                                           const RenderOptions& options, double t0)
+    : impl_(std::make_unique<Impl>(scene, camera, trajectory, options)) {
+  const std::string e1 = options.validate();
+  if (!e1.empty()) throw std::invalid_argument("render options: " + e1);
+  const std::string e2 = camera.validate();
+  if (!e2.empty()) throw std::invalid_argument("camera: " + e2);
+  if (camera.width > 65535 || camera.height > 65535)
+    throw std::invalid_argument("camera: resolution above 65535 px");
+  Impl& m = *impl_;
+  m.t = t0;
+  m.bearings = pixelBearings(camera);
+  const size_t n = static_cast<size_t>(camera.width) * camera.height;
+  m.ref.resize(n);
+  m.cp.resize(n);
+  m.cm.resize(n);
+  m.last_us.assign(n, kNever);
+  m.skip.assign(n, 0);
+  m.noise_next.assign(n, std::numeric_limits<double>::infinity());
+  m.rng.resize(n);
+  std::mt19937_64 gen(options.seed);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (size_t i = 0; i < n; ++i) {
+    m.cp[i] = static_cast<float>(std::max(0.01, options.contrast_on + options.contrast_sigma * N(gen)));
+    m.cm[i] = static_cast<float>(std::max(0.01, options.contrast_off + options.contrast_sigma * N(gen)));
+    m.rng[i] = options.seed * 0xD1B54A32D192ED03ULL + 0x632BE59BD9B4E019ULL * (i + 1);
+    if (options.noise_rate > 0.0)
+      m.noise_next[i] = t0 - std::log(uniform01(m.rng[i])) / options.noise_rate;
+  }
+  m.L = renderLogImage(scene, camera, trajectory.pose(t0), options.log_eps, options.smoothing_px);
+  m.ref = m.L;
+  m.stats.renders = 1;
+  const int gx = 12, gy = 9;
+  for (int j = 0; j < gy; ++j)
+    for (int i = 0; i < gx; ++i)
+      m.speed_samples.emplace_back((camera.width - 1) * double(i) / (gx - 1),
+                                   (camera.height - 1) * double(j) / (gy - 1));
+}
+
+RenderEventSimulator::~RenderEventSimulator() = default;
+
+void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
+  Impl& m = *impl_;
+  if (!(t_end > m.t)) return;
+  const int H = m.camera.height;
+  const int n_threads = std::min(m.opt.threads, H);
+  while (m.t < t_end) {
+    std::vector<double> steps;
+    double cur = m.t;
+    while (cur < t_end && steps.size() < kStepsPerChunk) {
+      const double dt = m.stepAt(cur);
+      // Avoid a sliver of a step at the end: stretch the last one by up to 20 %.
+      const double next = (t_end - cur <= 1.2 * dt) ? t_end : cur + dt;
+      const double used = next - cur;
+      if (m.stats.max_step == 0.0) m.stats.min_step = used;  // first step ever
+      m.stats.min_step = std::min(m.stats.min_step, used);
+      m.stats.max_step = std::max(m.stats.max_step, used);
+      steps.push_back(next);
+      cur = next;
+    }
+    std::vector<std::vector<CameraPlane>> planes;
+    planes.reserve(steps.size());
+    for (double ts : steps) planes.push_back(m.planesAt(ts));
+
+    std::vector<Impl::BandOutput> bands(n_threads);
+    std::vector<std::thread> workers;
+    const double t_begin = m.t;
+    for (int b = 1; b < n_threads; ++b) {
+      const int y0 = H * b / n_threads, y1 = H * (b + 1) / n_threads;
+      workers.emplace_back([&, y0, y1, b] { m.runBand(y0, y1, t_begin, steps, planes, bands[b]); });
+    }
+    m.runBand(0, H / n_threads, t_begin, steps, planes, bands[0]);
+    for (auto& w : workers) w.join();
+
+    // Merge: the events of step s from every band, sorted by (t, y, x). Steps
+    // are consecutive in time, so the output stays sorted across steps.
+    std::vector<size_t> pos(n_threads, 0);
+    for (size_t s = 0; s < steps.size(); ++s) {
+      const size_t first = out.size();
+      for (int b = 0; b < n_threads; ++b) {
+        const auto& ev = bands[b].events;
+        out.insert(out.end(), ev.begin() + pos[b], ev.begin() + bands[b].step_end[s]);
+        pos[b] = bands[b].step_end[s];
+      }
+      std::stable_sort(out.begin() + first, out.end(), eventLess);
+    }
+    for (const auto& b : bands) {
+      m.stats.events_on += b.on;
+      m.stats.events_off += b.off;
+      m.stats.events_noise += b.noise;
+      m.stats.refractory_dropped += b.dropped;
+      m.stats.pixels_shaded += b.shaded;
+    }
+    m.stats.renders += static_cast<int64_t>(steps.size());
+    m.t = cur;
+  }
+}
+
+double RenderEventSimulator::time() const { return impl_->t; }
+const RenderStats& RenderEventSimulator::stats() const { return impl_->stats; }
+const std::vector<float>& RenderEventSimulator::logIntensity() const { return impl_->L; }
+const std::vector<float>& RenderEventSimulator::reference() const { return impl_->ref; }
+const std::vector<float>& RenderEventSimulator::thresholdOn() const { return impl_->cp; }
+const std::vector<float>& RenderEventSimulator::thresholdOff() const { return impl_->cm; }
+double RenderEventSimulator::imageSpeed(double t) const { return impl_->speed(t); }
+
+}  // namespace celc::sim
