@@ -273,8 +273,9 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
     double cur = m.t;
     while (cur < t_end && steps.size() < kStepsPerChunk) {
       const double dt = m.stepAt(cur);
-      // Avoid a sliver of a step at the end: stretch the last one by up to 20 %.
-      const double next = (t_end - cur <= 1.2 * dt) ? t_end : cur + dt;
+      // Avoid a sliver of a step at the end: split the last two steps evenly.
+      const double rest = t_end - cur;
+      const double next = rest <= dt ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
       const double used = next - cur;
       if (m.stats.max_step == 0.0) m.stats.min_step = used;  // first step ever
       m.stats.min_step = std::min(m.stats.min_step, used);

@@ -70,7 +70,7 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
 /// (0: -u', 1: +u', 2: -v', 3: +v' in the rectangle's axes) nearest to it.
 inline double rectDistance(const TextureRect& r, double u, double v, const Vec2& ju,
                            const Vec2& jv, int& side) {
-  const double c = std::cos(r.angle), s = std::sin(r.angle);
+  const double c = r.cos_a, s = r.sin_a;
   const double du = u - r.centre.x(), dv = v - r.centre.y();
   const double qx = c * du + s * dv, qy = -s * du + c * dv;
   const double gx = (c * ju + s * jv).norm(), gy = (-s * ju + c * jv).norm();
@@ -102,7 +102,11 @@ PlaneShade shadeRects(const ScenePlane& pl, double u, double v, const Vec2& ju, 
   double I = pl.base;
   // Shapes not listed in this cell are > grid_margin [m] away; sqrt(gu^2 + gv^2)
   // bounds the metres per pixel in any direction.
-  double free_px = std::min({pl.grid_margin / std::max(std::hypot(gu, gv), 1e-12),
+  // Distance [m] from (u, v) to the border of its cell (0 outside the grid).
+  const double cw = W / n, ch = H / n;
+  const double cu = u + 0.5 * W - ci * cw, cv = v + 0.5 * H - cj * ch;
+  const double to_border = std::max(0.0, std::min({cu, cw - cu, cv, ch - cv}));
+  double free_px = std::min({(pl.grid_margin + to_border) / std::max(std::hypot(gu, gv), 1e-12),
                              std::abs(inside_u), std::abs(inside_v)});
   for (const uint32_t* it = first; it != last; ++it) {
     const TextureRect& r = pl.rects[*it];
@@ -194,9 +198,13 @@ int ScenePlane::edgeCount() const {
 
 void ScenePlane::buildGrid() {
   if (texture == TextureKind::Chessboard) return;
+  for (TextureRect& r : rects) {
+    r.cos_a = std::cos(r.angle);
+    r.sin_a = std::sin(r.angle);
+  }
   grid_n = std::clamp(static_cast<int>(std::ceil(2.0 * std::sqrt(double(rects.size())))), 1, 64);
-  grid_margin = 0.02 * std::min(width, height);
   const int n = grid_n;
+  grid_margin = std::max(0.02 * std::min(width, height), 0.5 * std::min(width, height) / n);
   std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(n) * n);
   for (size_t k = 0; k < rects.size(); ++k) {
     const TextureRect& r = rects[k];

@@ -44,6 +44,7 @@ struct TextureRect {
   double half_u = 0.05, half_v = 0.05;  ///< [m]
   double angle = 0.0;                   ///< [rad]
   float intensity = 0.5f;               ///< [0, 1]
+  double cos_a = 1.0, sin_a = 0.0;      ///< cos/sin of angle (set by ScenePlane::buildGrid)
 };
 
 /// How a plane's texture is generated (the SCENE.yaml `planes:` entry).
@@ -83,7 +84,7 @@ struct ScenePlane {
   double grid_margin = 0.0;              ///< [m] margin used for the cell lists
   std::vector<uint32_t> cell_start;      ///< grid_n*grid_n + 1 offsets into cell_items
   std::vector<uint32_t> cell_items;
-  void buildGrid();
+  void buildGrid();                      ///< also caches each rect's cos/sin
 };
 
 /// A straight edge of the scene: id and world end points [m].
