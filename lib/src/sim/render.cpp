@@ -67,10 +67,10 @@ std::vector<float> renderLogImage(const Scene& scene, const CameraModel& camera,
   const std::vector<double> b = pixelBearings(camera);
   std::vector<float> L(b.size() / 2);
   for (size_t i = 0; i < L.size(); ++i)
-    L[i] = static_cast<float>(std::log(
-        log_eps +
-        shadePixel(scene, cp, b[2 * i], b[2 * i + 1], camera.fx, camera.fy, smoothing_px, false)
-            .intensity));
+    L[i] = std::log(static_cast<float>(log_eps) +
+                    shadePixel(scene, cp, b[2 * i], b[2 * i + 1], camera.fx, camera.fy,
+                               smoothing_px, false)
+                        .intensity);  // the simulator's own float formula
   return L;
 }
 
@@ -83,6 +83,7 @@ struct RenderEventSimulator::Impl {
   RenderStats stats;
   std::vector<double> bearings;
   std::vector<float> L, ref, cp, cm;
+  std::vector<float> I_last;  ///< intensity of the last shading (L = log(eps + I_last))
   std::vector<int64_t> last_us;
   std::vector<uint16_t> skip;  ///< steps the pixel may still skip without shading
   std::vector<double> noise_next;
@@ -133,13 +134,25 @@ struct RenderEventSimulator::Impl {
     const int W = camera.width;
     const int64_t refr_us = std::llround(opt.refractory * 1e6);
     const double noise_rate = opt.noise_rate;
-    const double skip_scale = 1.0 / (2.0 * opt.max_step_px);
+    // Edges are assumed to move at most 1.5 max_step_px per step (the step is
+    // set from the speed sampled on a 12 x 9 pixel grid; the flow of a plane is
+    // smooth, so its maximum over the image is close to the sampled one).
+    const double skip_scale = 1.0 / (1.5 * opt.max_step_px);
     struct Crossing {
       double t;
       bool on;
       bool noise;
     };
     std::vector<Crossing> cross;
+    // Raw pointers: the compiler cannot prove that the vectors do not alias.
+    uint16_t* const skip_p = skip.data();
+    const double* const noise_p = noise_next.data();
+    const double* const bear_p = bearings.data();
+    float* const L_p = L.data();
+    float* const I_p = I_last.data();
+    const double fx = camera.fx, fy = camera.fy, smoothing = opt.smoothing_px;
+    const float eps = static_cast<float>(opt.log_eps);
+    const bool skip_static = opt.skip_static;
     double ta = t_begin;
     for (size_t s = 0; s < steps.size(); ++s) {
       const double tb = steps[s];
@@ -148,24 +161,32 @@ struct RenderEventSimulator::Impl {
       for (int y = y0; y < y1; ++y) {
         for (int x = 0; x < W; ++x) {
           const size_t i = static_cast<size_t>(y) * W + x;
-          const double bx = bearings[2 * i], by = bearings[2 * i + 1];
-          const float L0 = L[i];
+          // Fast path: a pixel no edge can reach yet and no noise event due.
+          bool shade = true;
+          if (skip_p[i] > 0) {
+            --skip_p[i];
+            if (!(noise_p[i] <= tb)) continue;
+            shade = false;
+          }
+          const double bx = bear_p[2 * i], by = bear_p[2 * i + 1];
+          const float L0 = L_p[i];
           float L1 = L0;
-          if (skip[i] > 0) {
-            --skip[i];
-          } else {
-            const PixelSample ps = shadePixel(scene, cps, bx, by, camera.fx, camera.fy,
-                                              opt.smoothing_px, false);
-            L1 = std::log(static_cast<float>(opt.log_eps) + ps.intensity);
+          if (shade) {
+            const PixelSample ps = shadePixel(scene, cps, bx, by, fx, fy, smoothing, false);
+            // Most re-shaded pixels see the very same intensity: skip the log then.
+            if (ps.intensity != I_p[i]) {
+              I_p[i] = ps.intensity;
+              L1 = std::log(eps + ps.intensity);
+            }
             ++out.shaded;
-            if (opt.skip_static) {
-              const double n = std::floor((ps.free_px - 0.5 * opt.smoothing_px) * skip_scale) - 1.0;
-              skip[i] = static_cast<uint16_t>(std::clamp(n, 0.0, 65535.0));
+            if (skip_static) {
+              const double n = std::floor((ps.free_px - 0.5 * smoothing) * skip_scale) - 1.0;
+              skip_p[i] = static_cast<uint16_t>(std::clamp(n, 0.0, 65535.0));
             }
           }
-          const bool has_noise = noise_rate > 0.0 && noise_next[i] <= tb;
+          const bool has_noise = noise_rate > 0.0 && noise_p[i] <= tb;
           if (L1 == L0 && !has_noise) continue;
-          L[i] = L1;
+          L_p[i] = L1;
           cross.clear();
           float r = ref[i];
           const double dL = static_cast<double>(L1) - L0;
@@ -251,7 +272,18 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
     if (options.noise_rate > 0.0)
       m.noise_next[i] = t0 - std::log(uniform01(m.rng[i])) / options.noise_rate;
   }
-  m.L = renderLogImage(scene, camera, trajectory.pose(t0), options.log_eps, options.smoothing_px);
+  {
+    std::vector<CameraPlane> cps;
+    for (const auto& pl : scene.planes) cps.push_back(toCameraFrame(pl, trajectory.pose(t0)));
+    m.L.resize(n);
+    m.I_last.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      m.I_last[i] = shadePixel(scene, cps, m.bearings[2 * i], m.bearings[2 * i + 1], camera.fx,
+                               camera.fy, options.smoothing_px, false)
+                        .intensity;
+      m.L[i] = std::log(static_cast<float>(options.log_eps) + m.I_last[i]);
+    }
+  }
   m.ref = m.L;
   m.stats.renders = 1;
   const int gx = 12, gy = 9;

@@ -14,7 +14,6 @@ namespace {
 constexpr int kMaxPlanes = 16;
 
 inline double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
-inline int parity(long i) { return static_cast<int>(((i % 2) + 2) % 2); }
 
 /// What one plane contributes at a pixel.
 struct PlaneShade {
@@ -34,21 +33,23 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
   PlaneShade out;
   const double W = pl.width, H = pl.height, sq = pl.square;
   const double uu = u + 0.5 * W, vv = v + 0.5 * H;
-  const double gu = ju.norm(), gv = jv.norm();
-  const long i = static_cast<long>(std::floor(uu / sq));
-  const long j = static_cast<long>(std::floor(vv / sq));
-  const double du = std::min(uu - i * sq, (i + 1) * sq - uu);
-  const double dv = std::min(vv - j * sq, (j + 1) * sq - vv);
+  // Pixels per metre along u and v (the inverse metres-per-pixel, bounded).
+  const double pu = 1.0 / std::max(ju.norm(), 1e-12), pv = 1.0 / std::max(jv.norm(), 1e-12);
+  const double fi = std::floor(uu / sq), fj = std::floor(vv / sq);
+  const long i = static_cast<long>(fi), j = static_cast<long>(fj);
+  const double du = std::min(uu - fi * sq, (fi + 1.0) * sq - uu) * pu;  // [px]
+  const double dv = std::min(vv - fj * sq, (fj + 1.0) * sq - vv) * pv;
   // Smoothed square waves in {-1, +1}: linear ramp of width w [px] across each line.
-  const double su = (parity(i) ? -1.0 : 1.0) * std::min(1.0, 2.0 * toPx(du, gu) / w);
-  const double sv = (parity(j) ? -1.0 : 1.0) * std::min(1.0, 2.0 * toPx(dv, gv) / w);
+  const double k = 2.0 / w;
+  const double su = ((i & 1) ? -1.0 : 1.0) * std::min(1.0, k * du);
+  const double sv = ((j & 1) ? -1.0 : 1.0) * std::min(1.0, k * dv);
   const double checker = 0.5 * (1.0 + su * sv);  // 1 on light squares ((i + j) even)
   out.intensity = pl.dark + (pl.light - pl.dark) * checker;
-  const double inside =
-      std::min(toPx(std::min(uu, W - uu), gu), toPx(std::min(vv, H - vv), gv));
+  const double inside = std::min(std::min(uu, W - uu) * pu, std::min(vv, H - vv) * pv);
   out.coverage = clamp01(0.5 + inside / w);
-  out.free_px = std::min({toPx(du, gu), toPx(dv, gv), std::abs(inside)});
+  out.free_px = std::min(std::min(du, dv), std::abs(inside));
   if (want_edge) {
+    const double gu = 1.0 / pu, gv = 1.0 / pv;
     const long iu = std::clamp(std::lround(uu / sq), 0L, static_cast<long>(pl.columns));
     const long jv2 = std::clamp(std::lround(vv / sq), 0L, static_cast<long>(pl.rows));
     const double out_v = std::max(0.0, std::max(-vv, vv - H));

@@ -49,7 +49,7 @@ struct RenderOptions {
   double smoothing_px = 1.0;      ///< width of the anti-aliasing ramp across edges [px]
   /// Skip shading a pixel while every edge is farther than it can travel in
   /// the coming steps (distance bound from the last render, assuming at most
-  /// 2 * max_step_px per step); false shades every pixel at every step.
+  /// 1.5 * max_step_px per step); false shades every pixel at every step.
   bool skip_static = true;
   int threads = 2;                ///< worker threads (1..64)
   uint64_t seed = 1;              ///< thresholds and noise
