@@ -24,6 +24,16 @@ inline uint64_t splitmix64(uint64_t& state) {
 inline double uniform01(uint64_t& state) {
   return (static_cast<double>(splitmix64(state) >> 11) + 1.0) * (1.0 / 9007199254740992.0);
 }
+/// Runs f(band, y0, y1) on `threads` bands of rows [0, H), the first on the calling thread.
+template <typename F>
+void forRowBands(int H, int threads, const F& f) {
+  threads = std::max(1, std::min(threads, H));
+  std::vector<std::thread> workers;
+  for (int b = 1; b < threads; ++b)
+    workers.emplace_back(f, b, H * b / threads, H * (b + 1) / threads);
+  f(0, 0, H / threads);
+  for (auto& w : workers) w.join();
+}
 inline bool eventLess(const SimEvent& a, const SimEvent& b) {
   if (a.t_us != b.t_us) return a.t_us < b.t_us;
   if (a.y != b.y) return a.y < b.y;
@@ -89,6 +99,7 @@ struct RenderEventSimulator::Impl {
   std::vector<double> noise_next;
   std::vector<uint64_t> rng;
   std::vector<Vec2> speed_samples;  ///< pixels where the image speed is measured
+  std::vector<Vec3> speed_bearings; ///< their bearings
 
   Impl(const Scene& s, const CameraModel& c, const Trajectory& tr, const RenderOptions& o)
       : scene(s), camera(c), trajectory(tr), opt(o) {}
@@ -106,8 +117,7 @@ struct RenderEventSimulator::Impl {
     const RigidPose T0 = trajectory.pose(time), T1 = trajectory.pose(time + h);
     const std::vector<CameraPlane> cps = planesAt(time);
     double vmax = 0.0;
-    for (const Vec2& px : speed_samples) {
-      const Vec3 d = camera.bearing(px);
+    for (const Vec3& d : speed_bearings) {
       Vec3 X;
       if (frontHit(scene, cps, d.x(), d.y(), T0, X) < 0) continue;
       const Vec3 c0 = T0.R.transpose() * (X - T0.p), c1 = T1.R.transpose() * (X - T1.p);
@@ -124,8 +134,7 @@ struct RenderEventSimulator::Impl {
   }
 
   struct BandOutput {
-    std::vector<SimEvent> events;
-    std::vector<size_t> step_end;  ///< events[.. step_end[s]] belong to steps <= s
+    std::vector<std::vector<SimEvent>> events;  ///< per step of the chunk
     int64_t on = 0, off = 0, noise = 0, dropped = 0, shaded = 0;
   };
 
@@ -153,12 +162,19 @@ struct RenderEventSimulator::Impl {
     const double fx = camera.fx, fy = camera.fy, smoothing = opt.smoothing_px;
     const float eps = static_cast<float>(opt.log_eps);
     const bool skip_static = opt.skip_static;
+    out.events.assign(steps.size(), {});
+    // Tiles of a few rows run through all the steps of the chunk, so that their
+    // per-pixel state stays in cache.
+    constexpr int kTileRows = 4;
+    for (int ty = y0; ty < y1; ty += kTileRows) {
+    const int ty1 = std::min(y1, ty + kTileRows);
     double ta = t_begin;
     for (size_t s = 0; s < steps.size(); ++s) {
       const double tb = steps[s];
       const double dt = tb - ta;
       const std::vector<CameraPlane>& cps = planes[s];
-      for (int y = y0; y < y1; ++y) {
+      std::vector<SimEvent>& step_events = out.events[s];
+      for (int y = ty; y < ty1; ++y) {
         for (int x = 0; x < W; ++x) {
           const size_t i = static_cast<size_t>(y) * W + x;
           // Fast path: a pixel no edge can reach yet and no noise event due.
@@ -230,14 +246,14 @@ struct RenderEventSimulator::Impl {
             e.y = static_cast<uint16_t>(y);
             e.on = c.on;
             e.label = c.noise ? -1 : label;
-            out.events.push_back(e);
+            step_events.push_back(e);
             if (c.on) ++out.on; else ++out.off;
             if (c.noise) ++out.noise;
           }
         }
       }
-      out.step_end.push_back(out.events.size());
       ta = tb;
+    }
     }
   }
 };
@@ -254,8 +270,28 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
     throw std::invalid_argument("camera: resolution above 65535 px");
   Impl& m = *impl_;
   m.t = t0;
-  m.bearings = pixelBearings(camera);
   const size_t n = static_cast<size_t>(camera.width) * camera.height;
+  m.bearings.resize(2 * n);
+  m.L.resize(n);
+  m.I_last.resize(n);
+  // Bearings (undistortion) and the first image, in parallel bands of rows.
+  {
+    std::vector<CameraPlane> cps;
+    for (const auto& pl : scene.planes) cps.push_back(toCameraFrame(pl, trajectory.pose(t0)));
+    forRowBands(camera.height, options.threads, [&](int, int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < camera.width; ++x) {
+          const size_t i = static_cast<size_t>(y) * camera.width + x;
+          const Vec3 d = camera.bearing(Vec2(x, y));
+          m.bearings[2 * i] = d.x();
+          m.bearings[2 * i + 1] = d.y();
+          m.I_last[i] = shadePixel(scene, cps, d.x(), d.y(), camera.fx, camera.fy,
+                                   options.smoothing_px, false)
+                            .intensity;
+          m.L[i] = std::log(static_cast<float>(options.log_eps) + m.I_last[i]);
+        }
+    });
+  }
   m.ref.resize(n);
   m.cp.resize(n);
   m.cm.resize(n);
@@ -272,25 +308,18 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
     if (options.noise_rate > 0.0)
       m.noise_next[i] = t0 - std::log(uniform01(m.rng[i])) / options.noise_rate;
   }
-  {
-    std::vector<CameraPlane> cps;
-    for (const auto& pl : scene.planes) cps.push_back(toCameraFrame(pl, trajectory.pose(t0)));
-    m.L.resize(n);
-    m.I_last.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      m.I_last[i] = shadePixel(scene, cps, m.bearings[2 * i], m.bearings[2 * i + 1], camera.fx,
-                               camera.fy, options.smoothing_px, false)
-                        .intensity;
-      m.L[i] = std::log(static_cast<float>(options.log_eps) + m.I_last[i]);
-    }
-  }
   m.ref = m.L;
   m.stats.renders = 1;
   const int gx = 12, gy = 9;
-  for (int j = 0; j < gy; ++j)
-    for (int i = 0; i < gx; ++i)
-      m.speed_samples.emplace_back((camera.width - 1) * double(i) / (gx - 1),
-                                   (camera.height - 1) * double(j) / (gy - 1));
+  for (int j = 0; j < gy; ++j) {
+    for (int i = 0; i < gx; ++i) {
+      const int x = static_cast<int>(std::lround((camera.width - 1) * double(i) / (gx - 1)));
+      const int y = static_cast<int>(std::lround((camera.height - 1) * double(j) / (gy - 1)));
+      const size_t k = static_cast<size_t>(y) * camera.width + x;
+      m.speed_samples.emplace_back(x, y);
+      m.speed_bearings.emplace_back(m.bearings[2 * k], m.bearings[2 * k + 1], 1.0);
+    }
+  }
 }
 
 RenderEventSimulator::~RenderEventSimulator() = default;
@@ -320,24 +349,18 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
     for (double ts : steps) planes.push_back(m.planesAt(ts));
 
     std::vector<Impl::BandOutput> bands(n_threads);
-    std::vector<std::thread> workers;
     const double t_begin = m.t;
-    for (int b = 1; b < n_threads; ++b) {
-      const int y0 = H * b / n_threads, y1 = H * (b + 1) / n_threads;
-      workers.emplace_back([&, y0, y1, b] { m.runBand(y0, y1, t_begin, steps, planes, bands[b]); });
-    }
-    m.runBand(0, H / n_threads, t_begin, steps, planes, bands[0]);
-    for (auto& w : workers) w.join();
+    forRowBands(H, n_threads, [&](int b, int y0, int y1) {
+      m.runBand(y0, y1, t_begin, steps, planes, bands[b]);
+    });
 
     // Merge: the events of step s from every band, sorted by (t, y, x). Steps
     // are consecutive in time, so the output stays sorted across steps.
-    std::vector<size_t> pos(n_threads, 0);
     for (size_t s = 0; s < steps.size(); ++s) {
       const size_t first = out.size();
       for (int b = 0; b < n_threads; ++b) {
-        const auto& ev = bands[b].events;
-        out.insert(out.end(), ev.begin() + pos[b], ev.begin() + bands[b].step_end[s]);
-        pos[b] = bands[b].step_end[s];
+        const auto& ev = bands[b].events[s];
+        out.insert(out.end(), ev.begin(), ev.end());
       }
       std::stable_sort(out.begin() + first, out.end(), eventLess);
     }
