@@ -13,6 +13,7 @@ namespace celc::sim {
 namespace {
 constexpr int64_t kNever = std::numeric_limits<int64_t>::min();
 constexpr size_t kStepsPerChunk = 64;
+constexpr int64_t kMaxPixels = 4 * 1024 * 1024;  ///< ~60 B of state per pixel
 
 inline uint64_t splitmix64(uint64_t& state) {
   uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
@@ -47,7 +48,7 @@ std::string RenderOptions::validate() const {
   if (!pos(contrast_on) || !pos(contrast_off)) e << "contrast thresholds must be > 0; ";
   if (!(contrast_sigma >= 0.0) || !std::isfinite(contrast_sigma)) e << "contrast_sigma must be >= 0; ";
   if (!(refractory >= 0.0) || !(refractory < 10.0)) e << "refractory must be in [0, 10) s; ";
-  if (!(noise_rate >= 0.0) || !(noise_rate <= 1e5)) e << "noise_rate must be in [0, 1e5] Hz; ";
+  if (!(noise_rate >= 0.0) || !(noise_rate <= 1e3)) e << "noise_rate must be in [0, 1000] Hz; ";
   if (!pos(log_eps)) e << "log_eps must be > 0; ";
   if (!pos(max_step_px)) e << "max_step_px must be > 0; ";
   if (!pos(max_step) || !pos(min_step) || min_step > max_step)
@@ -266,8 +267,9 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
   if (!e1.empty()) throw std::invalid_argument("render options: " + e1);
   const std::string e2 = camera.validate();
   if (!e2.empty()) throw std::invalid_argument("camera: " + e2);
-  if (camera.width > 65535 || camera.height > 65535)
-    throw std::invalid_argument("camera: resolution above 65535 px");
+  if (camera.width > 4096 || camera.height > 4096 ||
+      static_cast<int64_t>(camera.width) * camera.height > kMaxPixels)
+    throw std::invalid_argument("camera: at most 4096 px a side and 4 Mpx in all");
   Impl& m = *impl_;
   m.t = t0;
   const size_t n = static_cast<size_t>(camera.width) * camera.height;

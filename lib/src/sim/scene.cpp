@@ -35,18 +35,19 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
   const double uu = u + 0.5 * W, vv = v + 0.5 * H;
   // Pixels per metre along u and v (the inverse metres-per-pixel, bounded).
   const double pu = 1.0 / std::max(ju.norm(), 1e-12), pv = 1.0 / std::max(jv.norm(), 1e-12);
-  const double fi = std::floor(uu / sq), fj = std::floor(vv / sq);
+  const double inv_sq = 1.0 / sq;
+  const double fi = std::floor(uu * inv_sq), fj = std::floor(vv * inv_sq);
   const long i = static_cast<long>(fi), j = static_cast<long>(fj);
   const double du = std::min(uu - fi * sq, (fi + 1.0) * sq - uu) * pu;  // [px]
   const double dv = std::min(vv - fj * sq, (fj + 1.0) * sq - vv) * pv;
   // Smoothed square waves in {-1, +1}: linear ramp of width w [px] across each line.
-  const double k = 2.0 / w;
+  const double k = 2.0 / w, inv_w = 1.0 / w;
   const double su = ((i & 1) ? -1.0 : 1.0) * std::min(1.0, k * du);
   const double sv = ((j & 1) ? -1.0 : 1.0) * std::min(1.0, k * dv);
   const double checker = 0.5 * (1.0 + su * sv);  // 1 on light squares ((i + j) even)
   out.intensity = pl.dark + (pl.light - pl.dark) * checker;
   const double inside = std::min(std::min(uu, W - uu) * pu, std::min(vv, H - vv) * pv);
-  out.coverage = clamp01(0.5 + inside / w);
+  out.coverage = clamp01(0.5 + inside * inv_w);
   out.free_px = std::min(std::min(du, dv), std::abs(inside));
   if (want_edge) {
     const double gu = 1.0 / pu, gv = 1.0 / pv;
@@ -179,7 +180,7 @@ std::string PlaneSpec::validate() const {
     if (!(width > 0.0) || !(height > 0.0) || !std::isfinite(width) || !std::isfinite(height))
       e << "size must be > 0; ";
     if (!in01(base)) e << "base must be in [0, 1]; ";
-    if (count < 0 || count > 100000) e << "count must be in [0, 100000]; ";
+    if (count < 0 || count > 5000) e << "count must be in [0, 5000]; ";
     if (!(size_range.x() > 0.0) || !(size_range.y() >= size_range.x()) || !size_range.allFinite())
       e << "size_range must be 0 < min <= max; ";
     if (!(width_range.x() > 0.0) || !(width_range.y() >= width_range.x()) ||
@@ -344,16 +345,18 @@ inline bool hitPlane(const CameraPlane& cp, double x, double y, double fx, doubl
                      double& u, double& v, Vec2& ju, Vec2& jv) {
   const double nd = cp.n.x() * x + cp.n.y() * y + cp.n.z();
   if (std::abs(nd) < 1e-12) return false;
-  s = cp.n_o / nd;
+  const double inv_nd = 1.0 / nd;
+  s = cp.n_o * inv_nd;
   if (!(s > 1e-6)) return false;
   const double ad = cp.a.x() * x + cp.a.y() * y + cp.a.z();
   const double bd = cp.b.x() * x + cp.b.y() * y + cp.b.z();
   u = s * ad - cp.a_o;
   v = s * bd - cp.b_o;
   // d(s d)/dx = s (e_x - d n_x / (n . d)): metres per normalised unit, then per pixel.
-  const double kx = cp.n.x() / nd, ky = cp.n.y() / nd;
-  ju = Vec2(s * (cp.a.x() - ad * kx) / fx, s * (cp.a.y() - ad * ky) / fy);
-  jv = Vec2(s * (cp.b.x() - bd * kx) / fx, s * (cp.b.y() - bd * ky) / fy);
+  const double kx = cp.n.x() * inv_nd, ky = cp.n.y() * inv_nd;
+  const double sx = s / fx, sy = s / fy;
+  ju = Vec2(sx * (cp.a.x() - ad * kx), sy * (cp.a.y() - ad * ky));
+  jv = Vec2(sx * (cp.b.x() - bd * kx), sy * (cp.b.y() - bd * ky));
   return true;
 }
 }  // namespace

@@ -135,8 +135,8 @@ void readCamera(const Reader& r, const YAML::Node& n, SynthConfig& c) {
   int64_t w = c.camera.width, h = c.camera.height;
   r.integer(n, P, "width", w);
   r.integer(n, P, "height", h);
-  if (w < 1 || h < 1 || w > 65535 || h > 65535)
-    r.fail(n, "keys 'camera.width' and 'camera.height' must be in [1, 65535]");
+  if (w < 1 || h < 1 || w > 4096 || h > 4096 || w * h > 4 * 1024 * 1024)
+    r.fail(n, "keys 'camera.width' and 'camera.height' must be in [1, 4096] with at most 4 Mpx");
   c.camera.width = static_cast<int>(w);
   c.camera.height = static_cast<int>(h);
   r.num(n, P, "fx", c.camera.fx);
@@ -195,7 +195,7 @@ PlaneSpec readPlane(const Reader& r, const YAML::Node& n, const std::string& P) 
   r.num(n, P, "base", s.base);
   int64_t count = s.count;
   r.integer(n, P, "count", count);
-  if (count < 0 || count > 100000) r.fail(n["count"], "key '" + P + ".count' must be in [0, 100000]");
+  if (count < 0 || count > 5000) r.fail(n["count"], "key '" + P + ".count' must be in [0, 5000]");
   s.count = static_cast<int>(count);
   r.vec2(n, P, "intensity_range", s.intensity_range);
   r.vec2(n, P, "size_range", s.size_range);

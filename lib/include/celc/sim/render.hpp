@@ -41,7 +41,7 @@ struct RenderOptions {
   double contrast_off = 0.25;     ///< C- [log intensity]
   double contrast_sigma = 0.03;   ///< per-pixel threshold mismatch, std [log intensity]
   double refractory = 5e-4;       ///< [s]; 0 disables
-  double noise_rate = 0.0;        ///< background events per pixel [Hz]
+  double noise_rate = 0.0;        ///< background events per pixel [Hz], <= 1000
   double log_eps = 1e-2;          ///< eps in L = log(eps + I), I in [0, 1]
   double max_step_px = 0.3;       ///< largest image motion per render step [px]
   double max_step = 2e-3;         ///< largest render step [s]

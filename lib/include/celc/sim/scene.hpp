@@ -59,7 +59,7 @@ struct PlaneSpec {
   // rectangles / segments
   double width = 3.0, height = 2.0;     ///< plane extent along u and v [m]
   double base = 0.5;                    ///< intensity of the plane under its shapes
-  int count = 40;                       ///< number of shapes
+  int count = 40;                       ///< number of shapes (<= 5000)
   Vec2 size_range = Vec2(0.05, 0.4);    ///< rectangles: side; segments: length [m]
   Vec2 width_range = Vec2(0.01, 0.03);  ///< segments: thickness [m]
   Vec2 intensity_range = Vec2(0.05, 0.95);
