@@ -3,6 +3,7 @@
 // labels, SCENE.yaml parsing and the written sequence directory.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -513,6 +514,26 @@ TEST(SimSequence, WritesTheRpgLayout) {
   EXPECT_GT(n, 1000);
   EXPECT_EQ(s.imu_samples, 51);   // 1 kHz over 0.05 s
   EXPECT_EQ(s.poses, 11);         // 200 Hz
+  // The twist recovered from consecutive ground-truth poses (what a consumer
+  // computes) equals the configured one: T_rel = exp(twist dt) exactly.
+  std::ifstream gt(dir / "groundtruth.txt");
+  std::vector<std::array<double, 8>> poses;
+  std::array<double, 8> row;
+  while (gt >> row[0] >> row[1] >> row[2] >> row[3] >> row[4] >> row[5] >> row[6] >> row[7])
+    poses.push_back(row);
+  ASSERT_EQ(poses.size(), 11u);
+  for (size_t k = 1; k < poses.size(); ++k) {
+    auto toPose = [](const std::array<double, 8>& r) {
+      const Eigen::Quaterniond q(r[7], r[4], r[5], r[6]);  // file order: qx qy qz qw
+      return RigidPose{q.toRotationMatrix(), Vec3(r[1], r[2], r[3])};
+    };
+    const RigidPose rel = toPose(poses[k - 1]).inverse() * toPose(poses[k]);
+    const double dt = poses[k][0] - poses[k - 1][0];
+    const Vec3 phi = so3::log(rel.R);
+    const Vec3 v = so3::leftJacobianInverse(phi) * rel.p / dt;
+    EXPECT_LT((phi / dt - Vec3(0.0, 0.1, 0.2)).norm(), 1e-5);
+    EXPECT_LT((v - Vec3(1.0, 0.2, 0.0)).norm(), 1e-5);
+  }
   std::ifstream calib(dir / "calib.txt");
   double c[9];
   for (double& v : c) ASSERT_TRUE(calib >> v);
