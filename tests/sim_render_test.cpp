@@ -266,26 +266,40 @@ TEST(SimRender, SkippingStaticPixelsChangesNothing) {
   rect.count = 12;
   rect.size_range = Vec2(0.1, 0.4);
   rect.random_angle = true;
-  const Scene scene = Scene::build({rect, chessSpec(2.0)}, 0.5, 9);
-  const Trajectory tr(twistSpec(Vec3(0.7, 0.2, 0.4), Vec3(0.1, 0.3, 0.2)), 1.0);
-  RenderOptions o = quietOptions();
-  o.skip_static = false;
-  RenderEventSimulator full(scene, cam, tr, o);
-  o.skip_static = true;
-  RenderEventSimulator fast(scene, cam, tr, o);
-  std::vector<SimEvent> a, b;
-  full.advanceTo(0.15, a);
-  fast.advanceTo(0.15, b);
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_GT(a.size(), 2000u);
-  for (size_t k = 0; k < a.size(); ++k) {
-    ASSERT_EQ(a[k].t_us, b[k].t_us);
-    ASSERT_EQ(a[k].x, b[k].x);
-    ASSERT_EQ(a[k].y, b[k].y);
-    ASSERT_EQ(a[k].on, b[k].on);
-  }
-  // Dense textures at 64x48 px leave few pixels to skip, but some are.
-  EXPECT_LT(fast.stats().pixels_shaded, full.stats().pixels_shaded);
+  const Scene two = Scene::build({rect, chessSpec(2.0)}, 0.5, 9);
+  const Scene one = Scene::build({chessSpec(1.5)}, 0.5, 9);
+  TrajectorySpec constant = twistSpec(Vec3(0.7, 0.2, 0.4), Vec3(0.1, 0.3, 0.2));
+  TrajectorySpec sinus = constant;
+  sinus.kind = TrajectoryKind::Sinusoid;
+  sinus.amplitude_v = Vec3(0.6, 0.5, 0.0);
+  sinus.amplitude_w = Vec3(0.0, 0.3, 0.4);
+  sinus.frequency = 4.0;
+  TrajectorySpec piecewise;  // slow, then a sudden fast motion
+  piecewise.kind = TrajectoryKind::Piecewise;
+  piecewise.segments = {{0.05, Vec3(0.05, 0.0, 0.0), Vec3::Zero()},
+                        {0.1, Vec3(1.5, -0.5, 0.2), Vec3(0.0, 0.5, 0.0)}};
+  for (const Scene* scene : {&one, &two})
+    for (const TrajectorySpec& spec : {constant, sinus, piecewise}) {
+      const Trajectory tr(spec, 1.0);
+      RenderOptions o = quietOptions();
+      o.skip_static = false;
+      RenderEventSimulator full(*scene, cam, tr, o);
+      o.skip_static = true;
+      RenderEventSimulator fast(*scene, cam, tr, o);
+      std::vector<SimEvent> a, b;
+      full.advanceTo(0.15, a);
+      fast.advanceTo(0.15, b);
+      const std::string what = toString(spec.kind) + (scene == &one ? " 1 plane" : " 2 planes");
+      ASSERT_EQ(a.size(), b.size()) << what;
+      ASSERT_GT(a.size(), 1000u) << what;
+      for (size_t k = 0; k < a.size(); ++k) {
+        ASSERT_EQ(a[k].t_us, b[k].t_us) << what;
+        ASSERT_EQ(a[k].x, b[k].x) << what;
+        ASSERT_EQ(a[k].y, b[k].y) << what;
+        ASSERT_EQ(a[k].on, b[k].on) << what;
+      }
+      EXPECT_LT(fast.stats().pixels_shaded, full.stats().pixels_shaded) << what;
+    }
 }
 
 TEST(SimRender, AdaptiveStepBoundsImageMotion) {

@@ -13,6 +13,8 @@ namespace celc::sim {
 namespace {
 constexpr int64_t kNever = std::numeric_limits<int64_t>::min();
 constexpr size_t kStepsPerChunk = 64;
+constexpr double kAheadDt = 1e-4;  ///< [s] for the texture velocity at each pixel
+constexpr double kMaxSkip = 0.05;  ///< [s] longest time a pixel goes without shading
 constexpr int64_t kMaxPixels = 4 * 1024 * 1024;  ///< ~60 B of state per pixel
 
 inline uint64_t splitmix64(uint64_t& state) {
@@ -91,12 +93,14 @@ struct RenderEventSimulator::Impl {
   Trajectory trajectory;
   RenderOptions opt;
   double t = 0.0;
+  double speed_now = -1.0;  ///< image speed at t [px/s] (< 0: not computed yet)
   RenderStats stats;
   std::vector<double> bearings;
   std::vector<float> L, ref, cp, cm;
   std::vector<float> I_last;  ///< intensity of the last shading (L = log(eps + I_last))
   std::vector<int64_t> last_us;
-  std::vector<uint16_t> skip;  ///< steps the pixel may still skip without shading
+  std::vector<double> skip_until;  ///< the pixel needs no shading before this time [s]
+  std::vector<double> wake;        ///< min(skip_until, noise_next)
   std::vector<double> noise_next;
   std::vector<uint64_t> rng;
   std::vector<Vec2> speed_samples;  ///< pixels where the image speed is measured
@@ -128,26 +132,27 @@ struct RenderEventSimulator::Impl {
     return vmax;
   }
 
-  double stepAt(double time) const {
-    const double v = speed(time);
-    double dt = v > 0.0 ? opt.max_step_px / v : opt.max_step;
-    return std::clamp(dt, opt.min_step, opt.max_step);
-  }
 
   struct BandOutput {
     std::vector<std::vector<SimEvent>> events;  ///< per step of the chunk
     int64_t on = 0, off = 0, noise = 0, dropped = 0, shaded = 0;
   };
 
-  void runBand(int y0, int y1, double t_begin, const std::vector<double>& steps,
-               const std::vector<std::vector<CameraPlane>>& planes, BandOutput& out) {
+  /// One chunk of render steps, shared by the bands.
+  struct Chunk {
+    double t_begin = 0.0;
+    std::vector<double> steps;                         ///< render times
+    std::vector<std::vector<CameraPlane>> planes;      ///< planes at each render time
+    std::vector<std::vector<CameraPlane>> ahead;       ///< ... kAheadDt later
+    std::vector<double> speed;                         ///< largest image speed [px/s] at each
+    std::vector<double> skip_cap;                      ///< longest skip [s] from each render
+  };
+
+  void runBand(int y0, int y1, const Chunk& chunk, BandOutput& out) {
+    const std::vector<double>& steps = chunk.steps;
     const int W = camera.width;
     const int64_t refr_us = std::llround(opt.refractory * 1e6);
     const double noise_rate = opt.noise_rate;
-    // Edges are assumed to move at most 1.5 max_step_px per step (the step is
-    // set from the speed sampled on a 12 x 9 pixel grid; the flow of a plane is
-    // smooth, so its maximum over the image is close to the sampled one).
-    const double skip_scale = 1.0 / (1.5 * opt.max_step_px);
     struct Crossing {
       double t;
       bool on;
@@ -155,7 +160,8 @@ struct RenderEventSimulator::Impl {
     };
     std::vector<Crossing> cross;
     // Raw pointers: the compiler cannot prove that the vectors do not alias.
-    uint16_t* const skip_p = skip.data();
+    double* const until_p = skip_until.data();
+    double* const wake_p = wake.data();
     const double* const noise_p = noise_next.data();
     const double* const bear_p = bearings.data();
     float* const L_p = L.data();
@@ -169,27 +175,29 @@ struct RenderEventSimulator::Impl {
     constexpr int kTileRows = 4;
     for (int ty = y0; ty < y1; ty += kTileRows) {
     const int ty1 = std::min(y1, ty + kTileRows);
-    double ta = t_begin;
+    double ta = chunk.t_begin;
     for (size_t s = 0; s < steps.size(); ++s) {
       const double tb = steps[s];
       const double dt = tb - ta;
-      const std::vector<CameraPlane>& cps = planes[s];
+      const std::vector<CameraPlane>& cps = chunk.planes[s];
+      const std::vector<CameraPlane>* ahead = &chunk.ahead[s];
+      // Edges move at most ~max_step_px per step anywhere (the step is set from
+      // the largest speed sampled on a 12 x 9 grid of pixels); 1.5x margin.
+      const double global_speed = 1.5 * chunk.speed[s];
+      const double cap = chunk.skip_cap[s];
       std::vector<SimEvent>& step_events = out.events[s];
       for (int y = ty; y < ty1; ++y) {
         for (int x = 0; x < W; ++x) {
           const size_t i = static_cast<size_t>(y) * W + x;
           // Fast path: a pixel no edge can reach yet and no noise event due.
-          bool shade = true;
-          if (skip_p[i] > 0) {
-            --skip_p[i];
-            if (!(noise_p[i] <= tb)) continue;
-            shade = false;
-          }
+          if (tb < wake_p[i]) continue;
+          const bool shade = tb >= until_p[i];
           const double bx = bear_p[2 * i], by = bear_p[2 * i + 1];
           const float L0 = L_p[i];
           float L1 = L0;
           if (shade) {
-            const PixelSample ps = shadePixel(scene, cps, bx, by, fx, fy, smoothing, false);
+            const PixelSample ps =
+                shadePixel(scene, cps, bx, by, fx, fy, smoothing, false, ahead, kAheadDt);
             // Most re-shaded pixels see the very same intensity: skip the log then.
             if (ps.intensity != I_p[i]) {
               I_p[i] = ps.intensity;
@@ -197,9 +205,17 @@ struct RenderEventSimulator::Impl {
             }
             ++out.shaded;
             if (skip_static) {
-              const double n = std::floor((ps.free_px - 0.5 * smoothing) * skip_scale) - 1.0;
-              skip_p[i] = static_cast<uint16_t>(std::clamp(n, 0.0, 65535.0));
+              // Two lower bounds of the time before an edge can reach the pixel:
+              // at the texture's own velocity at this pixel (1.5x margin), and
+              // at the image's largest speed.
+              const double d = ps.free_px - 0.5 * smoothing - 0.25;
+              const double t_global = d > 0.0 && global_speed > 0.0 ? d / global_speed : 0.0;
+              const double t_skip = std::min(std::max(ps.free_time / 1.5, t_global), cap);
+              until_p[i] = tb + t_skip;
+            } else {
+              until_p[i] = tb;
             }
+            wake_p[i] = std::min(until_p[i], noise_p[i]);
           }
           const bool has_noise = noise_rate > 0.0 && noise_p[i] <= tb;
           if (L1 == L0 && !has_noise) continue;
@@ -226,6 +242,7 @@ struct RenderEventSimulator::Impl {
               cross.push_back({noise_next[i], on, true});
               noise_next[i] += -std::log(uniform01(rng[i])) / noise_rate;
             }
+            wake_p[i] = std::min(until_p[i], noise_p[i]);
             std::inplace_merge(cross.begin(), cross.begin() + n_signal, cross.end(),
                                [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
           }
@@ -298,7 +315,8 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
   m.cp.resize(n);
   m.cm.resize(n);
   m.last_us.assign(n, kNever);
-  m.skip.assign(n, 0);
+  m.skip_until.assign(n, -std::numeric_limits<double>::infinity());
+  m.wake.assign(n, -std::numeric_limits<double>::infinity());
   m.noise_next.assign(n, std::numeric_limits<double>::infinity());
   m.rng.resize(n);
   std::mt19937_64 gen(options.seed);
@@ -332,29 +350,37 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
   const int H = m.camera.height;
   const int n_threads = std::min(m.opt.threads, H);
   while (m.t < t_end) {
-    std::vector<double> steps;
+    Impl::Chunk chunk;
+    chunk.t_begin = m.t;
     double cur = m.t;
-    while (cur < t_end && steps.size() < kStepsPerChunk) {
-      const double dt = m.stepAt(cur);
+    if (!(m.speed_now >= 0.0)) m.speed_now = m.speed(cur);
+    while (cur < t_end && chunk.steps.size() < kStepsPerChunk) {
+      const double v = m.speed_now;
+      const double dt = std::clamp(v > 0.0 ? m.opt.max_step_px / v : m.opt.max_step,
+                                   m.opt.min_step, m.opt.max_step);
       // Avoid a sliver of a step at the end: split the last two steps evenly.
       const double rest = t_end - cur;
-      const double next = rest <= dt ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
+      double next = rest <= dt ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
+      // A render exactly at each jump of a piecewise twist.
+      const double brk = m.trajectory.nextBreak(cur);
+      if (brk > cur && brk < next) next = brk;
       const double used = next - cur;
       if (m.stats.max_step == 0.0) m.stats.min_step = used;  // first step ever
       m.stats.min_step = std::min(m.stats.min_step, used);
       m.stats.max_step = std::max(m.stats.max_step, used);
-      steps.push_back(next);
+      m.speed_now = m.speed(next);
+      chunk.steps.push_back(next);
+      chunk.planes.push_back(m.planesAt(next));
+      chunk.ahead.push_back(m.planesAt(next + kAheadDt));
+      chunk.speed.push_back(m.speed_now);
+      chunk.skip_cap.push_back(std::min({kMaxSkip, m.trajectory.smoothTime(),
+                                         m.trajectory.nextBreak(next) - next}));
       cur = next;
     }
-    std::vector<std::vector<CameraPlane>> planes;
-    planes.reserve(steps.size());
-    for (double ts : steps) planes.push_back(m.planesAt(ts));
+    const std::vector<double>& steps = chunk.steps;
 
     std::vector<Impl::BandOutput> bands(n_threads);
-    const double t_begin = m.t;
-    forRowBands(H, n_threads, [&](int b, int y0, int y1) {
-      m.runBand(y0, y1, t_begin, steps, planes, bands[b]);
-    });
+    forRowBands(H, n_threads, [&](int b, int y0, int y1) { m.runBand(y0, y1, chunk, bands[b]); });
 
     // Merge: the events of step s from every band, sorted by (t, y, x). Steps
     // are consecutive in time, so the output stays sorted across steps.

@@ -22,14 +22,26 @@ struct PlaneShade {
   int edge = -1;
   double edge_px = 1e30;
   double free_px = 0.0;   ///< lower bound of the distance to any edge of the plane [px]
+  double free_time = 0.0; ///< time [s] before an edge can reach the pixel, at the current rates
 };
+
+constexpr double kFreeMarginPx = 0.25;  ///< extra margin [px] beyond the ramp half-width
+constexpr double kInfTime = 1e30;
+
+/// Time to travel `dist` [px] (less the ramp half-width and a margin) at `speed` [px/s].
+inline double travelTime(double dist_px, double speed, double w) {
+  const double d = dist_px - 0.5 * w - kFreeMarginPx;
+  if (d <= 0.0) return 0.0;
+  return speed > 0.0 ? d / speed : kInfTime;
+}
 
 /// Pixel-space distance: metric distance d along a direction whose metres per
 /// pixel is g. g is bounded away from 0 so that a grazing view stays finite.
 inline double toPx(double d, double g) { return d / std::max(g, 1e-12); }
 
+/// (ru, rv): rates [m/s] at which the plane coordinates seen by the pixel change.
 PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2& ju,
-                           const Vec2& jv, double w, bool want_edge) {
+                           const Vec2& jv, double ru, double rv, double w, bool want_edge) {
   PlaneShade out;
   const double W = pl.width, H = pl.height, sq = pl.square;
   const double uu = u + 0.5 * W, vv = v + 0.5 * H;
@@ -49,6 +61,10 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
   const double inside = std::min(std::min(uu, W - uu) * pu, std::min(vv, H - vv) * pv);
   out.coverage = clamp01(0.5 + inside * inv_w);
   out.free_px = std::min(std::min(du, dv), std::abs(inside));
+  // Each family of lines moves across the pixel at its own normal speed [px/s];
+  // the board's border lines belong to the families (virtual lines outside the
+  // board are nearer than the border, so the bound stays conservative).
+  out.free_time = std::min(travelTime(du, std::abs(ru) * pu, w), travelTime(dv, std::abs(rv) * pv, w));
   if (want_edge) {
     const double gu = 1.0 / pu, gv = 1.0 / pv;
     const long iu = std::clamp(std::lround(uu / sq), 0L, static_cast<long>(pl.columns));
@@ -87,7 +103,7 @@ inline double rectDistance(const TextureRect& r, double u, double v, const Vec2&
 }
 
 PlaneShade shadeRects(const ScenePlane& pl, double u, double v, const Vec2& ju, const Vec2& jv,
-                      double w, bool want_edge) {
+                      double ru, double rv, double w, bool want_edge) {
   PlaneShade out;
   const double W = pl.width, H = pl.height;
   const double gu = ju.norm(), gv = jv.norm();
@@ -119,6 +135,14 @@ PlaneShade shadeRects(const ScenePlane& pl, double u, double v, const Vec2& ju, 
     free_px = std::min(free_px, std::abs(sd));
   }
   out.free_px = free_px;
+  {
+    // Image velocity of the texture at the pixel: [ju; jv] d(pixel) = d(u, v).
+    const double det = ju.x() * jv.y() - ju.y() * jv.x();
+    if (std::abs(det) > 1e-300) {
+      const double vx = (jv.y() * ru - ju.y() * rv) / det, vy = (-jv.x() * ru + ju.x() * rv) / det;
+      out.free_time = travelTime(free_px, std::hypot(vx, vy), w);
+    }
+  }
   out.intensity = I;
   if (want_edge) {
     bool hidden = false;
@@ -361,25 +385,48 @@ inline bool hitPlane(const CameraPlane& cp, double x, double y, double fx, doubl
 }
 }  // namespace
 
+/// Plane coordinates seen along bearing (x, y, 1); false when the plane is not in front.
+inline bool planeUV(const CameraPlane& cp, double x, double y, double& u, double& v) {
+  const double nd = cp.n.x() * x + cp.n.y() * y + cp.n.z();
+  if (std::abs(nd) < 1e-12) return false;
+  const double s = cp.n_o / nd;
+  if (!(s > 1e-6)) return false;
+  u = s * (cp.a.x() * x + cp.a.y() * y + cp.a.z()) - cp.a_o;
+  v = s * (cp.b.x() * x + cp.b.y() * y + cp.b.z()) - cp.b_o;
+  return true;
+}
+
 PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_planes, double x,
-                       double y, double fx, double fy, double smoothing_px, bool want_edge) {
+                       double y, double fx, double fy, double smoothing_px, bool want_edge,
+                       const std::vector<CameraPlane>* ahead, double ahead_dt) {
   PixelSample out;
   const double w = std::max(smoothing_px, 1e-3);
   const size_t np = cam_planes.size();
+  const bool rates = ahead != nullptr && ahead->size() == np && ahead_dt > 0.0;
+  // Rates [m/s] of the plane coordinates seen by the pixel; false: unknown.
+  auto rateOf = [&](size_t k, double u, double v, double& ru, double& rv) {
+    double u2, v2;
+    if (!rates || !planeUV((*ahead)[k], x, y, u2, v2)) return false;
+    ru = (u2 - u) / ahead_dt;
+    rv = (v2 - v) / ahead_dt;
+    return true;
+  };
   if (np == 1) {  // the common case: no sorting, no compositing of several planes
-    double s, u, v;
+    double s, u, v, ru = 0.0, rv = 0.0;
     Vec2 ju, jv;
     if (!hitPlane(cam_planes[0], x, y, fx, fy, s, u, v, ju, jv)) {
       out.intensity = scene.background;
       return out;
     }
+    const bool known = rateOf(0, u, v, ru, rv);
     const ScenePlane& pl = scene.planes[0];
     const PlaneShade sh = pl.texture == TextureKind::Chessboard
-                              ? shadeChessboard(pl, u, v, ju, jv, w, want_edge)
-                              : shadeRects(pl, u, v, ju, jv, w, want_edge);
+                              ? shadeChessboard(pl, u, v, ju, jv, ru, rv, w, want_edge)
+                              : shadeRects(pl, u, v, ju, jv, ru, rv, w, want_edge);
     out.intensity = static_cast<float>(sh.coverage * sh.intensity +
                                        (1.0 - sh.coverage) * scene.background);
     out.free_px = static_cast<float>(sh.free_px);
+    out.free_time = known ? static_cast<float>(std::min(sh.free_time, 1e30)) : 0.0f;
     if (want_edge && sh.coverage > 0.0) {
       out.edge = sh.edge;
       out.edge_px = static_cast<float>(sh.edge_px);
@@ -402,14 +449,17 @@ PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_p
     else missed = true;
   }
   double free_px = missed ? 0.0 : 1e30;
+  double free_time = missed ? 0.0 : 1e30;
   std::sort(hits, hits + nh, [](const Hit& a, const Hit& b) { return a.s < b.s; });
   double I = 0.0, T = 1.0;
   for (size_t i = 0; i < nh && T > 0.0; ++i) {
     const Hit& h = hits[i];
     const ScenePlane& pl = scene.planes[h.k];
+    double ru = 0.0, rv = 0.0;
+    const bool known = rateOf(h.k, h.u, h.v, ru, rv);
     const PlaneShade sh = pl.texture == TextureKind::Chessboard
-                              ? shadeChessboard(pl, h.u, h.v, h.ju, h.jv, w, want_edge)
-                              : shadeRects(pl, h.u, h.v, h.ju, h.jv, w, want_edge);
+                              ? shadeChessboard(pl, h.u, h.v, h.ju, h.jv, ru, rv, w, want_edge)
+                              : shadeRects(pl, h.u, h.v, h.ju, h.jv, ru, rv, w, want_edge);
     if (want_edge && out.edge < 0 && sh.coverage > 0.0) {
       out.edge = sh.edge;
       out.edge_px = static_cast<float>(sh.edge_px);
@@ -417,9 +467,11 @@ PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_p
     I += T * sh.coverage * sh.intensity;
     T *= 1.0 - sh.coverage;
     free_px = std::min(free_px, sh.free_px);
+    free_time = std::min(free_time, known ? sh.free_time : 0.0);
   }
   out.intensity = static_cast<float>(I + T * scene.background);
   out.free_px = static_cast<float>(free_px);
+  out.free_time = static_cast<float>(free_time);
   return out;
 }
 

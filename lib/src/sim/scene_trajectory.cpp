@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -120,6 +121,16 @@ Vec3 Trajectory::angularVelocity(double t) const {
       return spec_.w + spec_.amplitude_w * std::sin(2.0 * M_PI * spec_.frequency * t);
   }
   return spec_.w;
+}
+
+double Trajectory::nextBreak(double t) const {
+  const auto it = std::upper_bound(seg_start_.begin(), seg_start_.end(), t);
+  return it == seg_start_.end() ? std::numeric_limits<double>::infinity() : *it;
+}
+
+double Trajectory::smoothTime() const {
+  return spec_.kind == TrajectoryKind::Sinusoid ? 0.01 / spec_.frequency
+                                                : std::numeric_limits<double>::infinity();
 }
 
 Vec3 Trajectory::linearVelocityRate(double t) const {

@@ -47,9 +47,11 @@ struct RenderOptions {
   double max_step = 2e-3;         ///< largest render step [s]
   double min_step = 1e-6;         ///< smallest render step [s]
   double smoothing_px = 1.0;      ///< width of the anti-aliasing ramp across edges [px]
-  /// Skip shading a pixel while every edge is farther than it can travel in
-  /// the coming steps (distance bound from the last render, assuming at most
-  /// 1.5 * max_step_px per step); false shades every pixel at every step.
+  /// Skip shading a pixel until an edge could reach it: the larger of the
+  /// time its nearest edges need at the texture's own velocity at the pixel
+  /// (per chessboard line family, 1.5x margin) and at 1.5x the image's
+  /// largest speed; at most 50 ms, up to the next jump of a piecewise twist,
+  /// 0.01 / f for a sinusoid. false shades every pixel at every step.
   bool skip_static = true;
   int threads = 2;                ///< worker threads (1..64)
   uint64_t seed = 1;              ///< thresholds and noise

@@ -120,14 +120,21 @@ struct PixelSample {
   /// unknown): while edges move less than free_px - smoothing_px / 2 the
   /// pixel's intensity cannot change.
   float free_px = 0.0f;
+  /// Lower bound of the time [s] before an edge comes within smoothing_px / 2
+  /// + 0.25 px of the pixel if the texture keeps its current velocity at the
+  /// pixel (chessboard: per family of lines, so lines sliding along themselves
+  /// do not count); 0 when unknown (no `ahead` planes, plane not hit).
+  float free_time = 0.0f;
 };
 
 /// Intensity (and optionally the nearest edge) seen along bearing d = (x, y, 1)
 /// [normalised camera coordinates] given the planes in the camera frame.
-/// fx, fy [px] convert the plane-to-image Jacobian into pixels.
+/// fx, fy [px] convert the plane-to-image Jacobian into pixels. With `ahead`
+/// (the same planes ahead_dt [s] later) it also bounds free_time.
 PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_planes,
                        double x, double y, double fx, double fy, double smoothing_px,
-                       bool want_edge);
+                       bool want_edge, const std::vector<CameraPlane>* ahead = nullptr,
+                       double ahead_dt = 0.0);
 
 /// Front-most plane hit along bearing d: index and world point; -1 if none.
 int frontHit(const Scene& scene, const std::vector<CameraPlane>& cam_planes, double x, double y,

@@ -52,6 +52,11 @@ class Trajectory {
   Vec3 linearVelocity(double t) const;     ///< v(t), camera frame [m/s]
   Vec3 angularVelocity(double t) const;    ///< w(t), camera frame [rad/s]
   Vec3 linearVelocityRate(double t) const; ///< dv/dt, camera frame [m/s^2]
+  /// Piecewise: the first segment start after t (the twist jumps there); else +infinity.
+  double nextBreak(double t) const;
+  /// A time over which the twist changes little: 0.01 / frequency for the
+  /// sinusoid, +infinity otherwise [s].
+  double smoothTime() const;
 
  private:
   TrajectorySpec spec_;
