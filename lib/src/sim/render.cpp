@@ -360,7 +360,9 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
                                    m.opt.min_step, m.opt.max_step);
       // Avoid a sliver of a step at the end: split the last two steps evenly.
       const double rest = t_end - cur;
-      double next = rest <= dt ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
+      // (1e-9 relative tolerance: slices such as 0.01 - 0.008 are not exactly 0.002).
+      double next = rest <= dt * (1.0 + 1e-9) ? t_end
+                                              : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
       // A render exactly at each jump of a piecewise twist.
       const double brk = m.trajectory.nextBreak(cur);
       if (brk > cur && brk < next) next = brk;
