@@ -104,7 +104,8 @@ TEST(SimScene, ChessboardPixelsSeeTheirSquare) {
       // Plane coordinate u = (x - cx) / f * 1 m; the board starts at u = -1 m.
       // Lines at u = -1 + 0.1 k m, i.e. x = cx + 6 (k - 10) px = 31.5 + 6 m': half-integers.
       const double u = (x - cam.cx) / cam.fx + 1.0, v = (y - cam.cy) / cam.fy + 0.8;
-      const int i = static_cast<int>(std::floor(u / 0.1)), j = static_cast<int>(std::floor(v / 0.1));
+      const int i = static_cast<int>(std::floor(u / 0.1)),
+                j = static_cast<int>(std::floor(v / 0.1));
       const double expected = ((i + j) % 2 == 0) ? 0.8 : 0.2;
       ASSERT_NEAR(std::exp(L[y * cam.width + x]) - 0.01, expected, 1e-5) << x << "," << y;
     }
@@ -416,7 +417,8 @@ TEST(SimImu, GyroEqualsTheTwistInTheImuFrame) {
   for (const auto& m : imu) {
     ASSERT_LT((o.R_cam_imu * m.gyro - tr.angularVelocity(m.t)).norm(), 1e-12);
     // accel = R_imu_cam (dv/dt + w x v - R_world_cam^T g)
-    const Vec3 f = tr.linearVelocityRate(m.t) + tr.angularVelocity(m.t).cross(tr.linearVelocity(m.t)) -
+    const Vec3 f = tr.linearVelocityRate(m.t) +
+                   tr.angularVelocity(m.t).cross(tr.linearVelocity(m.t)) -
                    tr.pose(m.t).R.transpose() * o.gravity;
     ASSERT_LT((o.R_cam_imu * m.accel - f).norm(), 1e-9);
   }
@@ -457,7 +459,8 @@ trajectory: {type: constant_twist, v: [1, 0.2, 0], w: [0, 0.1, 0.2]}
 events: {noise_rate: 2.0}
 )";
 std::string loadError(const std::string& text) {
-  const std::string path = writeFile(fs::temp_directory_path() / "celc_sim_test_cfg", "bad.yaml", text);
+  const std::string path =
+      writeFile(fs::temp_directory_path() / "celc_sim_test_cfg", "bad.yaml", text);
   try {
     loadSynthConfig(path);
   } catch (const std::invalid_argument& e) {
@@ -537,8 +540,8 @@ TEST(SimSequence, WritesTheRpgLayout) {
   EXPECT_EQ(n, s.events);
   EXPECT_EQ(on, s.stats.events_on);
   EXPECT_GT(n, 1000);
-  EXPECT_EQ(s.imu_samples, 51);   // 1 kHz over 0.05 s
-  EXPECT_EQ(s.poses, 11);         // 200 Hz
+  EXPECT_EQ(s.imu_samples, 51);  // 1 kHz over 0.05 s
+  EXPECT_EQ(s.poses, 11);        // 200 Hz
   // The twist recovered from consecutive ground-truth poses (what a consumer
   // computes) equals the configured one: T_rel = exp(twist dt) exactly.
   std::ifstream gt(dir / "groundtruth.txt");

@@ -38,7 +38,8 @@ void runSynth(const SynthArgs& a) {
     if (!fs::is_directory(a.out, ec))
       throw std::runtime_error(a.out + ": exists and is not a directory");
     if (!fs::is_empty(a.out, ec) && !a.force)
-      throw std::runtime_error(a.out + ": directory exists and is not empty (use --force to overwrite)");
+      throw std::runtime_error(a.out +
+                               ": directory exists and is not empty (use --force to overwrite)");
   }
   spdlog::info("synth: {} -> {} ({} {}x{}, {} plane(s), {} s, seed {})", a.scene, a.out,
                cfg.camera_preset, cfg.camera.width, cfg.camera.height, cfg.planes.size(),
@@ -77,11 +78,13 @@ void registerSynth(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->out, "output sequence directory")->required();
-  cmd->add_option("--seed", args->seed, "random seed (overrides `seed`; thresholds, noise, textures)")
+  cmd->add_option("--seed", args->seed,
+                  "random seed (overrides `seed`; thresholds, noise, textures)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--duration", args->duration, "simulated duration [s] (overrides `duration`)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->threads, "render threads (overrides events.threads; default 2)")
+  cmd->add_option("--threads", args->threads,
+                  "render threads (overrides events.threads; default 2)")
       ->check(CLI::Range(1, 64));
   cmd->add_flag("--force", args->force, "write into an existing non-empty directory");
   cmd->add_flag("-q,--quiet", args->quiet, "warnings and errors only");

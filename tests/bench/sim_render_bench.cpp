@@ -43,11 +43,15 @@ void BM_SimRenderChessboardDavis346(benchmark::State& state) {
     events += static_cast<int64_t>(ev.size());
     benchmark::DoNotOptimize(ev.data());
   }
-  state.counters["events_per_s"] = benchmark::Counter(static_cast<double>(events),
-                                                      benchmark::Counter::kIsRate);
+  state.counters["events_per_s"] =
+      benchmark::Counter(static_cast<double>(events), benchmark::Counter::kIsRate);
   state.counters["events_per_iter"] =
       benchmark::Counter(static_cast<double>(events) / state.iterations());
 }
-BENCHMARK(BM_SimRenderChessboardDavis346)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimRenderChessboardDavis346)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace

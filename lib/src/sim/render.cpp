@@ -13,8 +13,8 @@ namespace celc::sim {
 namespace {
 constexpr int64_t kNever = std::numeric_limits<int64_t>::min();
 constexpr size_t kStepsPerChunk = 64;
-constexpr double kAheadDt = 1e-4;  ///< [s] for the texture velocity at each pixel
-constexpr double kMaxSkip = 0.05;  ///< [s] longest time a pixel goes without shading
+constexpr double kAheadDt = 1e-4;                ///< [s] for the texture velocity at each pixel
+constexpr double kMaxSkip = 0.05;                ///< [s] longest time a pixel goes without shading
 constexpr int64_t kMaxPixels = 4 * 1024 * 1024;  ///< ~60 B of state per pixel
 
 inline uint64_t splitmix64(uint64_t& state) {
@@ -48,7 +48,8 @@ std::string RenderOptions::validate() const {
   std::ostringstream e;
   auto pos = [](double x) { return x > 0.0 && std::isfinite(x); };
   if (!pos(contrast_on) || !pos(contrast_off)) e << "contrast thresholds must be > 0; ";
-  if (!(contrast_sigma >= 0.0) || !std::isfinite(contrast_sigma)) e << "contrast_sigma must be >= 0; ";
+  if (!(contrast_sigma >= 0.0) || !std::isfinite(contrast_sigma))
+    e << "contrast_sigma must be >= 0; ";
   if (!(refractory >= 0.0) || !(refractory < 10.0)) e << "refractory must be in [0, 10) s; ";
   if (!(noise_rate >= 0.0) || !(noise_rate <= 1e3)) e << "noise_rate must be in [0, 1000] Hz; ";
   if (!pos(log_eps)) e << "log_eps must be > 0; ";
@@ -80,10 +81,10 @@ std::vector<float> renderLogImage(const Scene& scene, const CameraModel& camera,
   const std::vector<double> b = pixelBearings(camera);
   std::vector<float> L(b.size() / 2);
   for (size_t i = 0; i < L.size(); ++i)
-    L[i] = std::log(static_cast<float>(log_eps) +
-                    shadePixel(scene, cp, b[2 * i], b[2 * i + 1], camera.fx, camera.fy,
-                               smoothing_px, false)
-                        .intensity);  // the simulator's own float formula
+    L[i] = std::log(
+        static_cast<float>(log_eps) +
+        shadePixel(scene, cp, b[2 * i], b[2 * i + 1], camera.fx, camera.fy, smoothing_px, false)
+            .intensity);  // the simulator's own float formula
   return L;
 }
 
@@ -103,8 +104,8 @@ struct RenderEventSimulator::Impl {
   std::vector<double> wake;        ///< min(skip_until, noise_next)
   std::vector<double> noise_next;
   std::vector<uint64_t> rng;
-  std::vector<Vec2> speed_samples;  ///< pixels where the image speed is measured
-  std::vector<Vec3> speed_bearings; ///< their bearings
+  std::vector<Vec2> speed_samples;   ///< pixels where the image speed is measured
+  std::vector<Vec3> speed_bearings;  ///< their bearings
 
   Impl(const Scene& s, const CameraModel& c, const Trajectory& tr, const RenderOptions& o)
       : scene(s), camera(c), trajectory(tr), opt(o) {}
@@ -132,7 +133,6 @@ struct RenderEventSimulator::Impl {
     return vmax;
   }
 
-
   struct BandOutput {
     std::vector<std::vector<SimEvent>> events;  ///< per step of the chunk
     int64_t on = 0, off = 0, noise = 0, dropped = 0, shaded = 0;
@@ -141,11 +141,11 @@ struct RenderEventSimulator::Impl {
   /// One chunk of render steps, shared by the bands.
   struct Chunk {
     double t_begin = 0.0;
-    std::vector<double> steps;                         ///< render times
-    std::vector<std::vector<CameraPlane>> planes;      ///< planes at each render time
-    std::vector<std::vector<CameraPlane>> ahead;       ///< ... kAheadDt later
-    std::vector<double> speed;                         ///< largest image speed [px/s] at each
-    std::vector<double> skip_cap;                      ///< longest skip [s] from each render
+    std::vector<double> steps;                     ///< render times
+    std::vector<std::vector<CameraPlane>> planes;  ///< planes at each render time
+    std::vector<std::vector<CameraPlane>> ahead;   ///< ... kAheadDt later
+    std::vector<double> speed;                     ///< largest image speed [px/s] at each
+    std::vector<double> skip_cap;                  ///< longest skip [s] from each render
   };
 
   void runBand(int y0, int y1, const Chunk& chunk, BandOutput& out) {
@@ -174,104 +174,107 @@ struct RenderEventSimulator::Impl {
     // per-pixel state stays in cache.
     constexpr int kTileRows = 4;
     for (int ty = y0; ty < y1; ty += kTileRows) {
-    const int ty1 = std::min(y1, ty + kTileRows);
-    double ta = chunk.t_begin;
-    for (size_t s = 0; s < steps.size(); ++s) {
-      const double tb = steps[s];
-      const double dt = tb - ta;
-      const std::vector<CameraPlane>& cps = chunk.planes[s];
-      const std::vector<CameraPlane>* ahead = &chunk.ahead[s];
-      // Edges move at most ~max_step_px per step anywhere (the step is set from
-      // the largest speed sampled on a 12 x 9 grid of pixels); 1.5x margin.
-      const double global_speed = 1.5 * chunk.speed[s];
-      const double cap = chunk.skip_cap[s];
-      std::vector<SimEvent>& step_events = out.events[s];
-      for (int y = ty; y < ty1; ++y) {
-        for (int x = 0; x < W; ++x) {
-          const size_t i = static_cast<size_t>(y) * W + x;
-          // Fast path: a pixel no edge can reach yet and no noise event due.
-          if (tb < wake_p[i]) continue;
-          const bool shade = tb >= until_p[i];
-          const double bx = bear_p[2 * i], by = bear_p[2 * i + 1];
-          const float L0 = L_p[i];
-          float L1 = L0;
-          if (shade) {
-            const PixelSample ps =
-                shadePixel(scene, cps, bx, by, fx, fy, smoothing, false, ahead, kAheadDt);
-            // Most re-shaded pixels see the very same intensity: skip the log then.
-            if (ps.intensity != I_p[i]) {
-              I_p[i] = ps.intensity;
-              L1 = std::log(eps + ps.intensity);
+      const int ty1 = std::min(y1, ty + kTileRows);
+      double ta = chunk.t_begin;
+      for (size_t s = 0; s < steps.size(); ++s) {
+        const double tb = steps[s];
+        const double dt = tb - ta;
+        const std::vector<CameraPlane>& cps = chunk.planes[s];
+        const std::vector<CameraPlane>* ahead = &chunk.ahead[s];
+        // Edges move at most ~max_step_px per step anywhere (the step is set from
+        // the largest speed sampled on a 12 x 9 grid of pixels); 1.5x margin.
+        const double global_speed = 1.5 * chunk.speed[s];
+        const double cap = chunk.skip_cap[s];
+        std::vector<SimEvent>& step_events = out.events[s];
+        for (int y = ty; y < ty1; ++y) {
+          for (int x = 0; x < W; ++x) {
+            const size_t i = static_cast<size_t>(y) * W + x;
+            // Fast path: a pixel no edge can reach yet and no noise event due.
+            if (tb < wake_p[i]) continue;
+            const bool shade = tb >= until_p[i];
+            const double bx = bear_p[2 * i], by = bear_p[2 * i + 1];
+            const float L0 = L_p[i];
+            float L1 = L0;
+            if (shade) {
+              const PixelSample ps =
+                  shadePixel(scene, cps, bx, by, fx, fy, smoothing, false, ahead, kAheadDt);
+              // Most re-shaded pixels see the very same intensity: skip the log then.
+              if (ps.intensity != I_p[i]) {
+                I_p[i] = ps.intensity;
+                L1 = std::log(eps + ps.intensity);
+              }
+              ++out.shaded;
+              if (skip_static) {
+                // Two lower bounds of the time before an edge can reach the pixel:
+                // at the texture's own velocity at this pixel (1.5x margin), and
+                // at the image's largest speed.
+                const double d = ps.free_px - 0.5 * smoothing - 0.25;
+                const double t_global = d > 0.0 && global_speed > 0.0 ? d / global_speed : 0.0;
+                const double t_skip = std::min(std::max(ps.free_time / 1.5, t_global), cap);
+                until_p[i] = tb + t_skip;
+              } else {
+                until_p[i] = tb;
+              }
+              wake_p[i] = std::min(until_p[i], noise_p[i]);
             }
-            ++out.shaded;
-            if (skip_static) {
-              // Two lower bounds of the time before an edge can reach the pixel:
-              // at the texture's own velocity at this pixel (1.5x margin), and
-              // at the image's largest speed.
-              const double d = ps.free_px - 0.5 * smoothing - 0.25;
-              const double t_global = d > 0.0 && global_speed > 0.0 ? d / global_speed : 0.0;
-              const double t_skip = std::min(std::max(ps.free_time / 1.5, t_global), cap);
-              until_p[i] = tb + t_skip;
-            } else {
-              until_p[i] = tb;
+            const bool has_noise = noise_rate > 0.0 && noise_p[i] <= tb;
+            if (L1 == L0 && !has_noise) continue;
+            L_p[i] = L1;
+            cross.clear();
+            float r = ref[i];
+            const double dL = static_cast<double>(L1) - L0;
+            if (L1 >= r + cp[i]) {
+              while (L1 >= r + cp[i]) {
+                r += cp[i];
+                cross.push_back({ta + (r - L0) / dL * dt, true, false});
+              }
+            } else if (L1 <= r - cm[i]) {
+              while (L1 <= r - cm[i]) {
+                r -= cm[i];
+                cross.push_back({ta + (r - L0) / dL * dt, false, false});
+              }
             }
-            wake_p[i] = std::min(until_p[i], noise_p[i]);
-          }
-          const bool has_noise = noise_rate > 0.0 && noise_p[i] <= tb;
-          if (L1 == L0 && !has_noise) continue;
-          L_p[i] = L1;
-          cross.clear();
-          float r = ref[i];
-          const double dL = static_cast<double>(L1) - L0;
-          if (L1 >= r + cp[i]) {
-            while (L1 >= r + cp[i]) {
-              r += cp[i];
-              cross.push_back({ta + (r - L0) / dL * dt, true, false});
+            ref[i] = r;
+            const size_t n_signal = cross.size();
+            if (has_noise) {
+              while (noise_next[i] <= tb) {
+                const bool on = (splitmix64(rng[i]) >> 63) != 0;
+                cross.push_back({noise_next[i], on, true});
+                noise_next[i] += -std::log(uniform01(rng[i])) / noise_rate;
+              }
+              wake_p[i] = std::min(until_p[i], noise_p[i]);
+              std::inplace_merge(cross.begin(), cross.begin() + n_signal, cross.end(),
+                                 [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
             }
-          } else if (L1 <= r - cm[i]) {
-            while (L1 <= r - cm[i]) {
-              r -= cm[i];
-              cross.push_back({ta + (r - L0) / dL * dt, false, false});
+            if (cross.empty()) continue;
+            int label = -1;
+            if (n_signal > 0)
+              label =
+                  shadePixel(scene, cps, bx, by, camera.fx, camera.fy, opt.smoothing_px, true).edge;
+            for (const Crossing& c : cross) {
+              const int64_t tu = std::llround(c.t * 1e6);
+              if (refr_us > 0 && last_us[i] != kNever && tu - last_us[i] < refr_us) {
+                ++out.dropped;
+                continue;
+              }
+              last_us[i] = tu;
+              SimEvent e;
+              e.t_us = tu;
+              e.x = static_cast<uint16_t>(x);
+              e.y = static_cast<uint16_t>(y);
+              e.on = c.on;
+              e.label = c.noise ? -1 : label;
+              step_events.push_back(e);
+              if (c.on)
+                ++out.on;
+              else
+                ++out.off;
+              if (c.noise) ++out.noise;
             }
-          }
-          ref[i] = r;
-          const size_t n_signal = cross.size();
-          if (has_noise) {
-            while (noise_next[i] <= tb) {
-              const bool on = (splitmix64(rng[i]) >> 63) != 0;
-              cross.push_back({noise_next[i], on, true});
-              noise_next[i] += -std::log(uniform01(rng[i])) / noise_rate;
-            }
-            wake_p[i] = std::min(until_p[i], noise_p[i]);
-            std::inplace_merge(cross.begin(), cross.begin() + n_signal, cross.end(),
-                               [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
-          }
-          if (cross.empty()) continue;
-          int label = -1;
-          if (n_signal > 0)
-            label = shadePixel(scene, cps, bx, by, camera.fx, camera.fy, opt.smoothing_px, true)
-                        .edge;
-          for (const Crossing& c : cross) {
-            const int64_t tu = std::llround(c.t * 1e6);
-            if (refr_us > 0 && last_us[i] != kNever && tu - last_us[i] < refr_us) {
-              ++out.dropped;
-              continue;
-            }
-            last_us[i] = tu;
-            SimEvent e;
-            e.t_us = tu;
-            e.x = static_cast<uint16_t>(x);
-            e.y = static_cast<uint16_t>(y);
-            e.on = c.on;
-            e.label = c.noise ? -1 : label;
-            step_events.push_back(e);
-            if (c.on) ++out.on; else ++out.off;
-            if (c.noise) ++out.noise;
           }
         }
+        ta = tb;
       }
-      ta = tb;
-    }
     }
   }
 };
@@ -322,8 +325,10 @@ RenderEventSimulator::RenderEventSimulator(const Scene& scene, const CameraModel
   std::mt19937_64 gen(options.seed);
   std::normal_distribution<double> N(0.0, 1.0);
   for (size_t i = 0; i < n; ++i) {
-    m.cp[i] = static_cast<float>(std::max(0.01, options.contrast_on + options.contrast_sigma * N(gen)));
-    m.cm[i] = static_cast<float>(std::max(0.01, options.contrast_off + options.contrast_sigma * N(gen)));
+    m.cp[i] =
+        static_cast<float>(std::max(0.01, options.contrast_on + options.contrast_sigma * N(gen)));
+    m.cm[i] =
+        static_cast<float>(std::max(0.01, options.contrast_off + options.contrast_sigma * N(gen)));
     m.rng[i] = options.seed * 0xD1B54A32D192ED03ULL + 0x632BE59BD9B4E019ULL * (i + 1);
     if (options.noise_rate > 0.0)
       m.noise_next[i] = t0 - std::log(uniform01(m.rng[i])) / options.noise_rate;
@@ -356,13 +361,13 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
     if (!(m.speed_now >= 0.0)) m.speed_now = m.speed(cur);
     while (cur < t_end && chunk.steps.size() < kStepsPerChunk) {
       const double v = m.speed_now;
-      const double dt = std::clamp(v > 0.0 ? m.opt.max_step_px / v : m.opt.max_step,
-                                   m.opt.min_step, m.opt.max_step);
+      const double dt = std::clamp(v > 0.0 ? m.opt.max_step_px / v : m.opt.max_step, m.opt.min_step,
+                                   m.opt.max_step);
       // Avoid a sliver of a step at the end: split the last two steps evenly.
       const double rest = t_end - cur;
       // (1e-9 relative tolerance: slices such as 0.01 - 0.008 are not exactly 0.002).
-      double next = rest <= dt * (1.0 + 1e-9) ? t_end
-                                              : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
+      double next =
+          rest <= dt * (1.0 + 1e-9) ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
       // A render exactly at each jump of a piecewise twist.
       const double brk = m.trajectory.nextBreak(cur);
       if (brk > cur && brk < next) next = brk;
@@ -375,8 +380,8 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
       chunk.planes.push_back(m.planesAt(next));
       chunk.ahead.push_back(m.planesAt(next + kAheadDt));
       chunk.speed.push_back(m.speed_now);
-      chunk.skip_cap.push_back(std::min({kMaxSkip, m.trajectory.smoothTime(),
-                                         m.trajectory.nextBreak(next) - next}));
+      chunk.skip_cap.push_back(
+          std::min({kMaxSkip, m.trajectory.smoothTime(), m.trajectory.nextBreak(next) - next}));
       cur = next;
     }
     const std::vector<double>& steps = chunk.steps;

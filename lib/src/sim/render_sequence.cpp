@@ -97,7 +97,8 @@ std::vector<ImuSample> simulateImu(const Trajectory& trajectory, const ImuOption
     const double t = t0 + static_cast<double>(k) / options.rate;
     const RigidPose T = trajectory.pose(t);
     const Vec3 v = trajectory.linearVelocity(t), w = trajectory.angularVelocity(t);
-    const Vec3 f_cam = trajectory.linearVelocityRate(t) + w.cross(v) - T.R.transpose() * options.gravity;
+    const Vec3 f_cam =
+        trajectory.linearVelocityRate(t) + w.cross(v) - T.R.transpose() * options.gravity;
     ImuSample s;
     s.t = t;
     s.gyro = R_imu_cam * w + options.gyro_bias + sg * Vec3(N(rng), N(rng), N(rng));
@@ -203,7 +204,9 @@ std::string num(double x) {
   s << std::setprecision(12) << x;
   return s.str();
 }
-std::string vec(const Vec3& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+std::string vec(const Vec3& v) {
+  return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
+}
 std::string mat(const Mat3& R) {
   std::string s = "[";
   for (int i = 0; i < 3; ++i)
@@ -223,8 +226,8 @@ std::string calibYaml(const SynthConfig& c) {
     << "  cx: " << num(k.cx) << "             # [px]\n"
     << "  cy: " << num(k.cy) << "             # [px]\n"
     << "  distortion_model: " << toString(k.distortion) << "\n"
-    << "  distortion: [" << num(k.coeffs[0]) << ", " << num(k.coeffs[1]) << ", "
-    << num(k.coeffs[2]) << ", " << num(k.coeffs[3]) << ", " << num(k.coeffs[4]) << "]\n"
+    << "  distortion: [" << num(k.coeffs[0]) << ", " << num(k.coeffs[1]) << ", " << num(k.coeffs[2])
+    << ", " << num(k.coeffs[3]) << ", " << num(k.coeffs[4]) << "]\n"
     << "imu:\n"
     << "  R_cam_imu: " << mat(c.imu.R_cam_imu) << "   # row-major\n"
     << "  time_offset: 0.0    # [s]\n"
@@ -347,9 +350,9 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     PartialFile f(dir, "imu.txt");
     char line[256];
     for (const ImuSample& s : imu) {
-      const int n = std::snprintf(line, sizeof line, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g\n", s.t,
-                                  s.accel.x(), s.accel.y(), s.accel.z(), s.gyro.x(), s.gyro.y(),
-                                  s.gyro.z());
+      const int n =
+          std::snprintf(line, sizeof line, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g\n", s.t, s.accel.x(),
+                        s.accel.y(), s.accel.z(), s.gyro.x(), s.gyro.y(), s.gyro.z());
       f.write(line, static_cast<size_t>(n));
     }
     f.close();
@@ -362,9 +365,9 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     char line[256];
     for (const PoseSample& p : poses) {
       const auto& q = p.orientation;
-      int n = std::snprintf(line, sizeof line, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", p.t,
-                            p.position.x(), p.position.y(), p.position.z(), q.x(), q.y(), q.z(),
-                            q.w());
+      int n =
+          std::snprintf(line, sizeof line, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", p.t,
+                        p.position.x(), p.position.y(), p.position.z(), q.x(), q.y(), q.z(), q.w());
       f.write(line, static_cast<size_t>(n));
       const Vec3 v = trajectory.linearVelocity(p.t), w = trajectory.angularVelocity(p.t);
       n = std::snprintf(line, sizeof line, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g\n", p.t, v.x(),

@@ -21,8 +21,8 @@ struct PlaneShade {
   double coverage = 0.0;  ///< fraction of the pixel covered by the plane's extent
   int edge = -1;
   double edge_px = 1e30;
-  double free_px = 0.0;   ///< lower bound of the distance to any edge of the plane [px]
-  double free_time = 0.0; ///< time [s] before an edge can reach the pixel, at the current rates
+  double free_px = 0.0;    ///< lower bound of the distance to any edge of the plane [px]
+  double free_time = 0.0;  ///< time [s] before an edge can reach the pixel, at the current rates
 };
 
 constexpr double kFreeMarginPx = 0.25;  ///< extra margin [px] beyond the ramp half-width
@@ -40,8 +40,8 @@ inline double travelTime(double dist_px, double speed, double w) {
 inline double toPx(double d, double g) { return d / std::max(g, 1e-12); }
 
 /// (ru, rv): rates [m/s] at which the plane coordinates seen by the pixel change.
-PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2& ju,
-                           const Vec2& jv, double ru, double rv, double w, bool want_edge) {
+PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2& ju, const Vec2& jv,
+                           double ru, double rv, double w, bool want_edge) {
   PlaneShade out;
   const double W = pl.width, H = pl.height, sq = pl.square;
   const double uu = u + 0.5 * W, vv = v + 0.5 * H;
@@ -64,7 +64,8 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
   // Each family of lines moves across the pixel at its own normal speed [px/s];
   // the board's border lines belong to the families (virtual lines outside the
   // board are nearer than the border, so the bound stays conservative).
-  out.free_time = std::min(travelTime(du, std::abs(ru) * pu, w), travelTime(dv, std::abs(rv) * pv, w));
+  out.free_time =
+      std::min(travelTime(du, std::abs(ru) * pu, w), travelTime(dv, std::abs(rv) * pv, w));
   if (want_edge) {
     const double gu = 1.0 / pu, gv = 1.0 / pv;
     const long iu = std::clamp(std::lround(uu / sq), 0L, static_cast<long>(pl.columns));
@@ -86,8 +87,8 @@ PlaneShade shadeChessboard(const ScenePlane& pl, double u, double v, const Vec2&
 
 /// Signed distance [px] of (u, v) to rectangle r (negative inside) and the side
 /// (0: -u', 1: +u', 2: -v', 3: +v' in the rectangle's axes) nearest to it.
-inline double rectDistance(const TextureRect& r, double u, double v, const Vec2& ju,
-                           const Vec2& jv, int& side) {
+inline double rectDistance(const TextureRect& r, double u, double v, const Vec2& ju, const Vec2& jv,
+                           int& side) {
   const double c = r.cos_a, s = r.sin_a;
   const double du = u - r.centre.x(), dv = v - r.centre.y();
   const double qx = c * du + s * dv, qy = -s * du + c * dv;
@@ -107,7 +108,8 @@ PlaneShade shadeRects(const ScenePlane& pl, double u, double v, const Vec2& ju, 
   PlaneShade out;
   const double W = pl.width, H = pl.height;
   const double gu = ju.norm(), gv = jv.norm();
-  const double inside_u = toPx(0.5 * W - std::abs(u), gu), inside_v = toPx(0.5 * H - std::abs(v), gv);
+  const double inside_u = toPx(0.5 * W - std::abs(u), gu),
+               inside_v = toPx(0.5 * H - std::abs(v), gv);
   out.coverage = clamp01(0.5 + std::min(inside_u, inside_v) / w);
   // Shapes outside a cell's list lie > grid_margin away: keep their ramp inside it.
   const double gmax = std::max(gu, gv);
@@ -184,9 +186,12 @@ TextureKind parseTextureKind(const std::string& name) {
 
 std::string toString(TextureKind kind) {
   switch (kind) {
-    case TextureKind::Chessboard: return "chessboard";
-    case TextureKind::Rectangles: return "rectangles";
-    case TextureKind::Segments: return "segments";
+    case TextureKind::Chessboard:
+      return "chessboard";
+    case TextureKind::Rectangles:
+      return "rectangles";
+    case TextureKind::Segments:
+      return "segments";
   }
   return "chessboard";
 }
@@ -423,8 +428,8 @@ PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_p
     const PlaneShade sh = pl.texture == TextureKind::Chessboard
                               ? shadeChessboard(pl, u, v, ju, jv, ru, rv, w, want_edge)
                               : shadeRects(pl, u, v, ju, jv, ru, rv, w, want_edge);
-    out.intensity = static_cast<float>(sh.coverage * sh.intensity +
-                                       (1.0 - sh.coverage) * scene.background);
+    out.intensity =
+        static_cast<float>(sh.coverage * sh.intensity + (1.0 - sh.coverage) * scene.background);
     out.free_px = static_cast<float>(sh.free_px);
     out.free_time = known ? static_cast<float>(std::min(sh.free_time, 1e30)) : 0.0f;
     if (want_edge && sh.coverage > 0.0) {
@@ -445,8 +450,10 @@ PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_p
   for (size_t k = 0; k < np && k < static_cast<size_t>(kMaxPlanes); ++k) {
     Hit h;
     h.k = k;
-    if (hitPlane(cam_planes[k], x, y, fx, fy, h.s, h.u, h.v, h.ju, h.jv)) hits[nh++] = h;
-    else missed = true;
+    if (hitPlane(cam_planes[k], x, y, fx, fy, h.s, h.u, h.v, h.ju, h.jv))
+      hits[nh++] = h;
+    else
+      missed = true;
   }
   double free_px = missed ? 0.0 : 1e30;
   double free_time = missed ? 0.0 : 1e30;

@@ -90,9 +90,9 @@ class Reader {
   }
   std::vector<double> list(const YAML::Node& n, const std::string& name, size_t min_size,
                            size_t max_size) const {
-    const std::string want = min_size == max_size ? std::to_string(min_size)
-                                                  : std::to_string(min_size) + " to " +
-                                                        std::to_string(max_size);
+    const std::string want = min_size == max_size
+                                 ? std::to_string(min_size)
+                                 : std::to_string(min_size) + " to " + std::to_string(max_size);
     if (!n.IsSequence() || n.size() < min_size || n.size() > max_size)
       fail(n, "key '" + name + "' must be a list of " + want + " numbers");
     std::vector<double> v;
@@ -124,8 +124,8 @@ int toInt(const Reader& r, const YAML::Node& at, const std::string& name, double
 
 void readCamera(const Reader& r, const YAML::Node& n, SynthConfig& c) {
   const std::string P = "camera";
-  r.keys(n, P, {"preset", "width", "height", "fx", "fy", "cx", "cy", "distortion_model",
-                "distortion"});
+  r.keys(n, P,
+         {"preset", "width", "height", "fx", "fy", "cx", "cy", "distortion_model", "distortion"});
   c.camera_preset = r.text(n, P, "preset", "davis346");
   try {
     c.camera = cameraPreset(c.camera_preset);
@@ -160,7 +160,8 @@ PlaneSpec readPlane(const Reader& r, const YAML::Node& n, const std::string& P) 
   PlaneSpec s;
   if (!n.IsMap()) r.fail(n, "key '" + P + "' must be a mapping");
   const std::string tex = r.text(n, P, "texture", "");
-  if (tex.empty()) r.fail(n, "key '" + P + ".texture' is required (chessboard, rectangles, segments)");
+  if (tex.empty())
+    r.fail(n, "key '" + P + ".texture' is required (chessboard, rectangles, segments)");
   try {
     s.texture = parseTextureKind(tex);
   } catch (const std::invalid_argument& e) {
@@ -218,8 +219,10 @@ void readTrajectory(const Reader& r, const YAML::Node& n, SynthConfig& c) {
     r.fail(n["type"], std::string("key 'trajectory.type': ") + e.what());
   }
   std::vector<std::string> allowed = {"type", "initial_position", "initial_rotation"};
-  if (t.kind == TrajectoryKind::Piecewise) allowed.push_back("segments");
-  else allowed.insert(allowed.end(), {"v", "w"});
+  if (t.kind == TrajectoryKind::Piecewise)
+    allowed.push_back("segments");
+  else
+    allowed.insert(allowed.end(), {"v", "w"});
   if (t.kind == TrajectoryKind::Sinusoid)
     allowed.insert(allowed.end(), {"amplitude_v", "amplitude_w", "frequency"});
   r.keys(n, P, allowed);
@@ -253,8 +256,9 @@ void readTrajectory(const Reader& r, const YAML::Node& n, SynthConfig& c) {
 
 void readEvents(const Reader& r, const YAML::Node& n, RenderOptions& o) {
   const std::string P = "events";
-  r.keys(n, P, {"contrast_on", "contrast_off", "contrast_sigma", "refractory", "noise_rate",
-                "log_eps", "max_step_px", "max_step", "smoothing_px", "threads"});
+  r.keys(n, P,
+         {"contrast_on", "contrast_off", "contrast_sigma", "refractory", "noise_rate", "log_eps",
+          "max_step_px", "max_step", "smoothing_px", "threads"});
   r.num(n, P, "contrast_on", o.contrast_on);
   r.num(n, P, "contrast_off", o.contrast_off);
   r.num(n, P, "contrast_sigma", o.contrast_sigma);
@@ -283,8 +287,8 @@ Mat3 rotationFrom(const Reader& r, const YAML::Node& n, const std::string& name)
 
 void readImu(const Reader& r, const YAML::Node& n, ImuOptions& o) {
   const std::string P = "imu";
-  r.keys(n, P, {"rate", "gyro_noise", "gyro_bias", "accel_noise", "accel_bias", "R_cam_imu",
-                "gravity"});
+  r.keys(n, P,
+         {"rate", "gyro_noise", "gyro_bias", "accel_noise", "accel_bias", "R_cam_imu", "gravity"});
   r.num(n, P, "rate", o.rate);
   r.num(n, P, "gyro_noise", o.gyro_noise);
   r.vec3(n, P, "gyro_bias", o.gyro_bias);
@@ -307,7 +311,8 @@ void readGroundTruth(const Reader& r, const YAML::Node& n, GroundTruthOptions& o
       for (int j = 0; j < 3; ++j) R(i, j) = v[4 * i + j];
     if ((R.transpose() * R - Mat3::Identity()).norm() > 1e-6 || R.determinant() < 0.0 ||
         v[12] != 0.0 || v[13] != 0.0 || v[14] != 0.0 || v[15] != 1.0)
-      r.fail(n["T_body_cam"], "key 'groundtruth.T_body_cam' must be a rigid transform (row-major 4x4)");
+      r.fail(n["T_body_cam"],
+             "key 'groundtruth.T_body_cam' must be a rigid transform (row-major 4x4)");
     o.T_body_cam.R = R;
     o.T_body_cam.p = Vec3(v[3], v[7], v[11]);
   }
@@ -328,11 +333,13 @@ SynthConfig loadSynthConfig(const std::string& path) {
                                 ": YAML syntax error: " + e.msg);
   }
   Reader r(path);
-  if (!root.IsMap()) throw std::invalid_argument(path + ": expected a YAML mapping at the top level");
+  if (!root.IsMap())
+    throw std::invalid_argument(path + ": expected a YAML mapping at the top level");
   SynthConfig c;
   c.source = path;
-  r.keys(root, "", {"seed", "duration", "background", "camera", "planes", "trajectory", "events",
-                    "imu", "groundtruth"});
+  r.keys(root, "",
+         {"seed", "duration", "background", "camera", "planes", "trajectory", "events", "imu",
+          "groundtruth"});
   int64_t seed = 1;
   r.integer(root, "", "seed", seed);
   if (seed < 0) r.fail(root["seed"], "key 'seed' must be >= 0");

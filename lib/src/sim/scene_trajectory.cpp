@@ -20,9 +20,12 @@ TrajectoryKind parseTrajectoryKind(const std::string& name) {
 
 std::string toString(TrajectoryKind kind) {
   switch (kind) {
-    case TrajectoryKind::ConstantTwist: return "constant_twist";
-    case TrajectoryKind::Piecewise: return "piecewise";
-    case TrajectoryKind::Sinusoid: return "sinusoid";
+    case TrajectoryKind::ConstantTwist:
+      return "constant_twist";
+    case TrajectoryKind::Piecewise:
+      return "piecewise";
+    case TrajectoryKind::Sinusoid:
+      return "sinusoid";
   }
   return "constant_twist";
 }
@@ -105,8 +108,10 @@ RigidPose Trajectory::pose(double t) const {
 
 Vec3 Trajectory::linearVelocity(double t) const {
   switch (spec_.kind) {
-    case TrajectoryKind::ConstantTwist: return spec_.v;
-    case TrajectoryKind::Piecewise: return spec_.segments[segmentAt(t)].v;
+    case TrajectoryKind::ConstantTwist:
+      return spec_.v;
+    case TrajectoryKind::Piecewise:
+      return spec_.segments[segmentAt(t)].v;
     case TrajectoryKind::Sinusoid:
       return spec_.v + spec_.amplitude_v * std::sin(2.0 * M_PI * spec_.frequency * t);
   }
@@ -115,8 +120,10 @@ Vec3 Trajectory::linearVelocity(double t) const {
 
 Vec3 Trajectory::angularVelocity(double t) const {
   switch (spec_.kind) {
-    case TrajectoryKind::ConstantTwist: return spec_.w;
-    case TrajectoryKind::Piecewise: return spec_.segments[segmentAt(t)].w;
+    case TrajectoryKind::ConstantTwist:
+      return spec_.w;
+    case TrajectoryKind::Piecewise:
+      return spec_.segments[segmentAt(t)].w;
     case TrajectoryKind::Sinusoid:
       return spec_.w + spec_.amplitude_w * std::sin(2.0 * M_PI * spec_.frequency * t);
   }

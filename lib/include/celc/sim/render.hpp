@@ -37,25 +37,25 @@
 namespace celc::sim {
 
 struct RenderOptions {
-  double contrast_on = 0.25;      ///< C+ [log intensity]
-  double contrast_off = 0.25;     ///< C- [log intensity]
-  double contrast_sigma = 0.03;   ///< per-pixel threshold mismatch, std [log intensity]
-  double refractory = 5e-4;       ///< [s]; 0 disables
-  double noise_rate = 0.0;        ///< background events per pixel [Hz], <= 1000
-  double log_eps = 1e-2;          ///< eps in L = log(eps + I), I in [0, 1]
-  double max_step_px = 0.3;       ///< largest image motion per render step [px]
-  double max_step = 2e-3;         ///< largest render step [s]
-  double min_step = 1e-6;         ///< smallest render step [s]
-  double smoothing_px = 1.0;      ///< width of the anti-aliasing ramp across edges [px]
+  double contrast_on = 0.25;     ///< C+ [log intensity]
+  double contrast_off = 0.25;    ///< C- [log intensity]
+  double contrast_sigma = 0.03;  ///< per-pixel threshold mismatch, std [log intensity]
+  double refractory = 5e-4;      ///< [s]; 0 disables
+  double noise_rate = 0.0;       ///< background events per pixel [Hz], <= 1000
+  double log_eps = 1e-2;         ///< eps in L = log(eps + I), I in [0, 1]
+  double max_step_px = 0.3;      ///< largest image motion per render step [px]
+  double max_step = 2e-3;        ///< largest render step [s]
+  double min_step = 1e-6;        ///< smallest render step [s]
+  double smoothing_px = 1.0;     ///< width of the anti-aliasing ramp across edges [px]
   /// Skip shading a pixel until an edge could reach it: the larger of the
   /// time its nearest edges need at the texture's own velocity at the pixel
   /// (per chessboard line family, 1.5x margin) and at 1.5x the image's
   /// largest speed; at most 50 ms, up to the next jump of a piecewise twist,
   /// 0.01 / f for a sinusoid. false shades every pixel at every step.
   bool skip_static = true;
-  int threads = 2;                ///< worker threads (1..64)
-  uint64_t seed = 1;              ///< thresholds and noise
-  std::string validate() const;   ///< empty when valid
+  int threads = 2;               ///< worker threads (1..64)
+  uint64_t seed = 1;             ///< thresholds and noise
+  std::string validate() const;  ///< empty when valid
 };
 
 /// One simulated event: time [us], pixel, polarity and the scene edge that
@@ -67,12 +67,22 @@ struct SimEvent {
   int32_t label = -1;
 };
 
+/// The library's event type (time in seconds).
+inline Event toEvent(const SimEvent& e) {
+  Event out;
+  out.t = static_cast<double>(e.t_us) * 1e-6;
+  out.x = static_cast<float>(e.x);
+  out.y = static_cast<float>(e.y);
+  out.on = e.on;
+  return out;
+}
+
 struct RenderStats {
-  int64_t renders = 0;          ///< images rendered (including the first)
-  int64_t pixels_shaded = 0;    ///< pixel evaluations after the first image
+  int64_t renders = 0;        ///< images rendered (including the first)
+  int64_t pixels_shaded = 0;  ///< pixel evaluations after the first image
   int64_t events_on = 0;
   int64_t events_off = 0;
-  int64_t events_noise = 0;     ///< included in on/off
+  int64_t events_noise = 0;  ///< included in on/off
   int64_t refractory_dropped = 0;
   double min_step = 0.0, max_step = 0.0;  ///< render steps used [s]
 };

@@ -34,36 +34,36 @@
 namespace celc::sim {
 
 struct ImuOptions {
-  double rate = 1000.0;                   ///< [Hz]
-  double gyro_noise = 1e-4;               ///< white-noise density [rad/s/sqrt(Hz)]
-  Vec3 gyro_bias = Vec3::Zero();          ///< [rad/s]
-  double accel_noise = 1e-3;              ///< [m/s^2/sqrt(Hz)]
-  Vec3 accel_bias = Vec3::Zero();         ///< [m/s^2]
+  double rate = 1000.0;            ///< [Hz]
+  double gyro_noise = 1e-4;        ///< white-noise density [rad/s/sqrt(Hz)]
+  Vec3 gyro_bias = Vec3::Zero();   ///< [rad/s]
+  double accel_noise = 1e-3;       ///< [m/s^2/sqrt(Hz)]
+  Vec3 accel_bias = Vec3::Zero();  ///< [m/s^2]
   Mat3 R_cam_imu = Mat3::Identity();
-  Vec3 gravity = Vec3(0.0, 9.81, 0.0);    ///< g in the world frame [m/s^2] (y down by default)
+  Vec3 gravity = Vec3(0.0, 9.81, 0.0);  ///< g in the world frame [m/s^2] (y down by default)
   std::string validate() const;
 };
 
 struct GroundTruthOptions {
-  double rate = 200.0;                    ///< [Hz]
-  RigidPose T_body_cam;                   ///< identity by default
+  double rate = 200.0;   ///< [Hz]
+  RigidPose T_body_cam;  ///< identity by default
   std::string validate() const;
 };
 
 /// Everything `celc synth` needs (one SCENE.yaml).
 struct SynthConfig {
-  std::string source;                     ///< the file it was read from
+  std::string source;  ///< the file it was read from
   uint64_t seed = 1;
-  double duration = 0.5;                  ///< [s]
+  double duration = 0.5;  ///< [s]
   CameraModel camera;
   std::string camera_preset = "davis346";
-  double background = 0.5;                ///< [0, 1]
+  double background = 0.5;  ///< [0, 1]
   std::vector<PlaneSpec> planes;
   TrajectorySpec trajectory;
   RenderOptions events;
   ImuOptions imu;
   GroundTruthOptions groundtruth;
-  std::string validate() const;           ///< empty when valid
+  std::string validate() const;  ///< empty when valid
 };
 
 /// IMU samples at t0, t0 + 1/rate, ... <= t1.
@@ -78,8 +78,8 @@ struct SynthSummary {
   int64_t events = 0;
   int64_t imu_samples = 0;
   int64_t poses = 0;
-  double duration = 0.0;                  ///< simulated [s]
-  double wall_seconds = 0.0;              ///< simulation + writing [s]
+  double duration = 0.0;      ///< simulated [s]
+  double wall_seconds = 0.0;  ///< simulation + writing [s]
 };
 
 /// Progress: simulated time so far [s] and events so far.

@@ -53,9 +53,9 @@ struct PlaneSpec {
   Vec3 position = Vec3(0.0, 0.0, 2.0);  ///< plane centre in the world [m]
   Vec3 rotation = Vec3::Zero();         ///< axis-angle of R_world_plane [rad]
   // chessboard
-  double square = 0.2;                  ///< side of a square [m]
-  int columns = 16, rows = 12;          ///< squares along u and v
-  double dark = 0.2, light = 0.8;       ///< intensities [0, 1]
+  double square = 0.2;             ///< side of a square [m]
+  int columns = 16, rows = 12;     ///< squares along u and v
+  double dark = 0.2, light = 0.8;  ///< intensities [0, 1]
   // rectangles / segments
   double width = 3.0, height = 2.0;     ///< plane extent along u and v [m]
   double base = 0.5;                    ///< intensity of the plane under its shapes
@@ -63,28 +63,28 @@ struct PlaneSpec {
   Vec2 size_range = Vec2(0.05, 0.4);    ///< rectangles: side; segments: length [m]
   Vec2 width_range = Vec2(0.01, 0.03);  ///< segments: thickness [m]
   Vec2 intensity_range = Vec2(0.05, 0.95);
-  bool random_angle = false;            ///< rectangles: rotate each by a uniform angle
-  int64_t seed = -1;                    ///< shape layout seed; < 0: derived from the scene seed
-  std::string validate() const;         ///< empty when valid
+  bool random_angle = false;     ///< rectangles: rotate each by a uniform angle
+  int64_t seed = -1;             ///< shape layout seed; < 0: derived from the scene seed
+  std::string validate() const;  ///< empty when valid
 };
 
 /// One textured plane, ready to render.
 struct ScenePlane {
   TextureKind texture = TextureKind::Chessboard;
-  RigidPose T_world_plane;               ///< columns of R: u axis, v axis, normal
-  double width = 1.0, height = 1.0;      ///< extent [m] (chessboard: columns*square, rows*square)
+  RigidPose T_world_plane;           ///< columns of R: u axis, v axis, normal
+  double width = 1.0, height = 1.0;  ///< extent [m] (chessboard: columns*square, rows*square)
   double square = 0.1;
   int columns = 1, rows = 1;
   float dark = 0.2f, light = 0.8f, base = 0.5f;
-  std::vector<TextureRect> rects;        ///< painted in order over `base`
-  int edge_id_offset = 0;                ///< ids of this plane's edges start here
-  int edgeCount() const;                 ///< chessboard: (columns+1)+(rows+1); else 4 + 4*rects
+  std::vector<TextureRect> rects;  ///< painted in order over `base`
+  int edge_id_offset = 0;          ///< ids of this plane's edges start here
+  int edgeCount() const;           ///< chessboard: (columns+1)+(rows+1); else 4 + 4*rects
   // Uniform grid over the plane listing the rects near each cell (built by buildGrid()).
   int grid_n = 0;
-  double grid_margin = 0.0;              ///< [m] margin used for the cell lists
-  std::vector<uint32_t> cell_start;      ///< grid_n*grid_n + 1 offsets into cell_items
+  double grid_margin = 0.0;          ///< [m] margin used for the cell lists
+  std::vector<uint32_t> cell_start;  ///< grid_n*grid_n + 1 offsets into cell_items
   std::vector<uint32_t> cell_items;
-  void buildGrid();                      ///< also caches each rect's cos/sin
+  void buildGrid();  ///< also caches each rect's cos/sin
 };
 
 /// A straight edge of the scene: id and world end points [m].
@@ -95,7 +95,7 @@ struct SceneEdge {
 
 struct Scene {
   std::vector<ScenePlane> planes;
-  float background = 0.5f;               ///< intensity seen where no plane is
+  float background = 0.5f;  ///< intensity seen where no plane is
   /// Builds the planes from their specs; random layouts use `seed` (or each spec's own seed).
   static Scene build(const std::vector<PlaneSpec>& specs, double background, uint64_t seed);
   std::vector<SceneEdge> edges() const;  ///< every edge with its world end points
@@ -131,10 +131,9 @@ struct PixelSample {
 /// [normalised camera coordinates] given the planes in the camera frame.
 /// fx, fy [px] convert the plane-to-image Jacobian into pixels. With `ahead`
 /// (the same planes ahead_dt [s] later) it also bounds free_time.
-PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_planes,
-                       double x, double y, double fx, double fy, double smoothing_px,
-                       bool want_edge, const std::vector<CameraPlane>* ahead = nullptr,
-                       double ahead_dt = 0.0);
+PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_planes, double x,
+                       double y, double fx, double fy, double smoothing_px, bool want_edge,
+                       const std::vector<CameraPlane>* ahead = nullptr, double ahead_dt = 0.0);
 
 /// Front-most plane hit along bearing d: index and world point; -1 if none.
 int frontHit(const Scene& scene, const std::vector<CameraPlane>& cam_planes, double x, double y,

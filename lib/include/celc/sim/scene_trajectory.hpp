@@ -26,21 +26,21 @@ TrajectoryKind parseTrajectoryKind(const std::string& name);
 std::string toString(TrajectoryKind kind);
 
 struct TwistSegment {
-  double duration = 1.0;     ///< [s]
-  Vec3 v = Vec3::Zero();     ///< [m/s], camera frame
-  Vec3 w = Vec3::Zero();     ///< [rad/s], camera frame
+  double duration = 1.0;  ///< [s]
+  Vec3 v = Vec3::Zero();  ///< [m/s], camera frame
+  Vec3 w = Vec3::Zero();  ///< [rad/s], camera frame
 };
 
 struct TrajectorySpec {
   TrajectoryKind kind = TrajectoryKind::ConstantTwist;
-  Vec3 v = Vec3(1.0, 0.0, 0.0);          ///< [m/s] (constant twist; sinusoid mean)
-  Vec3 w = Vec3::Zero();                  ///< [rad/s]
-  std::vector<TwistSegment> segments;     ///< piecewise
-  Vec3 amplitude_v = Vec3::Zero();        ///< sinusoid [m/s]
-  Vec3 amplitude_w = Vec3::Zero();        ///< sinusoid [rad/s]
-  double frequency = 1.0;                 ///< sinusoid [Hz]
-  RigidPose initial;                      ///< T_world_cam(0)
-  std::string validate() const;           ///< empty when valid
+  Vec3 v = Vec3(1.0, 0.0, 0.0);        ///< [m/s] (constant twist; sinusoid mean)
+  Vec3 w = Vec3::Zero();               ///< [rad/s]
+  std::vector<TwistSegment> segments;  ///< piecewise
+  Vec3 amplitude_v = Vec3::Zero();     ///< sinusoid [m/s]
+  Vec3 amplitude_w = Vec3::Zero();     ///< sinusoid [rad/s]
+  double frequency = 1.0;              ///< sinusoid [Hz]
+  RigidPose initial;                   ///< T_world_cam(0)
+  std::string validate() const;        ///< empty when valid
 };
 
 class Trajectory {
@@ -48,10 +48,10 @@ class Trajectory {
   /// `horizon` [s]: the sinusoid is integrated over [0, horizon] (constant twist afterwards).
   Trajectory(const TrajectorySpec& spec, double horizon);
   const TrajectorySpec& spec() const { return spec_; }
-  RigidPose pose(double t) const;          ///< T_world_cam(t)
-  Vec3 linearVelocity(double t) const;     ///< v(t), camera frame [m/s]
-  Vec3 angularVelocity(double t) const;    ///< w(t), camera frame [rad/s]
-  Vec3 linearVelocityRate(double t) const; ///< dv/dt, camera frame [m/s^2]
+  RigidPose pose(double t) const;           ///< T_world_cam(t)
+  Vec3 linearVelocity(double t) const;      ///< v(t), camera frame [m/s]
+  Vec3 angularVelocity(double t) const;     ///< w(t), camera frame [rad/s]
+  Vec3 linearVelocityRate(double t) const;  ///< dv/dt, camera frame [m/s^2]
   /// Piecewise: the first segment start after t (the twist jumps there); else +infinity.
   double nextBreak(double t) const;
   /// A time over which the twist changes little: 0.01 / frequency for the
@@ -60,10 +60,10 @@ class Trajectory {
 
  private:
   TrajectorySpec spec_;
-  std::vector<double> seg_start_;          ///< piecewise: start time of each segment
-  std::vector<RigidPose> seg_pose_;        ///< pose at each segment start
+  std::vector<double> seg_start_;    ///< piecewise: start time of each segment
+  std::vector<RigidPose> seg_pose_;  ///< pose at each segment start
   double knot_dt_ = 1e-4;
-  std::vector<RigidPose> knots_;           ///< sinusoid: pose at k * knot_dt_
+  std::vector<RigidPose> knots_;  ///< sinusoid: pose at k * knot_dt_
   int segmentAt(double t) const;
 };
 
