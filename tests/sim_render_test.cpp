@@ -2,6 +2,7 @@
 // per-pixel event model, refractory period, ordering, IMU, trajectories,
 // labels, SCENE.yaml parsing and the written sequence directory.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -75,7 +76,9 @@ std::vector<SimEvent> simulate(const Scene& scene, const CameraModel& cam, const
 }
 
 fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("celc_sim_test_" + name);
+  // Per process: CTest runs tests in parallel, and several builds may share /tmp.
+  const fs::path d =
+      fs::temp_directory_path() / ("celc_sim_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
 }
@@ -459,8 +462,7 @@ trajectory: {type: constant_twist, v: [1, 0.2, 0], w: [0, 0.1, 0.2]}
 events: {noise_rate: 2.0}
 )";
 std::string loadError(const std::string& text) {
-  const std::string path =
-      writeFile(fs::temp_directory_path() / "celc_sim_test_cfg", "bad.yaml", text);
+  const std::string path = writeFile(tempDir("cfg"), "bad.yaml", text);
   try {
     loadSynthConfig(path);
   } catch (const std::invalid_argument& e) {
@@ -495,6 +497,7 @@ TEST(SimConfig, RejectsUnknownKeysAndWrongTypesNamingKeyAndFile) {
   EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
   e = loadError("planes:\n  - {texture: chessboard}\nimu: {R_cam_imu: [1,0,0, 0,1,0, 0,0,2]}\n");
   EXPECT_NE(e.find("key 'imu.R_cam_imu' must be a rotation matrix"), std::string::npos) << e;
+  fs::remove_all(tempDir("cfg"));
 }
 
 TEST(SimConfig, BundledScenesLoad) {
@@ -577,6 +580,7 @@ TEST(SimSequence, WritesTheRpgLayout) {
   EXPECT_EQ(sa.str(), sb.str());
   fs::remove_all(dir);
   fs::remove_all(dir2);
+  fs::remove_all(dir.string() + "_cfg");
 }
 
 TEST(SimSequence, CliRefusesExistingDirectoryWithoutForce) {
@@ -596,4 +600,5 @@ TEST(SimSequence, CliRefusesExistingDirectoryWithoutForce) {
   EXPECT_NE(ts.str().find("seed: 4"), std::string::npos);
   EXPECT_NE(ts.str().find("duration: 0.02"), std::string::npos);
   fs::remove_all(dir);
+  fs::remove_all(dir.string() + "_cfg");
 }
