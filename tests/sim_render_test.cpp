@@ -497,6 +497,13 @@ TEST(SimConfig, RejectsUnknownKeysAndWrongTypesNamingKeyAndFile) {
   EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
   e = loadError("planes:\n  - {texture: chessboard}\nimu: {R_cam_imu: [1,0,0, 0,1,0, 0,0,2]}\n");
   EXPECT_NE(e.find("key 'imu.R_cam_imu' must be a rotation matrix"), std::string::npos) << e;
+  // Hostile values: NaN, huge sizes.
+  e = loadError("planes:\n  - {texture: chessboard}\nevents: {noise_rate: .nan}\n");
+  EXPECT_NE(e.find("key 'events.noise_rate' must be finite"), std::string::npos) << e;
+  e = loadError("camera: {width: 100000}\nplanes:\n  - {texture: chessboard}\n");
+  EXPECT_NE(e.find("camera.width"), std::string::npos) << e;
+  e = loadError("planes:\n  - {texture: segments, count: 10000000}\n");
+  EXPECT_NE(e.find("key 'planes[0].count' must be in [0, 5000]"), std::string::npos) << e;
   fs::remove_all(tempDir("cfg"));
 }
 
