@@ -370,7 +370,7 @@ void RenderEventSimulator::advanceTo(double t_end, std::vector<SimEvent>& out) {
           rest <= dt * (1.0 + 1e-9) ? t_end : (rest < 2.0 * dt ? cur + 0.5 * rest : cur + dt);
       // A render exactly at each jump of a piecewise twist.
       const double brk = m.trajectory.nextBreak(cur);
-      if (brk > cur && brk < next) next = brk;
+      if (brk > cur + m.opt.min_step && brk < next) next = brk;
       const double used = next - cur;
       if (m.stats.max_step == 0.0) m.stats.min_step = used;  // first step ever
       m.stats.min_step = std::min(m.stats.min_step, used);

@@ -315,8 +315,9 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   std::vector<SimEvent> buf;
   std::string ebuf, lbuf;
   const double slice = 0.01;  // [s] events are written every 10 ms of simulated time
-  for (double t = 0.0; t < config.duration;) {
-    const double t_next = std::min(config.duration, t + slice);
+  for (int64_t k = 1;; ++k) {
+    // Slice ends k * slice (not accumulated sums: 0.1 stays 0.1).
+    const double t_next = std::min(config.duration, static_cast<double>(k) * slice);
     buf.clear();
     sim.advanceTo(t_next, buf);
     ebuf.resize(buf.size() * 40);
@@ -338,8 +339,8 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     events.write(ebuf.data(), static_cast<size_t>(pe - ebuf.data()));
     labels.write(lbuf.data(), static_cast<size_t>(pl - lbuf.data()));
     summary.events += static_cast<int64_t>(buf.size());
-    t = t_next;
-    if (progress) progress(t, summary.events);
+    if (progress) progress(t_next, summary.events);
+    if (t_next >= config.duration) break;
   }
   events.close();
   labels.close();
