@@ -16,6 +16,8 @@ void registerTable(CLI::App& app);
 void registerInfo(CLI::App& app);
 /// `celc cluster EVENTS`: clustering of an event file's windows (cmd_cluster.cpp).
 void registerCluster(CLI::App& app);
+/// `celc synth SCENE.yaml -o DIR`: the rendering event simulator (cmd_synth.cpp).
+void registerSynth(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

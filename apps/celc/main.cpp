@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   celc::app::registerSolve(app);
   celc::app::registerInfo(app);
   celc::app::registerCluster(app);
+  celc::app::registerSynth(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,149 @@
+#include "celc/sim/scene_trajectory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "celc/geometry/so3.hpp"
+
+namespace celc::sim {
+
+TrajectoryKind parseTrajectoryKind(const std::string& name) {
+  if (name == "constant_twist") return TrajectoryKind::ConstantTwist;
+  if (name == "piecewise") return TrajectoryKind::Piecewise;
+  if (name == "sinusoid") return TrajectoryKind::Sinusoid;
+  throw std::invalid_argument("unknown trajectory type '" + name +
+                              "' (expected constant_twist, piecewise or sinusoid)");
+}
+
+std::string toString(TrajectoryKind kind) {
+  switch (kind) {
+    case TrajectoryKind::ConstantTwist:
+      return "constant_twist";
+    case TrajectoryKind::Piecewise:
+      return "piecewise";
+    case TrajectoryKind::Sinusoid:
+      return "sinusoid";
+  }
+  return "constant_twist";
+}
+
+std::string TrajectorySpec::validate() const {
+  std::ostringstream e;
+  if (!v.allFinite() || !w.allFinite()) e << "v and w must be finite; ";
+  if (!initial.R.allFinite() || !initial.p.allFinite()) e << "initial pose must be finite; ";
+  if (kind == TrajectoryKind::Piecewise) {
+    if (segments.empty()) e << "piecewise trajectory needs at least one segment; ";
+    for (size_t i = 0; i < segments.size(); ++i)
+      if (!(segments[i].duration > 0.0) || !std::isfinite(segments[i].duration) ||
+          !segments[i].v.allFinite() || !segments[i].w.allFinite())
+        e << "segment " << i << " needs a positive duration and finite v, w; ";
+  }
+  if (kind == TrajectoryKind::Sinusoid) {
+    if (!amplitude_v.allFinite() || !amplitude_w.allFinite()) e << "amplitudes must be finite; ";
+    if (!(frequency > 0.0) || !(frequency < 1e4)) e << "frequency must be in (0, 1e4) Hz; ";
+  }
+  return e.str();
+}
+
+RigidPose twistExp(const Vec3& v, const Vec3& w, double tau) {
+  const Vec3 phi = w * tau;
+  return {so3::exp(phi), so3::leftJacobian(phi) * v * tau};
+}
+
+Trajectory::Trajectory(const TrajectorySpec& spec, double horizon) : spec_(spec) {
+  const std::string err = spec.validate();
+  if (!err.empty()) throw std::invalid_argument("trajectory: " + err);
+  if (spec.kind == TrajectoryKind::Piecewise) {
+    double t = 0.0;
+    RigidPose T = spec.initial;
+    for (const TwistSegment& s : spec.segments) {
+      seg_start_.push_back(t);
+      seg_pose_.push_back(T);
+      T = T * twistExp(s.v, s.w, s.duration);
+      t += s.duration;
+    }
+  } else if (spec.kind == TrajectoryKind::Sinusoid) {
+    // At most ~200k knots (19 MB): 0.1 ms spacing up to 20 s, coarser beyond.
+    knot_dt_ = std::max(1e-4, std::max(horizon, 0.0) / 2e5);
+    const size_t n = static_cast<size_t>(std::ceil(std::max(horizon, 0.0) / knot_dt_)) + 2;
+    knots_.resize(n);
+    knots_[0] = spec.initial;
+    for (size_t k = 1; k < n; ++k) {
+      const double tm = (k - 0.5) * knot_dt_;
+      knots_[k] = knots_[k - 1] * twistExp(linearVelocity(tm), angularVelocity(tm), knot_dt_);
+    }
+  }
+}
+
+int Trajectory::segmentAt(double t) const {
+  const auto it = std::upper_bound(seg_start_.begin(), seg_start_.end(), t);
+  return std::max(0, static_cast<int>(it - seg_start_.begin()) - 1);
+}
+
+RigidPose Trajectory::pose(double t) const {
+  switch (spec_.kind) {
+    case TrajectoryKind::ConstantTwist:
+      return spec_.initial * twistExp(spec_.v, spec_.w, t);
+    case TrajectoryKind::Piecewise: {
+      const int i = segmentAt(t);
+      const TwistSegment& s = spec_.segments[i];
+      return seg_pose_[i] * twistExp(s.v, s.w, t - seg_start_[i]);
+    }
+    case TrajectoryKind::Sinusoid: {
+      if (t <= 0.0) return spec_.initial * twistExp(spec_.v, spec_.w, t);
+      const size_t last = knots_.size() - 1;
+      const size_t k = std::min(static_cast<size_t>(t / knot_dt_), last);
+      const double t_k = k * knot_dt_;
+      const double tau = t - t_k;
+      if (k == last) return knots_[k] * twistExp(linearVelocity(t_k), angularVelocity(t_k), tau);
+      const double tm = t_k + 0.5 * tau;
+      return knots_[k] * twistExp(linearVelocity(tm), angularVelocity(tm), tau);
+    }
+  }
+  return spec_.initial;
+}
+
+Vec3 Trajectory::linearVelocity(double t) const {
+  switch (spec_.kind) {
+    case TrajectoryKind::ConstantTwist:
+      return spec_.v;
+    case TrajectoryKind::Piecewise:
+      return spec_.segments[segmentAt(t)].v;
+    case TrajectoryKind::Sinusoid:
+      return spec_.v + spec_.amplitude_v * std::sin(2.0 * M_PI * spec_.frequency * t);
+  }
+  return spec_.v;
+}
+
+Vec3 Trajectory::angularVelocity(double t) const {
+  switch (spec_.kind) {
+    case TrajectoryKind::ConstantTwist:
+      return spec_.w;
+    case TrajectoryKind::Piecewise:
+      return spec_.segments[segmentAt(t)].w;
+    case TrajectoryKind::Sinusoid:
+      return spec_.w + spec_.amplitude_w * std::sin(2.0 * M_PI * spec_.frequency * t);
+  }
+  return spec_.w;
+}
+
+double Trajectory::nextBreak(double t) const {
+  const auto it = std::upper_bound(seg_start_.begin(), seg_start_.end(), t);
+  return it == seg_start_.end() ? std::numeric_limits<double>::infinity() : *it;
+}
+
+double Trajectory::smoothTime() const {
+  return spec_.kind == TrajectoryKind::Sinusoid ? 0.01 / spec_.frequency
+                                                : std::numeric_limits<double>::infinity();
+}
+
+Vec3 Trajectory::linearVelocityRate(double t) const {
+  if (spec_.kind != TrajectoryKind::Sinusoid) return Vec3::Zero();
+  const double om = 2.0 * M_PI * spec_.frequency;
+  return spec_.amplitude_v * om * std::cos(om * t);
+}
+
+}  // namespace celc::sim
