@@ -14,6 +14,7 @@ namespace detail {
 void readSolverSection(Section s, SolverOptions& o) {
   Section l = s.sub("linear");
   l.get("max_rows", o.linear.max_rows);
+  l.get("balance_clusters", o.linear.balance_clusters);
   l.get("seed", o.linear.seed);
   l.get("max_iterations", o.linear.max_iterations);
   l.get("huber_k", o.linear.huber_k);
@@ -32,6 +33,7 @@ void readSolverSection(Section s, SolverOptions& o) {
   r.get("huber_px", o.refine.huber_px);
   r.get("max_iterations", o.refine.max_iterations);
   r.get("max_events", o.refine.max_events);
+  r.get("balance_clusters", o.refine.balance_clusters);
   r.get("seed", o.refine.seed);
   r.get("function_tolerance", o.refine.function_tolerance);
   r.get("num_threads", o.refine.num_threads);
@@ -47,6 +49,7 @@ std::string solverYaml(const SolverOptions& o, const std::string& in) {
   y << in << "solver:\n"
     << in << "  linear:\n"
     << in << "    max_rows: " << l.max_rows << "\n"
+    << in << "    balance_clusters: " << (l.balance_clusters ? "true" : "false") << "\n"
     << in << "    seed: " << l.seed << "\n"
     << in << "    max_iterations: " << l.max_iterations << "\n"
     << in << "    huber_k: " << l.huber_k << "\n"
@@ -64,6 +67,7 @@ std::string solverYaml(const SolverOptions& o, const std::string& in) {
     << in << "    huber_px: " << r.huber_px << "\n"
     << in << "    max_iterations: " << r.max_iterations << "\n"
     << in << "    max_events: " << r.max_events << "\n"
+    << in << "    balance_clusters: " << (r.balance_clusters ? "true" : "false") << "\n"
     << in << "    seed: " << r.seed << "\n"
     << in << "    function_tolerance: " << r.function_tolerance << "\n"
     << in << "    num_threads: " << r.num_threads << "\n";

@@ -2,6 +2,7 @@
 // Internal: the linear constraint rows shared by CELC, CE3LC, the refinement
 // and the sign test. All vectors in the reference frame of the motion model
 // unless said otherwise.
+#include <cstdint>
 #include <vector>
 
 #include "celc/geometry/motion_model.hpp"
@@ -68,6 +69,12 @@ struct ClusterParallax {
 };
 ClusterParallax clusterParallax(const ClusterObservation& c, const MotionModel& motion,
                                 double focal_px, int max_events);
+
+/// Seeded random subset of k of the indices 0..n-1, sorted (all when k == 0 or k >= n).
+std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed);
+/// Rows per cluster out of a budget (0 = every event). Balanced: water-filling,
+/// every cluster the same share unless it has fewer events; else proportional.
+std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bool balanced);
 
 /// Median of |x| (x is reordered).
 double medianAbs(std::vector<double>& x);

@@ -13,18 +13,6 @@
 namespace celc {
 namespace {
 
-std::vector<size_t> subset(size_t n, int max_events, std::uint64_t seed) {
-  std::vector<size_t> idx(n);
-  for (size_t i = 0; i < n; ++i) idx[i] = i;
-  if (max_events > 0 && static_cast<size_t>(max_events) < n) {
-    std::mt19937_64 rng(seed);
-    std::shuffle(idx.begin(), idx.end(), rng);
-    idx.resize(static_cast<size_t>(max_events));
-    std::sort(idx.begin(), idx.end());
-  }
-  return idx;
-}
-
 constexpr size_t kChunk = 256;  // events per residual block
 
 }  // namespace
@@ -44,9 +32,10 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     return result;
   }
   const std::vector<int> usable = detail::usableClusters(obs, 2);
-  std::vector<size_t> offsets{0};
-  for (int c : usable) offsets.push_back(offsets.back() + obs.clusters[c].size());
-  const std::vector<size_t> pick = subset(offsets.back(), opt.max_events, opt.seed);
+  std::vector<size_t> sizes;
+  for (int c : usable) sizes.push_back(obs.clusters[c].size());
+  const std::vector<size_t> quota =
+      detail::rowQuota(sizes, static_cast<size_t>(opt.max_events), opt.balance_clusters);
 
   Vec3 v = initial.normalized();
   // Lines: reference-frame plane normals (unit); free parameters in joint mode.
@@ -57,20 +46,19 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     m1[i] = frames.back().m1.normalized();
     m3[i] = frames.back().m3.normalized();
   }
-  // Per-event terms grouped by cluster.
+  // Per-event terms grouped by cluster (a seeded subset of each).
   std::vector<std::vector<detail::EventTerm>> terms(usable.size());
-  size_t ci = 0;
-  for (size_t flat : pick) {
-    while (flat >= offsets[ci + 1]) ++ci;
+  for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
-    const size_t k = flat - offsets[ci];
-    const double t = cl.times[k];
-    const Vec3& f = cl.bearings[k];
-    if (!f.allFinite() || !std::isfinite(t)) continue;
-    const Mat3 Rk = motion.rotation(t), Pk = motion.positionMatrix(t);
-    detail::EventTerm e{Rk * f, Rk.transpose().topRows<2>(), frames[ci].Pe - Pk,
-                        frames[ci].Ps - Pk};
-    if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms[ci].push_back(e);
+    for (size_t k : detail::sampleIndices(cl.size(), quota[ci], opt.seed + ci)) {
+      const double t = cl.times[k];
+      const Vec3& f = cl.bearings[k];
+      if (!f.allFinite() || !std::isfinite(t)) continue;
+      const Mat3 Rk = motion.rotation(t), Pk = motion.positionMatrix(t);
+      detail::EventTerm e{Rk * f, Rk.transpose().topRows<2>(), frames[ci].Pe - Pk,
+                          frames[ci].Ps - Pk};
+      if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms[ci].push_back(e);
+    }
   }
 
   ceres::Problem::Options problem_options;

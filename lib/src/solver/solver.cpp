@@ -185,27 +185,6 @@ SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservation
   return r;
 }
 
-// Seeded random subset of k indices out of n (sorted), or all when k >= n or k == 0.
-std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed) {
-  std::vector<size_t> idx;
-  if (k == 0 || k >= n) {
-    idx.resize(n);
-    for (size_t i = 0; i < n; ++i) idx[i] = i;
-    return idx;
-  }
-  // Floyd's algorithm: k draws, no O(n) buffer.
-  std::mt19937_64 rng(seed);
-  std::unordered_set<size_t> chosen;
-  chosen.reserve(2 * k);
-  for (size_t j = n - k; j < n; ++j) {
-    const size_t t = std::uniform_int_distribution<size_t>(0, j)(rng);
-    if (!chosen.insert(t).second) chosen.insert(j);
-  }
-  idx.assign(chosen.begin(), chosen.end());
-  std::sort(idx.begin(), idx.end());
-  return idx;
-}
-
 detail::NullspaceOptions nullspaceOptions(const LinearOptions& o) {
   detail::NullspaceOptions n;
   n.max_iterations = o.max_iterations;
@@ -243,23 +222,19 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
     result.time_us = microsecondsSince(start);
     return result;
   }
-  // Flat index over the events of usable clusters, then a seeded subset.
-  std::vector<size_t> offsets{0};
-  for (int c : usable) offsets.push_back(offsets.back() + obs.clusters[c].size());
-  const std::vector<size_t> pick =
-      sampleIndices(offsets.back(), static_cast<size_t>(opt.max_rows), opt.seed);
-  std::vector<ClusterFrame> frames;
-  for (int c : usable) frames.push_back(detail::makeClusterFrame(obs.clusters[c], motion));
+  // Rows: a seeded subset of each usable cluster's events.
+  std::vector<size_t> sizes;
+  for (int c : usable) sizes.push_back(obs.clusters[c].size());
+  const std::vector<size_t> quota = detail::rowQuota(sizes, static_cast<size_t>(opt.max_rows), opt.balance_clusters);
   std::vector<ConstraintRow> rows;
-  rows.reserve(pick.size());
-  size_t ci = 0;
-  for (size_t flat : pick) {
-    while (flat >= offsets[ci + 1]) ++ci;
+  for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
-    const size_t k = flat - offsets[ci];
-    if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
-    ConstraintRow row = detail::celcRow(frames[ci], motion, cl.times[k], cl.bearings[k]);
-    if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
+    const ClusterFrame frame = detail::makeClusterFrame(cl, motion);
+    for (size_t k : detail::sampleIndices(cl.size(), quota[ci], opt.seed + ci)) {
+      if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
+      ConstraintRow row = detail::celcRow(frame, motion, cl.times[k], cl.bearings[k]);
+      if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
+    }
   }
   const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
   result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));

@@ -56,6 +56,10 @@ struct SolverResult {
 /// Options of the robust linear stage (CELC and CE3LC).
 struct LinearOptions {
   int max_rows = 1000;           ///< random subset of event rows (0 = all) [rows]
+  /// Share the rows equally among clusters (water-filling) instead of in
+  /// proportion to their sizes. Off by default: on rendered scenes it let
+  /// short, weakly informative clusters dominate (measured worse).
+  bool balance_clusters = false;
   std::uint64_t seed = 1;        ///< seed of the row subset
   int max_iterations = 20;       ///< IRLS iterations
   double huber_k = 1.345;        ///< Huber threshold in units of the robust scale
@@ -89,7 +93,8 @@ struct LinearOptions {
 struct RefineOptions {
   double huber_px = 1.5;          ///< Huber loss threshold on the point-line distance [px]
   int max_iterations = 50;        ///< Levenberg-Marquardt iterations
-  int max_events = 0;             ///< events used (0 = all; else a seeded random subset)
+  int max_events = 5000;          ///< events used (0 = all; else a seeded random subset)
+  bool balance_clusters = false;  ///< share max_events equally among clusters (water-filling)
   std::uint64_t seed = 1;
   double function_tolerance = 1e-10;
   int num_threads = 1;
