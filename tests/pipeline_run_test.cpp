@@ -1,0 +1,248 @@
+// celc run / batch / table end to end on the bundled simulated sequence.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "celc/config/config.hpp"
+#include "celc/eval/run_tables.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/pipeline/run_output.hpp"
+
+namespace fs = std::filesystem;
+using namespace celc;
+
+namespace {
+const std::string kSample = CELC_SOURCE_DIR "/data/sample_seq";
+
+struct Run {
+  int status;
+  std::string out, err;
+};
+Run celcCmd(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string cmd = std::string(CELC_BINARY) + " " + args + " 2> '" + err.string() + "'";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  std::ifstream e(err);
+  std::stringstream es;
+  es << e.rdbuf();
+  return {WEXITSTATUS(st), out, es.str()};
+}
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("celc_pipe_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+// Small windows over the first 0.12 s keep every run here to about a second.
+const std::string kFast = " -q --threads 2 --window-events 15000 --set windows.t_end=0.12 ";
+}  // namespace
+
+TEST(RunConfig, ShippedFileEqualsDefaults) {
+  const RunConfig loaded = loadRunConfig(CELC_SOURCE_DIR "/config/run.yaml");
+  EXPECT_EQ(toYaml(loaded), toYaml(RunConfig{}));
+}
+
+TEST(RunConfig, EffectiveConfigRoundTripsAndErrorsNameTheKey) {
+  RunConfig c;
+  applyRunConfig("windows: {events: 1234}\ncluster: {smoothness_deg: 12}\nmethods: [celc]\n", "a.yaml", c);
+  EXPECT_EQ(c.windows.events_per_window, 1234u);
+  EXPECT_EQ(c.cluster.smoothness_deg, 12.0);
+  RunConfig back;
+  applyRunConfig(toYaml(c), "effective", back);
+  EXPECT_EQ(toYaml(back), toYaml(c));
+  try {
+    RunConfig d;
+    applyRunConfig("windows:\n  event: 10\n", "bad.yaml", d);
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("windows.event"), std::string::npos) << e.what();
+  }
+  RunConfig d;
+  EXPECT_THROW(applyRunConfig("motion: {model: wobbly}\n", "m.yaml", d), std::exception);
+  EXPECT_THROW(applyRunConfig("windows: {events: many}\n", "w.yaml", d), std::exception);
+  EXPECT_THROW(applyRunConfig("cluster: {smoothnes_deg: 3}\n", "c.yaml", d), std::exception);
+}
+
+// The whole pipeline on the simulated room: every window and method has a
+// row, the ground truth the pipeline computes from the pose file equals the
+// simulator's twist, and the outputs exist.
+TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
+  const fs::path d = tempDir("run");
+  const auto r = celcCmd("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = eval::readWindowsCsv((d / "o" / "windows.csv").string(), false);
+  ASSERT_GE(rows.size(), 4u * 3);  // >= 3 windows x 4 methods
+  std::map<std::int64_t, int> per_window;
+  const Vec3 twist = Vec3(1.6, -0.3, 1.2).normalized();  // data/README.md
+  for (const auto& row : rows) {
+    per_window[row.window]++;
+    EXPECT_FALSE(row.status.empty());
+    ASSERT_TRUE(row.has_gt) << "window " << row.window;
+    // Constant twist: the body-frame velocity direction is the same at all times.
+    EXPECT_LT((row.gt - twist).norm(), 1e-3) << "window " << row.window;
+    if (row.status == "ok") {
+      EXPECT_TRUE(row.has_v);
+      EXPECT_NEAR(row.v.norm(), 1.0, 1e-6);
+      EXPECT_TRUE(row.has_metrics);
+    }
+  }
+  for (const auto& [w, n] : per_window) EXPECT_EQ(n, 4) << "window " << w;
+  EXPECT_TRUE(fs::exists(d / "o" / "summary.md"));
+  EXPECT_NE(readAll(d / "o" / "summary.md").find("| celc_opt |"), std::string::npos);
+  EXPECT_NE(readAll(d / "o" / "config.yaml").find("events: 15000"), std::string::npos);
+  EXPECT_NE(r.out.find("| celc |"), std::string::npos);
+  // An existing output folder is refused without --force / --resume.
+  const auto again = celcCmd("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
+  EXPECT_NE(again.status, 0);
+  EXPECT_NE(again.err.find("--force"), std::string::npos) << again.err;
+  fs::remove_all(d);
+}
+
+// Shards: the union of the N shares equals the single run, row for row, and
+// `celc table` merges the shares into the same table.
+TEST(Pipeline, ShardsUnionEqualsSingleRun) {
+  const fs::path d = tempDir("shard");
+  ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / "all" / "seq").string() + "'" + kFast, d).status, 0);
+  for (int k = 1; k <= 2; ++k)
+    ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / ("s" + std::to_string(k)) / "seq").string() +
+                          "' --shard " + std::to_string(k) + "/2" + kFast, d).status, 0);
+  auto lines = [](const fs::path& p) {
+    std::multiset<std::string> s;
+    std::stringstream ss(readAll(p));
+    std::string l;
+    std::getline(ss, l);
+    while (std::getline(ss, l)) {
+      // Drop runtime_ms (the last column): timing differs between runs.
+      s.insert(l.substr(0, l.rfind(',')));
+    }
+    return s;
+  };
+  auto all = lines(d / "all" / "seq" / "windows.csv");
+  auto s1 = lines(d / "s1" / "seq" / "windows.csv"), s2 = lines(d / "s2" / "seq" / "windows.csv");
+  EXPECT_FALSE(s1.empty());
+  EXPECT_FALSE(s2.empty());
+  std::multiset<std::string> both = s1;
+  both.insert(s2.begin(), s2.end());
+  EXPECT_EQ(both, all);
+  const auto t_single = celcCmd("table '" + (d / "all").string() + "'", d);
+  const auto t_merged = celcCmd("table '" + (d / "s1").string() + "' '" + (d / "s2").string() + "'", d);
+  ASSERT_EQ(t_single.status, 0) << t_single.err;
+  EXPECT_EQ(t_single.out, t_merged.out);
+  EXPECT_NE(t_single.out.find("| seq | eps [m/s] |"), std::string::npos) << t_single.out;
+  EXPECT_NE(t_single.out.find("**"), std::string::npos);  // best in bold
+  fs::remove_all(d);
+}
+
+// An interrupted run (windows.csv cut inside a window) resumes after its last
+// complete window and ends with the same rows as an uninterrupted one.
+TEST(Pipeline, ResumeAfterInterruptionLosesNothing) {
+  const fs::path d = tempDir("resume");
+  ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / "full").string() + "'" + kFast, d).status, 0);
+  const std::string full = readAll(d / "full" / "windows.csv");
+  // Keep the header, the first window and half a line of the second.
+  std::stringstream ss(full);
+  std::string l, cut;
+  int line_no = 0;
+  while (std::getline(ss, l)) {
+    ++line_no;
+    if (line_no <= 5) cut += l + "\n";
+    else if (line_no == 6) cut += l.substr(0, l.size() / 2);
+  }
+  fs::create_directories(d / "part");
+  std::ofstream(d / "part" / "windows.csv") << cut;
+  const auto r = celcCmd("run '" + kSample + "' -o '" + (d / "part").string() + "' --resume" + kFast, d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto strip = [](const std::string& text) {
+    std::stringstream in(text);
+    std::string line, out;
+    while (std::getline(in, line)) out += line.substr(0, line.rfind(',')) + "\n";
+    return out;
+  };
+  EXPECT_EQ(strip(readAll(d / "part" / "windows.csv")), strip(full));
+  EXPECT_NE(readAll(d / "part" / "summary.md").find("resumed after window 0"), std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST(Pipeline, BadInputsGiveOneLineErrorsOrStatuses) {
+  const fs::path d = tempDir("bad");
+  // A directory without calibration.
+  fs::create_directories(d / "seq");
+  fs::copy_file(kSample + "/events.txt", d / "seq" / "events.txt");
+  auto r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o1").string() + "'" + kFast, d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("calibration"), std::string::npos) << r.err;
+  // No IMU: every window gets the status no_gyro, not a guess.
+  fs::copy_file(kSample + "/calib.yaml", d / "seq" / "calib.yaml");
+  r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o2").string() + "'" + kFast, d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& row : eval::readWindowsCsv((d / "o2" / "windows.csv").string())) {
+    EXPECT_EQ(row.status, "no_gyro");
+    EXPECT_FALSE(row.has_v);
+  }
+  // An IMU that stops early: the windows it does not cover get a status.
+  {
+    std::ifstream in(kSample + "/imu.txt");
+    std::ofstream out(d / "seq" / "imu.txt");
+    std::string line;
+    for (int i = 0; i < 40 && std::getline(in, line); ++i) out << line << "\n";  // 40 ms
+  }
+  r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o3").string() + "'" + kFast, d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::set<std::string> statuses;
+  for (const auto& row : eval::readWindowsCsv((d / "o3" / "windows.csv").string())) statuses.insert(row.status);
+  EXPECT_TRUE(statuses.count("not_covered") || statuses.count("gyro_gap")) << *statuses.begin();
+  // A wrong configuration key names the key and the file.
+  std::ofstream(d / "bad.yaml") << "windows:\n  evnts: 3\n";
+  r = celcCmd("run '" + kSample + "' -c '" + (d / "bad.yaml").string() + "' -o '" + (d / "o4").string() + "'", d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("bad.yaml:2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("windows.evnts"), std::string::npos) << r.err;
+  // A missing input.
+  r = celcCmd("run '" + (d / "nothing").string() + "' -o '" + (d / "o5").string() + "'", d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
+  fs::remove_all(d);
+}
+
+TEST(Pipeline, BatchWritesPaperTables) {
+  const fs::path d = tempDir("batch");
+  std::ofstream(d / "batch.yaml") << "sequences:\n"
+                                  << "  - {label: roomA, path: '" << kSample << "', t_end: 0.08}\n"
+                                  << "  - {label: roomB, path: '" << kSample << "', t_end: 0.08, "
+                                  << "config: {methods: [celc, ce3lc]}}\n";
+  const auto r = celcCmd("batch '" + (d / "batch.yaml").string() + "' -o '" + (d / "out").string() +
+                             "' -q --window-events 15000",
+                         d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"table.md", "table.tex", "table.csv", "roomA/windows.csv", "roomB/summary.md"})
+    EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
+  const std::string tex = readAll(d / "out" / "table.tex");
+  EXPECT_NE(tex.find("\\toprule"), std::string::npos);
+  EXPECT_NE(tex.find("\\textbf{"), std::string::npos);
+  EXPECT_NE(readAll(d / "out" / "table.md").find("| roomB | phi [rad] |"), std::string::npos);
+  // roomB ran only two methods.
+  for (const auto& row : eval::readWindowsCsv((d / "out" / "roomB" / "windows.csv").string()))
+    EXPECT_TRUE(row.method == "celc" || row.method == "ce3lc") << row.method;
+  std::ofstream(d / "bad.yaml") << "sequences:\n  - {label: x, pth: y}\n";
+  const auto bad = celcCmd("batch '" + (d / "bad.yaml").string() + "' -o '" + (d / "o2").string() + "'", d);
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("bad.yaml:2"), std::string::npos) << bad.err;
+  fs::remove_all(d);
+}
