@@ -91,7 +91,7 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   }
   auto given = [&](const char* name) { return a.config.empty() || cmd.count(name) > 0; };
   if (given("--method")) opt.method = parseClusterMethod(a.method);
-  if (given("--c")) opt.c_px_per_s = a.c;
+  if (given("--c-px-per-s")) opt.c_px_per_s = a.c;
   if (cmd.count("--merge-polarity") > 0) opt.separate_polarity = false;
   if (given("--threads")) opt.threads = a.threads;
   if (given("--smoothness-deg")) opt.smoothness_deg = a.smoothness_deg;
@@ -148,7 +148,7 @@ void registerCluster(CLI::App& app) {
   cmd->add_option("--dump", args->dump, "directory for window_NNNNN.png (x-y and x-t views) and .ply");
   cmd->add_option("--method", args->method, "grid (fast, default) or pcl (PCL region growing reference)")
       ->capture_default_str();
-  cmd->add_option("--c", args->c, "time scale c [px/s] of the points (x, y, c t); 0 = automatic")
+  cmd->add_option("--c-px-per-s", args->c, "time scale c [px/s] of the points (x, y, c t); 0 = automatic")
       ->capture_default_str();
   cmd->add_flag("--merge-polarity", args->merge_polarity, "cluster ON and OFF events together");
   cmd->add_option("--threads", args->threads, "worker threads")->capture_default_str();

@@ -170,10 +170,11 @@ std::vector<std::vector<int>> splitPlanes(const Group& g, double c, std::vector<
       if (count > best_count) best_count = count, best_n = nrm, best_p = a;
     }
     if (best_count == 0) break;
-    // Refine: PCA on the inliers, then inliers again.
+    // Refine: PCA on the close inliers (half the threshold, so that a nearby
+    // second plane pulls little), then inliers again at the threshold.
     std::vector<int> in;
     for (int i : idx)
-      if (std::fabs(best_n.dot(pt(i) - best_p)) < thr) in.push_back(i);
+      if (std::fabs(best_n.dot(pt(i) - best_p)) < 0.5 * thr) in.push_back(i);
     if (static_cast<int>(in.size()) < opt.min_cluster_size) break;
     const PlaneFit f = fitPlane(g, c, in);
     in.clear();

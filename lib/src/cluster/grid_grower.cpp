@@ -252,10 +252,9 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
   index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, valid, [&](int k, int j) {
     const bool lk = curv[k] < curv_thr, lj = curv[j] < curv_thr;
     if (lk && lj) {
-      if (similar(k, j)) {
-        const int rk = find(k), rj = find(j);
-        if (rk != rj) parent[std::max(rk, rj)] = std::min(rk, rj);
-      }
+      // Already in one region (the common case): nothing to test.
+      const int rk = find(k), rj = find(j);
+      if (rk != rj && similar(k, j)) parent[std::max(rk, rj)] = std::min(rk, rj);
     } else if (lk != lj) {
       const int hi = lk ? j : k, lo = lk ? k : j;  // high- and low-curvature point
       if (curv[hi] <= 1.0f && attach[hi] < 0 && similar(hi, lo)) attach[hi] = lo;
