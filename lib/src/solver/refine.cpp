@@ -99,7 +99,9 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.linear_solver_type = ceres::DENSE_QR;
+  // Joint mode: the line blocks of each cluster are eliminated (Schur
+  // complement), leaving a small system in v; v alone: 2 parameters.
+  so.linear_solver_type = refine_lines ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = opt.function_tolerance;
   so.num_threads = opt.num_threads;
