@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include "celc/solver/npt.hpp"
 #include "constraint_rows.hpp"
 
 namespace celc {
@@ -22,13 +23,14 @@ std::string toString(Method method) {
     case Method::CelcOpt: return "celc_opt";
     case Method::CelcMl: return "celc_ml";
     case Method::Ce3lc: return "ce3lc";
+    case Method::Npt: return "npt";
   }
   return "unknown";
 }
 
 const std::vector<Method>& allMethods() {
   static const std::vector<Method> all{Method::Celc, Method::CelcOpt, Method::CelcMl,
-                                       Method::Ce3lc};
+                                       Method::Ce3lc, Method::Npt};
   return all;
 }
 
@@ -36,7 +38,7 @@ Method parseMethod(const std::string& name) {
   for (Method m : allMethods())
     if (toString(m) == name) return m;
   throw std::invalid_argument("unknown method '" + name +
-                              "' (expected celc, celc_opt, celc_ml or ce3lc)");
+                              "' (expected celc, celc_opt, celc_ml, ce3lc or npt)");
 }
 
 std::vector<Method> parseMethodList(const std::string& list) {
@@ -101,7 +103,9 @@ std::string RefineOptions::validate() const {
   return e.str();
 }
 
-std::string SolverOptions::validate() const { return linear.validate() + refine.validate(); }
+std::string SolverOptions::validate() const {
+  return linear.validate() + refine.validate() + npt.validate();
+}
 
 double angleBetween(const Vec3& a, const Vec3& b) {
   // atan2 form: accurate for small and large angles alike.
@@ -376,6 +380,18 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     switch (m) {
       case Method::Celc: out.push_back(getLinear()); break;
       case Method::Ce3lc: out.push_back(solveCe3lc(obs, motion, options.linear)); break;
+      case Method::Npt: {
+        SolverResult r = solveNpt(obs, motion, options.npt);
+        if (r.ok() && options.linear.resolve_sign) {
+          const auto t0 = Clock::now();
+          const SignDecision s = resolveSign(obs, motion, r.v);
+          r.v *= s.sign;
+          r.sign_margin = s.margin * s.sign;
+          r.time_us += microsecondsSince(t0);
+        }
+        out.push_back(r);
+        break;
+      }
       case Method::CelcOpt:
       case Method::CelcMl: {
         const SolverResult& init = getLinear();
