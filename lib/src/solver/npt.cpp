@@ -58,7 +58,12 @@ NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector
   out.x = es.eigenvectors().col(0).normalized();
   const Vec3 a = out.x.head<3>(), m = out.x.tail<3>();
   const Vec3 mxa = m.cross(a);
-  if (!(mxa.norm() > 1e-14) || !(m.norm() > 1e-14)) return out;  // no parallax, or line through c
+  // No parallax: a = d x v ~ 0 (v = 0 or v along d), or a parallel to m (v in
+  // the plane of the line and the camera centre: the image line does not move;
+  // with v = 0 the nullspace is [alpha m; beta m]); or a line through the centre.
+  if (!(m.norm() > 1e-14) || !(a.norm() > 1e-9 * m.norm()) ||
+      !(mxa.norm() > 1e-6 * m.norm() * a.norm()))
+    return out;
   const Vec3 d = mxa.normalized();
   out.direction = d;
   out.partial_velocity = a.cross(d);

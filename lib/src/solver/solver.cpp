@@ -104,7 +104,9 @@ std::string RefineOptions::validate() const {
 }
 
 std::string SolverOptions::validate() const {
-  return linear.validate() + refine.validate() + npt.validate();
+  std::string e = linear.validate() + refine.validate() + npt.validate();
+  if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
+  return e;
 }
 
 double angleBetween(const Vec3& a, const Vec3& b) {
@@ -376,30 +378,78 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
     return linear;
   };
+  SolverResult npt;
+  bool have_npt = false;
+  auto getNpt = [&]() -> const SolverResult& {
+    if (!have_npt) {
+      npt = solveNpt(obs, motion, options.npt);
+      if (npt.ok() && options.linear.resolve_sign) {
+        const auto t0 = Clock::now();
+        const SignDecision s = resolveSign(obs, motion, npt.v);
+        npt.v *= s.sign;
+        npt.sign_margin = s.margin * s.sign;
+        npt.time_us += microsecondsSince(t0);
+      }
+      have_npt = true;
+    }
+    return npt;
+  };
   for (Method m : methods) {
     switch (m) {
       case Method::Celc: out.push_back(getLinear()); break;
       case Method::Ce3lc: out.push_back(solveCe3lc(obs, motion, options.linear)); break;
-      case Method::Npt: {
-        SolverResult r = solveNpt(obs, motion, options.npt);
-        if (r.ok() && options.linear.resolve_sign) {
-          const auto t0 = Clock::now();
-          const SignDecision s = resolveSign(obs, motion, r.v);
-          r.v *= s.sign;
-          r.sign_margin = s.margin * s.sign;
-          r.time_us += microsecondsSince(t0);
+      case Method::Npt: out.push_back(getNpt()); break;
+      case Method::CelcMl: {
+        const SolverResult& init = getLinear();
+        if (!options.ml_second_start) {
+          if (!init.ok()) {
+            out.push_back(init);
+            break;
+          }
+          SolverResult r = refineVelocity(obs, motion, init.v, true, options.refine);
+          r.time_us += init.time_us;
+          r.sigma_min = init.sigma_min;
+          r.sigma_second = init.sigma_second;
+          r.sign_margin = init.sign_margin;
+          out.push_back(r);
+          break;
         }
-        out.push_back(r);
+        const SolverResult& second = getNpt();
+        if (!init.ok() && !second.ok()) {
+          out.push_back(init);
+          break;
+        }
+        SolverResult best;
+        bool have = false;
+        double time_us = init.time_us + second.time_us;
+        for (const SolverResult* start : {&init, &second}) {
+          if (!start->ok()) continue;
+          if (have && angleBetweenSignAgnostic(start->v, best.v) * 180.0 / M_PI <
+                          options.ml_second_start_deg)
+            continue;  // same basin as the result so far
+          SolverResult r = refineVelocity(obs, motion, start->v, true, options.refine);
+          time_us += r.time_us;
+          if (!r.ok()) continue;
+          if (!have || r.residual_px < best.residual_px) {
+            best = r;
+            best.sigma_min = start->sigma_min;
+            best.sigma_second = start->sigma_second;
+            best.sign_margin = start->sign_margin;
+          }
+          have = true;
+        }
+        if (!have) best = init.ok() ? init : second;
+        if (have) best.time_us = time_us;
+        out.push_back(best);
         break;
       }
-      case Method::CelcOpt:
-      case Method::CelcMl: {
+      case Method::CelcOpt: {
         const SolverResult& init = getLinear();
         if (!init.ok()) {
           out.push_back(init);
           break;
         }
-        SolverResult r = refineVelocity(obs, motion, init.v, m == Method::CelcMl, options.refine);
+        SolverResult r = refineVelocity(obs, motion, init.v, false, options.refine);
         r.time_us += init.time_us;  // a refined estimate costs its initialisation too
         r.sigma_min = init.sigma_min;
         r.sigma_second = init.sigma_second;

@@ -112,6 +112,12 @@ struct SolverOptions {
   LinearOptions linear;
   RefineOptions refine;
   NptOptions npt;
+  /// celc_ml also starts from npt's estimate (sign resolved) when it ends more
+  /// than ml_second_start_deg away from the celc start's result, and keeps the
+  /// lower robust cost; it also runs from npt alone when celc fails. A remedy
+  /// for the local minima of the joint problem (docs/peers.md).
+  bool ml_second_start = true;
+  double ml_second_start_deg = 2.0;  ///< [deg]
   std::string validate() const;
 };
 
