@@ -44,11 +44,10 @@ NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector
     Vec6 row;
     row << displacementScale(P) * fp, fp;
     if (!row.allFinite()) continue;
-    G.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    G.noalias() += row * row.transpose();
     ++out.events;
   }
   if (out.events < opt.min_line_events) return out;
-  G = G.selfadjointView<Eigen::Lower>();
   const Eigen::SelfAdjointEigenSolver<Mat6> es(G);
   if (es.info() != Eigen::Success) return out;
   const Vec6 ev = es.eigenvalues().cwiseMax(0.0);
