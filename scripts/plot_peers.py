@@ -9,7 +9,9 @@ Writes
                              with the CRLB (RMS) as a dashed line;
   OUTDIR/peers_ratio.png     RMS / CRLB per method over the V x sigma grid;
   OUTDIR/peers_factors.png   median phi against each one-factor sweep
-                             (angular-velocity error, lines, events, outliers).
+                             (angular-velocity error, lines, events, outliers);
+  OUTDIR/peers_table.md      the study table (rows: cells; per method median
+                             sign-agnostic phi [deg], RMS / CRLB, median time [us]).
 Needs python3-matplotlib.
 """
 import csv
@@ -63,7 +65,9 @@ def plot_grid(outdir, rows):
         rs = sorted([r for r in cell if r["method"] == cell[0]["method"]],
                     key=lambda r: num(r["sigma_px"]))
         ax.plot([num(r["sigma_px"]) for r in rs], [num(r["crlb_rms_deg"]) for r in rs], "k--",
-                label="CRLB (RMS)")
+                label="CRLB (RMS over trials)")
+        ax.plot([num(r["sigma_px"]) for r in rs], [num(r["crlb_median_deg"]) for r in rs], "k:",
+                label="CRLB (median over trials)")
         ax.set_title("V = %g m/s (parallax %.3g)" % (v, num(cell[0]["parallax_ratio"])))
         ax.set_xlabel("pixel noise sigma [px]")
         ax.set_yscale("symlog", linthresh=0.1)
@@ -126,6 +130,36 @@ def plot_factors(outdir, rows):
     plt.close(fig)
 
 
+def write_table(outdir, rows):
+    ms = methods(rows)
+    cells = []
+    for r in rows:
+        key = (r["groups"], r["speed_m_s"], r["sigma_px"], r["omega_error_deg_s"], r["lines"],
+               r["events_per_line"], r["outliers"])
+        if key not in [c[0] for c in cells]:
+            cells.append((key, r))
+    out = ["| cells | V [m/s] (parallax) | sigma [px] | w err [deg/s] | lines | events/line | outliers "
+           "| CRLB RMS / median [deg] | " + " | ".join(ms) + " |",
+           "|---" * (8 + len(ms)) + "|"]
+    for key, first in cells:
+        line = "| %s | %s (%.3g) | %s | %s | %s | %s | %s | %s" % (
+            key[0].replace(";", ", "), key[1], num(first["parallax_ratio"]), key[2], key[3], key[4],
+            key[5], key[6], ("%.3g / %.3g" % (num(first["crlb_rms_deg"]), num(first["crlb_median_deg"])))
+            if first["crlb_rms_deg"] else "-")
+        for m in ms:
+            rr = [r for r in rows if r["method"] == m and (r["groups"], r["speed_m_s"], r["sigma_px"],
+                  r["omega_error_deg_s"], r["lines"], r["events_per_line"], r["outliers"]) == key]
+            if not rr or not rr[0]["phi_median_agn_deg"]:
+                line += " | -"
+                continue
+            r = rr[0]
+            ratio = ("%.2f" % num(r["rms_over_crlb"])) if r["rms_over_crlb"] else "-"
+            line += " | %.3g / %s / %.0f" % (num(r["phi_median_agn_deg"]), ratio, num(r["time_median_us"]))
+        out.append(line + " |")
+    with open(os.path.join(outdir, "peers_table.md"), "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plot_peers.py OUTDIR")
@@ -135,6 +169,7 @@ def main():
     rows = read(path)
     plot_grid(sys.argv[1], rows)
     plot_factors(sys.argv[1], rows)
+    write_table(sys.argv[1], rows)
 
 
 if __name__ == "__main__":

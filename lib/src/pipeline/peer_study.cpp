@@ -172,7 +172,7 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
       r.cell = cells[static_cast<size_t>(ci)];
       r.method = config.methods[static_cast<size_t>(m)];
       r.trials = n_trials;
-      std::vector<double> phi, agn, time;
+      std::vector<double> phi, agn, time, bound;
       double sq = 0.0, bound_sq = 0.0;
       int above = 0, n_bound = 0;
       for (int t = 0; t < n_trials; ++t) {
@@ -184,11 +184,11 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
         time.push_back(o.time_us);
         sq += o.agn * o.agn;
         if (o.agn * kDeg > 5.0) ++above;
-        if (std::isfinite(bounds[job])) {
+        // NaN: no bound for this trial; +inf: direction unobservable (kept).
+        if (!std::isnan(bounds[job])) {
+          bound.push_back(bounds[job] * kDeg);
           bound_sq += bounds[job] * bounds[job];
           ++n_bound;
-        } else {
-          bound_sq = NAN;
         }
       }
       r.n_ok = static_cast<int>(phi.size());
@@ -199,7 +199,9 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
       r.share_above_5deg = r.n_ok > 0 ? static_cast<double>(above) / r.n_ok : NAN;
       r.rms_agn_deg = r.n_ok > 0 ? std::sqrt(sq / r.n_ok) * kDeg : NAN;
       r.crlb_rms_deg = n_bound > 0 ? std::sqrt(bound_sq / n_bound) * kDeg : NAN;
-      r.ratio = r.crlb_rms_deg > 0.0 ? r.rms_agn_deg / r.crlb_rms_deg : NAN;
+      r.crlb_median_deg = bound.empty() ? NAN : median(bound);
+      r.ratio = r.crlb_rms_deg > 0.0 && std::isfinite(r.crlb_rms_deg) ? r.rms_agn_deg / r.crlb_rms_deg
+                                                                      : NAN;
       r.time_median_us = median(time);
       rows.push_back(r);
     }
@@ -210,7 +212,7 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
 std::string peerCsvHeader() {
   return "groups,speed_m_s,parallax_ratio,sigma_px,omega_error_deg_s,lines,events_per_line,"
          "outliers,method,trials,n_ok,phi_median_deg,phi_mean_deg,phi_median_agn_deg,"
-         "phi_mean_agn_deg,share_above_5deg,rms_agn_deg,crlb_rms_deg,rms_over_crlb,"
+         "phi_mean_agn_deg,share_above_5deg,rms_agn_deg,crlb_rms_deg,crlb_median_deg,rms_over_crlb,"
          "time_median_us";
 }
 
@@ -229,7 +231,8 @@ std::string peerCsvRow(const PeerCellResult& r, const PeerSceneOptions& base) {
   num(r.cell.outliers);
   os << "," << toString(r.method) << "," << r.trials << "," << r.n_ok;
   for (double x : {r.phi_median_deg, r.phi_mean_deg, r.phi_median_agn_deg, r.phi_mean_agn_deg,
-                   r.share_above_5deg, r.rms_agn_deg, r.crlb_rms_deg, r.ratio, r.time_median_us})
+                   r.share_above_5deg, r.rms_agn_deg, r.crlb_rms_deg, r.crlb_median_deg, r.ratio,
+                   r.time_median_us})
     num(x);
   return os.str();
 }

@@ -106,6 +106,7 @@ std::string RefineOptions::validate() const {
 std::string SolverOptions::validate() const {
   std::string e = linear.validate() + refine.validate() + npt.validate();
   if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
+  if (!(ml_second_start_max_twist >= 0.0)) e += "ml_second_start_max_twist must be >= 0; ";
   return e;
 }
 
@@ -221,6 +222,18 @@ detail::NullspaceOptions nullspaceOptions(const LinearOptions& o) {
   n.grid_starts = o.grid_starts;
   n.grid_rows = o.grid_rows;
   return n;
+}
+
+// npt's motion model (P(t) = tau I) holds: GyroIntegrated exactly; a constant
+// twist while |w| max|tau| / 2 <= max_twist.
+bool nptModelHolds(const WindowObservations& obs, const MotionModel& motion, double max_twist) {
+  if (motion.kind() == MotionModelKind::GyroIntegrated) return true;
+  double tau = 0.0;
+  for (const auto& c : obs.clusters)
+    for (double t : c.times)
+      if (std::isfinite(t)) tau = std::max(tau, std::abs(t - motion.referenceTime()));
+  const Vec3 w = motion.meanOmega(motion.referenceTime(), motion.referenceTime() + 1.0);
+  return w.norm() * tau / 2.0 <= max_twist;
 }
 
 bool validInput(const WindowObservations& obs, const MotionModel& motion, SolverResult& r) {
@@ -401,7 +414,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcMl: {
         const SolverResult& init = getLinear();
-        if (!options.ml_second_start) {
+        if (!options.ml_second_start || !nptModelHolds(obs, motion, options.ml_second_start_max_twist)) {
           if (!init.ok()) {
             out.push_back(init);
             break;

@@ -51,6 +51,7 @@ struct PeerCellResult {
   double share_above_5deg = 0;   ///< of ok trials, sign-agnostic phi > 5 deg
   double rms_agn_deg = 0;        ///< RMS of the sign-agnostic phi [deg]
   double crlb_rms_deg = 0;       ///< RMS over the same trials of the bound sqrt(trace C) [deg]
+  double crlb_median_deg = 0;    ///< median over the same trials of the per-trial bound [deg]
   double ratio = 0;              ///< rms_agn_deg / crlb_rms_deg (NaN when the bound is 0)
   double time_median_us = 0;     ///< median solver time [us]
 };

@@ -115,8 +115,13 @@ struct SolverOptions {
   /// celc_ml also starts from npt's estimate (sign resolved) when it ends more
   /// than ml_second_start_deg away from the celc start's result, and keeps the
   /// lower robust cost; it also runs from npt alone when celc fails. A remedy
-  /// for the local minima of the joint problem (docs/peers.md).
+  /// for the local minima of the joint problem (docs/peers.md). Only where
+  /// npt's motion model holds: GyroIntegrated (P = tau I, exact), or a constant
+  /// twist turning little, |w| max|tau| / 2 <= ml_second_start_max_twist (the
+  /// relative error npt makes on the displacement); on the paper's scene
+  /// (|w| T = 1 rad) npt's estimate is far off and would only cost time.
   bool ml_second_start = true;
+  double ml_second_start_max_twist = 0.02;
   double ml_second_start_deg = 2.0;  ///< [deg]
   std::string validate() const;
 };
