@@ -62,6 +62,19 @@ TEST(Cli, SimulateWritesCsvAndRefusesToOverwrite) {
   fs::remove_all(d);
 }
 
+TEST(Cli, SimulatePeersWritesCsv) {
+  const fs::path d = tempDir("peers");
+  const auto r = runCelc("simulate --study peers --trials 2 --no-plots -q -o '" + (d / "o").string() + "'", d);
+  ASSERT_EQ(r.status, 0) << readAll(d / "stderr.txt");
+  const std::string csv = readAll(d / "o" / "peers.csv");
+  EXPECT_EQ(csv.substr(0, csv.find(',')), "groups");
+  // 25 cells x 5 methods + header.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 126);
+  EXPECT_NE(r.out.find("| npt |"), std::string::npos);
+  EXPECT_NE(runCelc("simulate --study nope -o '" + (d / "p").string() + "'", d).status, 0);
+  fs::remove_all(d);
+}
+
 TEST(Cli, SimulateIsDeterministicAcrossThreadCounts) {
   const fs::path d = tempDir("det");
   ASSERT_EQ(runCelc("simulate --sweep default --trials 12 --threads 1 -q -o '" + (d / "a").string() + "'", d).status, 0);
