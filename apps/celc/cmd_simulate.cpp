@@ -8,6 +8,7 @@
 
 #include "celc/config/config.hpp"
 #include "celc/io/labelled_events.hpp"
+#include "celc/pipeline/peer_study.hpp"
 #include "celc/pipeline/simulation_study.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
@@ -19,6 +20,7 @@ namespace {
 
 struct SimulateArgs {
   std::string sweep = "all";
+  std::string study = "paper";
   std::string config;
   std::string outdir = "celc_simulate";
   std::string methods;
@@ -28,14 +30,14 @@ struct SimulateArgs {
   bool force = false, no_plots = false, quiet = false, verbose = false;
 };
 
-// Finds scripts/plot_simulation.py: $CELC_SCRIPTS_DIR, the source tree, or next to the binary.
-std::string findPlotScript() {
+// Finds scripts/<name>: $CELC_SCRIPTS_DIR, the source tree, or next to the binary.
+std::string findPlotScript(const std::string& name = "plot_simulation.py") {
   std::vector<fs::path> candidates;
   if (const char* env = std::getenv("CELC_SCRIPTS_DIR")) candidates.emplace_back(env);
   candidates.emplace_back(CELC_SCRIPTS_DIR);
   candidates.emplace_back(fs::path("scripts"));
   for (const auto& dir : candidates) {
-    const fs::path p = dir / "plot_simulation.py";
+    const fs::path p = dir / name;
     if (fs::exists(p)) return p.string();
   }
   return {};
@@ -73,6 +75,73 @@ void printSweepTable(const Sweep& sweep, const std::vector<SweepCell>& cells,
   }
 }
 
+// Runs a plot script on OUTDIR with Debian's interpreter (or $CELC_PYTHON).
+void runPlotScript(const std::string& name, const fs::path& out) {
+  const std::string script = findPlotScript(name);
+  if (script.empty()) {
+    spdlog::warn("plot script scripts/{} not found: no plots (set CELC_SCRIPTS_DIR)", name);
+    return;
+  }
+  std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (const char* env = std::getenv("CELC_PYTHON")) python = env;
+  const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
+  if (std::system(cmd.c_str()) != 0)
+    spdlog::warn("plotting failed (needs python3-matplotlib): {}", cmd);
+  else
+    spdlog::info("plots written to {}/*.png", out.string());
+}
+
+// The peer study: OUTDIR/peers.csv, a Markdown table on stdout, plots.
+void runPeers(const SimulateArgs& a, const SimulateConfig& cfg) {
+  PeerStudyConfig pc;
+  pc.solver = cfg.solver;
+  // Every window of the peer scene moves; the parallax test (meant for real
+  // data) rejects whole windows once 10% uniform outliers inflate its robust
+  // scales, for every method alike. Off here, so the outlier cells are solved.
+  pc.solver.linear.check_parallax = false;
+  pc.methods = cfg.methods;
+  pc.trials = a.trials > 0 ? a.trials : 200;
+  pc.seed = cfg.seed;
+  if (const std::string err = pc.validate(); !err.empty())
+    throw std::runtime_error("peer study: " + err);
+  const fs::path out(a.outdir);
+  if (fs::exists(out / "peers.csv") && !a.force)
+    throw std::runtime_error(out.string() + ": holds results of an earlier run (use --force to overwrite)");
+  fs::create_directories(out);
+  const auto cells = peerStudyCells();
+  spdlog::info("simulate --study peers: {} cells, {} trials per cell, seed {}, output {}",
+               cells.size(), pc.trials, pc.seed, out.string());
+  Progress progress("simulate peers", a.quiet);
+  const auto rows = runPeerStudy(cells, pc, a.threads,
+                                 [&](int done, int total) { progress.update(done, total); });
+  std::string csv = peerCsvHeader() + "\n";
+  for (const auto& r : rows) csv += peerCsvRow(r, pc.scene) + "\n";
+  writeFileAtomically((out / "peers.csv").string(), csv);
+
+  const size_t nm = pc.methods.size();
+  std::cout << "\nPeer study: median sign-agnostic phi [deg] / RMS over CRLB / median time [us]"
+               " (ok trials of " << pc.trials << ")\n\n| cell | V | sigma | w err | lines | events | outl. | CRLB [deg]";
+  for (Method m : pc.methods) std::cout << " | " << toString(m);
+  std::cout << " |\n|---|---|---|---|---|---|---|---";
+  for (size_t i = 0; i < nm; ++i) std::cout << "|---";
+  std::cout << "|\n";
+  for (size_t i = 0; i < rows.size(); i += nm) {
+    const PeerCell& c = rows[i].cell;
+    std::cout << fmt::format("| {} | {:g} | {:g} | {:g} | {} | {} | {:g} | {}", c.groups, c.speed,
+                             c.sigma_px, c.omega_error_deg_s, c.lines, c.events_per_line,
+                             c.outliers, fmtCell(rows[i].crlb_rms_deg));
+    for (size_t m = 0; m < nm; ++m) {
+      const auto& r = rows[i + m];
+      std::cout << fmt::format(" | {} / {} / {:.0f}", fmtCell(r.phi_median_agn_deg),
+                               std::isfinite(r.ratio) ? fmt::format("{:.2f}", r.ratio) : "-",
+                               r.time_median_us);
+    }
+    std::cout << " |\n";
+  }
+  std::cout << std::flush;
+  if (!a.no_plots) runPlotScript("plot_peers.py", out);
+}
+
 void runSimulate(const SimulateArgs& a) {
   configureLogging(a.quiet, a.verbose);
   SimulateConfig cfg;
@@ -80,6 +149,12 @@ void runSimulate(const SimulateArgs& a) {
   if (a.trials > 0) cfg.trials = a.trials;
   if (a.seed >= 0) cfg.seed = static_cast<std::uint64_t>(a.seed);
   if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
+  if (a.study != "paper" && a.study != "peers")
+    throw std::invalid_argument("unknown study '" + a.study + "' (expected paper or peers)");
+  if (a.study == "peers" || a.sweep == "peers") {
+    runPeers(a, cfg);
+    return;
+  }
 
   std::vector<const Sweep*> sweeps{&findSweep("default")};
   if (a.sweep == "all") {
@@ -110,19 +185,7 @@ void runSimulate(const SimulateArgs& a) {
   std::cout << std::flush;
 
   if (a.no_plots || sweeps.size() < 2) return;
-  const std::string script = findPlotScript();
-  if (script.empty()) {
-    spdlog::warn("plot script scripts/plot_simulation.py not found: no plots (set CELC_SCRIPTS_DIR)");
-    return;
-  }
-  // Debian's interpreter (where python3-matplotlib installs) unless $CELC_PYTHON says otherwise.
-  std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  if (const char* env = std::getenv("CELC_PYTHON")) python = env;
-  const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
-  if (std::system(cmd.c_str()) != 0)
-    spdlog::warn("plotting failed (needs python3-matplotlib): {}", cmd);
-  else
-    spdlog::info("plots written to {}/*.png", out.string());
+  runPlotScript("plot_simulation.py", out);
 }
 
 }  // namespace
@@ -136,7 +199,13 @@ void registerSimulate(CLI::App& app) {
       "[rad] per method. Writes OUTDIR/<sweep>.csv, OUTDIR/config.yaml and plots "
       "OUTDIR/<sweep>.png; prints the tables.");
   cmd->add_option("--sweep", a->sweep,
-                  "all, default, event_noise, line_noise, omega_noise, speed, interval or lines")
+                  "all, default, event_noise, line_noise, omega_noise, speed, interval, lines "
+                  "(the paper's study), or peers (= --study peers)")
+      ->capture_default_str();
+  cmd->add_option("--study", a->study,
+                  "paper: the paper's sweeps; peers: npt and CELC on the peers' scene (640x480, "
+                  "f 320 px, T 0.5 s) beside the Cramer-Rao bound, OUTDIR/peers.csv and "
+                  "peers_*.png; --trials defaults to 200 there")
       ->capture_default_str();
   cmd->add_option("-c,--config", a->config, "YAML configuration (see config/simulate.yaml)")
       ->check(CLI::ExistingFile);
@@ -145,7 +214,7 @@ void registerSimulate(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", a->seed, "random seed (default: config, 1)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", a->threads, "worker threads (0 = all cores)")->capture_default_str();
-  cmd->add_option("--methods", a->methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc (default all)");
+  cmd->add_option("--methods", a->methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc,npt (default all)");
   cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
   cmd->add_flag("--no-plots", a->no_plots, "skip the PNG plots");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

@@ -20,7 +20,7 @@ namespace celc::app {
 namespace {
 
 struct SolveArgs {
-  std::string events, calib, methods = "celc,celc_opt,celc_ml,ce3lc", omega = "0,0,0", gyro;
+  std::string events, calib, methods = "celc,celc_opt,celc_ml,ce3lc,npt", omega = "0,0,0", gyro;
   bool normalized = false, quiet = false, verbose = false;
   double focal = 320.0;
   double interval_ms = 5.0;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include "celc/solver/npt.hpp"
 #include "constraint_rows.hpp"
 
 namespace celc {
@@ -22,13 +23,14 @@ std::string toString(Method method) {
     case Method::CelcOpt: return "celc_opt";
     case Method::CelcMl: return "celc_ml";
     case Method::Ce3lc: return "ce3lc";
+    case Method::Npt: return "npt";
   }
   return "unknown";
 }
 
 const std::vector<Method>& allMethods() {
   static const std::vector<Method> all{Method::Celc, Method::CelcOpt, Method::CelcMl,
-                                       Method::Ce3lc};
+                                       Method::Ce3lc, Method::Npt};
   return all;
 }
 
@@ -36,7 +38,7 @@ Method parseMethod(const std::string& name) {
   for (Method m : allMethods())
     if (toString(m) == name) return m;
   throw std::invalid_argument("unknown method '" + name +
-                              "' (expected celc, celc_opt, celc_ml or ce3lc)");
+                              "' (expected celc, celc_opt, celc_ml, ce3lc or npt)");
 }
 
 std::vector<Method> parseMethodList(const std::string& list) {
@@ -101,7 +103,12 @@ std::string RefineOptions::validate() const {
   return e.str();
 }
 
-std::string SolverOptions::validate() const { return linear.validate() + refine.validate(); }
+std::string SolverOptions::validate() const {
+  std::string e = linear.validate() + refine.validate() + npt.validate();
+  if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
+  if (!(ml_second_start_max_twist >= 0.0)) e += "ml_second_start_max_twist must be >= 0; ";
+  return e;
+}
 
 double angleBetween(const Vec3& a, const Vec3& b) {
   // atan2 form: accurate for small and large angles alike.
@@ -194,6 +201,18 @@ detail::NullspaceOptions nullspaceOptions(const LinearOptions& o) {
   n.grid_starts = o.grid_starts;
   n.grid_rows = o.grid_rows;
   return n;
+}
+
+// npt's motion model (P(t) = tau I) holds: GyroIntegrated exactly; a constant
+// twist while |w| max|tau| / 2 <= max_twist.
+bool nptModelHolds(const WindowObservations& obs, const MotionModel& motion, double max_twist) {
+  if (motion.kind() == MotionModelKind::GyroIntegrated) return true;
+  double tau = 0.0;
+  for (const auto& c : obs.clusters)
+    for (double t : c.times)
+      if (std::isfinite(t)) tau = std::max(tau, std::abs(t - motion.referenceTime()));
+  const Vec3 w = motion.meanOmega(motion.referenceTime(), motion.referenceTime() + 1.0);
+  return w.norm() * tau / 2.0 <= max_twist;
 }
 
 bool validInput(const WindowObservations& obs, const MotionModel& motion, SolverResult& r) {
@@ -347,18 +366,78 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
     return linear;
   };
+  SolverResult npt;
+  bool have_npt = false;
+  auto getNpt = [&]() -> const SolverResult& {
+    if (!have_npt) {
+      npt = solveNpt(obs, motion, options.npt);
+      if (npt.ok() && options.linear.resolve_sign) {
+        const auto t0 = Clock::now();
+        const SignDecision s = resolveSign(obs, motion, npt.v);
+        npt.v *= s.sign;
+        npt.sign_margin = s.margin * s.sign;
+        npt.time_us += microsecondsSince(t0);
+      }
+      have_npt = true;
+    }
+    return npt;
+  };
   for (Method m : methods) {
     switch (m) {
       case Method::Celc: out.push_back(getLinear()); break;
       case Method::Ce3lc: out.push_back(solveCe3lc(obs, motion, options.linear)); break;
-      case Method::CelcOpt:
+      case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcMl: {
+        const SolverResult& init = getLinear();
+        if (!options.ml_second_start || !nptModelHolds(obs, motion, options.ml_second_start_max_twist)) {
+          if (!init.ok()) {
+            out.push_back(init);
+            break;
+          }
+          SolverResult r = refineVelocity(obs, motion, init.v, true, options.refine);
+          r.time_us += init.time_us;
+          r.sigma_min = init.sigma_min;
+          r.sigma_second = init.sigma_second;
+          r.sign_margin = init.sign_margin;
+          out.push_back(r);
+          break;
+        }
+        const SolverResult& second = getNpt();
+        if (!init.ok() && !second.ok()) {
+          out.push_back(init);
+          break;
+        }
+        SolverResult best;
+        bool have = false;
+        double time_us = init.time_us + second.time_us;
+        for (const SolverResult* start : {&init, &second}) {
+          if (!start->ok()) continue;
+          if (have && angleBetweenSignAgnostic(start->v, best.v) * 180.0 / M_PI <
+                          options.ml_second_start_deg)
+            continue;  // same basin as the result so far
+          SolverResult r = refineVelocity(obs, motion, start->v, true, options.refine);
+          time_us += r.time_us;
+          if (!r.ok()) continue;
+          if (!have || r.residual_px < best.residual_px) {
+            best = r;
+            best.sigma_min = start->sigma_min;
+            best.sigma_second = start->sigma_second;
+            best.sign_margin = start->sign_margin;
+          }
+          have = true;
+        }
+        if (!have) best = init.ok() ? init : second;
+        if (have) best.time_us = time_us;
+        out.push_back(best);
+        break;
+      }
+      case Method::CelcOpt: {
         const SolverResult& init = getLinear();
         if (!init.ok()) {
           out.push_back(init);
           break;
         }
-        SolverResult r = refineVelocity(obs, motion, init.v, m == Method::CelcMl, options.refine);
+        SolverResult r = refineVelocity(obs, motion, init.v, false, options.refine);
         r.time_us += init.time_us;  // a refined estimate costs its initialisation too
         r.sigma_min = init.sigma_min;
         r.sigma_second = init.sigma_second;

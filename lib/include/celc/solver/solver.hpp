@@ -23,9 +23,9 @@
 namespace celc {
 
 /// Method names as used in every CSV, table and option.
-enum class Method { Celc, CelcOpt, CelcMl, Ce3lc };
+enum class Method { Celc, CelcOpt, CelcMl, Ce3lc, Npt };
 std::string toString(Method method);
-/// Parses "celc", "celc_opt", "celc_ml", "ce3lc"; throws std::invalid_argument otherwise.
+/// Parses "celc", "celc_opt", "celc_ml", "ce3lc", "npt"; throws std::invalid_argument otherwise.
 Method parseMethod(const std::string& name);
 /// Parses a comma-separated list of method names.
 std::vector<Method> parseMethodList(const std::string& list);
@@ -101,9 +101,33 @@ struct RefineOptions {
   std::string validate() const;
 };
 
+/// Options of the N-point linear solver `npt` (Gao et al., CVPR 2024; see npt.hpp).
+struct NptOptions {
+  int min_line_events = 5;   ///< a line needs this many events (>= 5: 6 homogeneous unknowns)
+  int min_lines = 2;         ///< fewer lines with a partial velocity -> degenerate
+  /// A line is dropped when its per-line system has no unique nullspace:
+  /// (second smallest / largest singular value) below this.
+  double min_line_sigma_ratio = 1e-10;
+  /// The averaging stage: sigma_min / sigma_second above this -> degenerate.
+  double max_sigma_ratio = 0.999;
+  std::string validate() const;  ///< empty when valid
+};
+
 struct SolverOptions {
   LinearOptions linear;
   RefineOptions refine;
+  NptOptions npt;
+  /// celc_ml also starts from npt's estimate (sign resolved) when it ends more
+  /// than ml_second_start_deg away from the celc start's result, and keeps the
+  /// lower robust cost; it also runs from npt alone when celc fails. A remedy
+  /// for the local minima of the joint problem (docs/peers.md). Only where
+  /// npt's motion model holds: GyroIntegrated (P = tau I, exact), or a constant
+  /// twist turning little, |w| max|tau| / 2 <= ml_second_start_max_twist (the
+  /// relative error npt makes on the displacement); on the paper's scene
+  /// (|w| T = 1 rad) npt's estimate is far off and would only cost time.
+  bool ml_second_start = true;
+  double ml_second_start_max_twist = 0.02;
+  double ml_second_start_deg = 2.0;  ///< [deg]
   std::string validate() const;
 };
 
@@ -126,6 +150,7 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
 
 /// Runs the requested methods on one window; celc_opt and celc_ml start from
 /// the celc result (computed once), the cluster and parallax checks run once.
+/// npt's sign is resolved with resolveSign when options.linear.resolve_sign.
 /// Results are in the order of `methods`.
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
