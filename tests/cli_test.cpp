@@ -9,39 +9,15 @@
 
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "cli_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace celc;
 
+using celc::test::readAll;
+using celc::test::runCelc;
 namespace {
-struct RunResult {
-  int status;
-  std::string out;
-};
-// Runs the celc binary with arguments; captures stdout (stderr to a file).
-RunResult runCelc(const std::string& args, const fs::path& dir) {
-  const std::string cmd =
-      std::string(CELC_BINARY) + " " + args + " 2> '" + (dir / "stderr.txt").string() + "'";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  return {WEXITSTATUS(st), out};
-}
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("celc_cli_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path tempDir(const std::string& name) { return celc::test::freshTempDir("cli_" + name); }
 }  // namespace
 
 TEST(Cli, SimulateWritesCsvAndRefusesToOverwrite) {

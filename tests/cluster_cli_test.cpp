@@ -76,7 +76,7 @@ TEST(ClusterCli, MalformedLineNamesFileAndLine) {
   std::ofstream(f) << "# t x y p\r\n0.1 10 20 1\r\n0.2 11 twenty 0\r\n";
   const CliRun r = runCelc("cluster " + f.string());
   EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.out.find(f.string() + ":3:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(f.string() + ": line 3:"), std::string::npos) << r.out;  // io reader format
   const CliRun missing = runCelc("cluster " + (dir / "nope.txt").string());
   EXPECT_NE(missing.status, 0);
   EXPECT_NE(missing.out.find("cannot open"), std::string::npos) << missing.out;

@@ -12,43 +12,15 @@
 #include "celc/eval/run_tables.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/run_output.hpp"
+#include "cli_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace celc;
+using celc::test::readAll;
 
 namespace {
 const std::string kSample = CELC_SOURCE_DIR "/data/sample_seq";
 
-struct Run {
-  int status;
-  std::string out, err;
-};
-Run celcCmd(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = std::string(CELC_BINARY) + " " + args + " 2> '" + err.string() + "'";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  std::ifstream e(err);
-  std::stringstream es;
-  es << e.rdbuf();
-  return {WEXITSTATUS(st), out, es.str()};
-}
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("celc_pipe_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 // Small windows over the first 0.12 s keep every run here to about a second.
 const std::string kFast = " -q --threads 2 --window-events 15000 --set windows.t_end=0.12 ";
 }  // namespace
@@ -84,8 +56,8 @@ TEST(RunConfig, EffectiveConfigRoundTripsAndErrorsNameTheKey) {
 // row, the ground truth the pipeline computes from the pose file equals the
 // simulator's twist, and the outputs exist.
 TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
-  const fs::path d = tempDir("run");
-  const auto r = celcCmd("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
+  const fs::path d = test::freshTempDir("pipe_run");
+  const auto r = test::runCelc("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto rows = eval::readWindowsCsv((d / "o" / "windows.csv").string(), false);
   const size_t n_methods = RunConfig{}.methods.size();
@@ -110,7 +82,7 @@ TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
   EXPECT_NE(readAll(d / "o" / "config.yaml").find("events: 15000"), std::string::npos);
   EXPECT_NE(r.out.find("| celc |"), std::string::npos);
   // An existing output folder is refused without --force / --resume.
-  const auto again = celcCmd("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
+  const auto again = test::runCelc("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
   EXPECT_NE(again.status, 0);
   EXPECT_NE(again.err.find("--force"), std::string::npos) << again.err;
   fs::remove_all(d);
@@ -119,10 +91,10 @@ TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
 // Shards: the union of the N shares equals the single run, row for row, and
 // `celc table` merges the shares into the same table.
 TEST(Pipeline, ShardsUnionEqualsSingleRun) {
-  const fs::path d = tempDir("shard");
-  ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / "all" / "seq").string() + "'" + kFast, d).status, 0);
+  const fs::path d = test::freshTempDir("pipe_shard");
+  ASSERT_EQ(test::runCelc("run '" + kSample + "' -o '" + (d / "all" / "seq").string() + "'" + kFast, d).status, 0);
   for (int k = 1; k <= 2; ++k)
-    ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / ("s" + std::to_string(k)) / "seq").string() +
+    ASSERT_EQ(test::runCelc("run '" + kSample + "' -o '" + (d / ("s" + std::to_string(k)) / "seq").string() +
                           "' --shard " + std::to_string(k) + "/2" + kFast, d).status, 0);
   auto lines = [](const fs::path& p) {
     std::multiset<std::string> s;
@@ -142,8 +114,8 @@ TEST(Pipeline, ShardsUnionEqualsSingleRun) {
   std::multiset<std::string> both = s1;
   both.insert(s2.begin(), s2.end());
   EXPECT_EQ(both, all);
-  const auto t_single = celcCmd("table '" + (d / "all").string() + "'", d);
-  const auto t_merged = celcCmd("table '" + (d / "s1").string() + "' '" + (d / "s2").string() + "'", d);
+  const auto t_single = test::runCelc("table '" + (d / "all").string() + "'", d);
+  const auto t_merged = test::runCelc("table '" + (d / "s1").string() + "' '" + (d / "s2").string() + "'", d);
   ASSERT_EQ(t_single.status, 0) << t_single.err;
   EXPECT_EQ(t_single.out, t_merged.out);
   EXPECT_NE(t_single.out.find("| seq | eps [m/s] |"), std::string::npos) << t_single.out;
@@ -154,8 +126,8 @@ TEST(Pipeline, ShardsUnionEqualsSingleRun) {
 // An interrupted run (windows.csv cut inside a window) resumes after its last
 // complete window and ends with the same rows as an uninterrupted one.
 TEST(Pipeline, ResumeAfterInterruptionLosesNothing) {
-  const fs::path d = tempDir("resume");
-  ASSERT_EQ(celcCmd("run '" + kSample + "' -o '" + (d / "full").string() + "'" + kFast, d).status, 0);
+  const fs::path d = test::freshTempDir("pipe_resume");
+  ASSERT_EQ(test::runCelc("run '" + kSample + "' -o '" + (d / "full").string() + "'" + kFast, d).status, 0);
   const std::string full = readAll(d / "full" / "windows.csv");
   // Keep the header, the first window and half a line of the second.
   const int n_methods = static_cast<int>(RunConfig{}.methods.size());
@@ -169,7 +141,7 @@ TEST(Pipeline, ResumeAfterInterruptionLosesNothing) {
   }
   fs::create_directories(d / "part");
   std::ofstream(d / "part" / "windows.csv") << cut;
-  const auto r = celcCmd("run '" + kSample + "' -o '" + (d / "part").string() + "' --resume" + kFast, d);
+  const auto r = test::runCelc("run '" + kSample + "' -o '" + (d / "part").string() + "' --resume" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
   auto strip = [](const std::string& text) {
     std::stringstream in(text);
@@ -183,16 +155,16 @@ TEST(Pipeline, ResumeAfterInterruptionLosesNothing) {
 }
 
 TEST(Pipeline, BadInputsGiveOneLineErrorsOrStatuses) {
-  const fs::path d = tempDir("bad");
+  const fs::path d = test::freshTempDir("pipe_bad");
   // A directory without calibration.
   fs::create_directories(d / "seq");
   fs::copy_file(kSample + "/events.txt", d / "seq" / "events.txt");
-  auto r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o1").string() + "'" + kFast, d);
+  auto r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "o1").string() + "'" + kFast, d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("calibration"), std::string::npos) << r.err;
   // No IMU: every window gets the status no_gyro, not a guess.
   fs::copy_file(kSample + "/calib.yaml", d / "seq" / "calib.yaml");
-  r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o2").string() + "'" + kFast, d);
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "o2").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
   for (const auto& row : eval::readWindowsCsv((d / "o2" / "windows.csv").string())) {
     EXPECT_EQ(row.status, "no_gyro");
@@ -205,31 +177,31 @@ TEST(Pipeline, BadInputsGiveOneLineErrorsOrStatuses) {
     std::string line;
     for (int i = 0; i < 40 && std::getline(in, line); ++i) out << line << "\n";  // 40 ms
   }
-  r = celcCmd("run '" + (d / "seq").string() + "' -o '" + (d / "o3").string() + "'" + kFast, d);
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "o3").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
   std::set<std::string> statuses;
   for (const auto& row : eval::readWindowsCsv((d / "o3" / "windows.csv").string())) statuses.insert(row.status);
   EXPECT_TRUE(statuses.count("not_covered") || statuses.count("gyro_gap")) << *statuses.begin();
   // A wrong configuration key names the key and the file.
   std::ofstream(d / "bad.yaml") << "windows:\n  evnts: 3\n";
-  r = celcCmd("run '" + kSample + "' -c '" + (d / "bad.yaml").string() + "' -o '" + (d / "o4").string() + "'", d);
+  r = test::runCelc("run '" + kSample + "' -c '" + (d / "bad.yaml").string() + "' -o '" + (d / "o4").string() + "'", d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("bad.yaml:2"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("windows.evnts"), std::string::npos) << r.err;
   // A missing input.
-  r = celcCmd("run '" + (d / "nothing").string() + "' -o '" + (d / "o5").string() + "'", d);
+  r = test::runCelc("run '" + (d / "nothing").string() + "' -o '" + (d / "o5").string() + "'", d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
   fs::remove_all(d);
 }
 
 TEST(Pipeline, BatchWritesPaperTables) {
-  const fs::path d = tempDir("batch");
+  const fs::path d = test::freshTempDir("pipe_batch");
   std::ofstream(d / "batch.yaml") << "sequences:\n"
                                   << "  - {label: roomA, path: '" << kSample << "', t_end: 0.08}\n"
                                   << "  - {label: roomB, path: '" << kSample << "', t_end: 0.08, "
                                   << "config: {methods: [celc, ce3lc]}}\n";
-  const auto r = celcCmd("batch '" + (d / "batch.yaml").string() + "' -o '" + (d / "out").string() +
+  const auto r = test::runCelc("batch '" + (d / "batch.yaml").string() + "' -o '" + (d / "out").string() +
                              "' -q --window-events 15000",
                          d);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -243,7 +215,7 @@ TEST(Pipeline, BatchWritesPaperTables) {
   for (const auto& row : eval::readWindowsCsv((d / "out" / "roomB" / "windows.csv").string()))
     EXPECT_TRUE(row.method == "celc" || row.method == "ce3lc") << row.method;
   std::ofstream(d / "bad.yaml") << "sequences:\n  - {label: x, pth: y}\n";
-  const auto bad = celcCmd("batch '" + (d / "bad.yaml").string() + "' -o '" + (d / "o2").string() + "'", d);
+  const auto bad = test::runCelc("batch '" + (d / "bad.yaml").string() + "' -o '" + (d / "o2").string() + "'", d);
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.err.find("bad.yaml:2"), std::string::npos) << bad.err;
   fs::remove_all(d);

@@ -17,48 +17,12 @@
 #include "celc/cluster/cluster.hpp"
 #include "celc/cluster/cluster_yaml.hpp"
 #include "celc/cluster/dump.hpp"
+#include "celc/io/event_reader.hpp"
+#include "celc/io/window_source.hpp"
 #include "commands.hpp"
 
 namespace celc::app {
 namespace {
-
-// ---------------------------------------------------------------------------
-// TEMPORARY minimal reader for `t x y p` text files ('#' comments, CRLF
-// tolerated). To be replaced by the io module's event reader when it lands.
-std::vector<Event> readEventsTxtMinimal(const std::string& path, size_t max_events) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  std::vector<Event> events;
-  std::string line;
-  size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    const char* p = line.c_str();
-    char* end = nullptr;
-    double v[4];
-    for (int k = 0; k < 4; ++k) {
-      errno = 0;
-      v[k] = std::strtod(p, &end);
-      if (end == p || errno == ERANGE || !std::isfinite(v[k]))
-        throw std::runtime_error(path + ":" + std::to_string(line_no) +
-                                 ": expected 't x y p' (4 numbers), got '" + line.substr(0, 60) + "'");
-      p = end;
-    }
-    while (*p == ' ' || *p == '\t') ++p;
-    if (*p != '\0')
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": trailing text after 't x y p'");
-    if (v[1] < 0 || v[2] < 0 || v[1] > 65535 || v[2] > 65535 || (v[3] != 0 && v[3] != 1 && v[3] != -1))
-      throw std::runtime_error(path + ":" + std::to_string(line_no) +
-                               ": pixel out of range or polarity not 0/1/-1");
-    events.push_back({v[0], static_cast<float>(v[1]), static_cast<float>(v[2]), v[3] > 0});
-    if (max_events > 0 && events.size() >= max_events) break;
-  }
-  return events;
-}
-// ---------------------------------------------------------------------------
 
 struct ClusterArgs {
   std::string events;
@@ -100,16 +64,20 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   if (given("--max-plane-rms")) opt.max_plane_rms_px = a.max_plane_rms_px;
   if (const std::string err = opt.validate(); !err.empty())
     throw std::runtime_error("invalid clustering options: " + err);
-  const size_t limit = a.max_windows > 0 ? a.max_windows * a.window_events : 0;
-  const std::vector<Event> all = readEventsTxtMinimal(a.events, limit);
-  spdlog::info("{}: {} events", a.events, all.size());
+  // Any format the io module reads (text, AEDAT 2.0 / 3.1 / 4.0), window by window.
+  io::ReaderOptions ro;
+  ro.width = a.width;
+  ro.height = a.height;
+  const auto reader = io::openEventSource(a.events, ro);
+  io::WindowOptions wo;
+  wo.events_per_window = a.window_events;
+  io::WindowSource source(*reader, wo);
   if (!a.dump.empty()) std::filesystem::create_directories(a.dump);
   std::cout << "window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms\n";
-  size_t window = 0;
-  for (size_t b = 0; b < all.size(); b += a.window_events, ++window) {
+  io::EventWindow win;
+  for (size_t window = 0; source.next(win); ++window) {
     if (a.max_windows > 0 && window >= a.max_windows) break;
-    const size_t e = std::min(all.size(), b + a.window_events);
-    const std::vector<Event> ev(all.begin() + static_cast<long>(b), all.begin() + static_cast<long>(e));
+    const std::vector<Event>& ev = win.events;
     const ClusterResult r = clusterEvents(ev, opt);
     char row[256];
     std::snprintf(row, sizeof row, "%zu,%.6f,%.6f,%zu,%s,%.1f,%zu,%d,%.1f", window, ev.front().t,

@@ -1,5 +1,7 @@
 #include "celc/eval/run_tables.hpp"
 
+#include "celc/eval/statistics.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -39,19 +41,7 @@ double toDouble(const std::string& s, const std::string& where, const char* col)
   return v;
 }
 
-double median(std::vector<double> x) {
-  if (x.empty()) return NAN;
-  std::sort(x.begin(), x.end());
-  const size_t n = x.size();
-  return n % 2 ? x[n / 2] : 0.5 * (x[n / 2 - 1] + x[n / 2]);
-}
 
-double mean(const std::vector<double>& x) {
-  if (x.empty()) return NAN;
-  double s = 0;
-  for (double v : x) s += v;
-  return s / static_cast<double>(x.size());
-}
 
 std::string fmt(double x, int digits = 4) {
   if (!std::isfinite(x)) return "-";

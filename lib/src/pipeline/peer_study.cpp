@@ -1,5 +1,7 @@
 #include "celc/pipeline/peer_study.hpp"
 
+#include "celc/eval/statistics.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -86,18 +88,10 @@ std::string PeerStudyConfig::validate() const {
 
 namespace {
 
-double median(std::vector<double> x) {
-  if (x.empty()) return NAN;
-  const size_t n = x.size() / 2;
-  std::nth_element(x.begin(), x.begin() + static_cast<long>(n), x.end());
-  if (x.size() % 2) return x[n];
-  const double hi = x[n];
-  return 0.5 * (hi + *std::max_element(x.begin(), x.begin() + static_cast<long>(n)));
-}
+using eval::mean;
+using eval::median;
 
-double mean(const std::vector<double>& x) {
-  return x.empty() ? NAN : std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
-}
+
 
 std::uint32_t cellHash(const PeerCell& c) {
   std::ostringstream k;

@@ -1,5 +1,7 @@
 #include "celc/pipeline/simulation_study.hpp"
 
+#include "celc/eval/statistics.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -18,24 +20,10 @@ std::vector<double> range(double from, double to, double step) {
   return v;
 }
 
-double median(std::vector<double> x) {
-  if (x.empty()) return NAN;
-  const size_t n = x.size() / 2;
-  std::nth_element(x.begin(), x.begin() + static_cast<long>(n), x.end());
-  if (x.size() % 2) return x[n];
-  const double hi = x[n];
-  return 0.5 * (hi + *std::max_element(x.begin(), x.begin() + static_cast<long>(n)));
-}
 
-void meanStd(const std::vector<double>& x, double& mean, double& stdev) {
-  if (x.empty()) {
-    mean = stdev = NAN;
-    return;
-  }
-  mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
-  double ss = 0.0;
-  for (double v : x) ss += (v - mean) * (v - mean);
-  stdev = x.size() > 1 ? std::sqrt(ss / static_cast<double>(x.size() - 1)) : 0.0;
+void meanStd(const std::vector<double>& x, double& m, double& stdev) {
+  m = eval::mean(x);
+  stdev = eval::sampleStd(x);
 }
 
 }  // namespace
@@ -137,9 +125,9 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
       c.n_ok = static_cast<int>(phi.size());
       meanStd(eps, c.eps_mean, c.eps_std);
       meanStd(phi, c.phi_mean, c.phi_std);
-      c.phi_median = median(phi);
-      c.phi_median_sign_agnostic = median(agn);
-      c.time_median_us = median(time);
+      c.phi_median = eval::median(phi);
+      c.phi_median_sign_agnostic = eval::median(agn);
+      c.time_median_us = eval::median(time);
       cells.push_back(c);
     }
   }
