@@ -42,7 +42,7 @@ Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double
 struct NullspaceOptions {
   int max_iterations = 20;
   double huber_k = 1.345;
-  double tolerance = 1e-6;
+  double tolerance = 1e-4;
   int grid_directions = 0;   // hemisphere grid size (0 = no grid)
   int grid_starts = 2;       // IRLS runs from the best grid directions
   int grid_rows = 200;       // rows used to score the grid

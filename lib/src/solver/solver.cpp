@@ -308,7 +308,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
     const auto& cl = obs.clusters[c];
     const ClusterFrame fr = detail::makeClusterFrame(cl, motion);
     const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
-    const size_t stride = std::max<size_t>(1, cl.size() / 60);
+    const size_t stride = std::max<size_t>(1, cl.size() / 24);  // 24 votes per cluster
     long pos = 0, neg = 0;
     for (size_t k = 0; k < cl.size(); k += stride) {
       Mat3 Rk, Pk;
