@@ -60,6 +60,45 @@ double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::v
   return 1.4826 * medianAbs(r);
 }
 
+// The 6 distinct entries of a a^T and of N^T N (symmetric) of each row,
+// packed contiguously once, so an IRLS iteration is ~30 flops per row.
+struct Packed {
+  double a[3];
+  double aa[6];  // xx yy zz xy xz yz
+  double nn[6];
+};
+std::vector<Packed> pack(const std::vector<ConstraintRow>& rows) {
+  std::vector<Packed> P(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Vec3& a = rows[i].a;
+    const Mat3 NN = rows[i].N.transpose() * rows[i].N;
+    P[i] = {{a.x(), a.y(), a.z()},
+            {a.x() * a.x(), a.y() * a.y(), a.z() * a.z(), a.x() * a.y(), a.x() * a.z(), a.y() * a.z()},
+            {NN(0, 0), NN(1, 1), NN(2, 2), NN(0, 1), NN(0, 2), NN(1, 2)}};
+  }
+  return P;
+}
+double quad(const double* q, const Vec3& v) {
+  return q[0] * v.x() * v.x() + q[1] * v.y() * v.y() + q[2] * v.z() * v.z() +
+         2.0 * (q[3] * v.x() * v.y() + q[4] * v.x() * v.z() + q[5] * v.y() * v.z());
+}
+Mat3 unpack(const double* q) {
+  Mat3 M;
+  M << q[0], q[3], q[4], q[3], q[1], q[5], q[4], q[5], q[2];
+  return M;
+}
+// Robust scale of the geometric residuals at v from a strided sample of at
+// most 256 rows (relative standard error ~5%).
+double sampledScale(const std::vector<Packed>& P, const Vec3& v) {
+  const size_t stride = std::max<size_t>(1, P.size() / 256);
+  std::vector<double> r;
+  for (size_t i = 0; i < P.size(); i += stride) {
+    const double g = std::sqrt(std::max(0.0, quad(P[i].nn, v)));
+    r.push_back(g > 0.0 ? (P[i].a[0] * v.x() + P[i].a[1] * v.y() + P[i].a[2] * v.z()) / g : 1e300);
+  }
+  return 1.4826 * medianAbs(r);
+}
+
 // IRLS from a starting direction. Each step solves the generalised
 // eigenproblem (sum w_i a_i a_i^T) v = lambda (sum w_i N_i^T N_i) v with
 // w_i = Huber(r_i / scale) / |N_i v_prev|^2. A plain weighted eigenvector
@@ -67,16 +106,10 @@ double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::v
 // transferred lines collapse (|N v| -> 0 makes a.v -> 0 too); keeping the
 // weighted normaliser on the right-hand side penalises that collapse, and at a
 // fixed point lambda is the weighted squared geometric residual.
-NullspaceSolution irlsFrom(const std::vector<ConstraintRow>& rows, Vec3 v, int max_iterations,
+NullspaceSolution irlsFrom(const std::vector<Packed>& P, Vec3 v, int max_iterations,
                            double huber_k, double tolerance) {
   NullspaceSolution out;
-  const size_t n = rows.size();
-  // Per row, once: a a^T and N^T N (symmetric), so an iteration is O(1) per row.
-  std::vector<Mat3> AA(n), NN(n);
-  for (size_t i = 0; i < n; ++i) {
-    AA[i] = rows[i].a * rows[i].a.transpose();
-    NN[i] = rows[i].N.transpose() * rows[i].N;
-  }
+  const size_t n = P.size();
   // The MAD scale from a strided subset of at most 256 rows (its relative
   // standard error is ~5%, well inside what the Huber threshold needs).
   const size_t stride = std::max<size_t>(1, n / 256);
@@ -85,20 +118,23 @@ NullspaceSolution irlsFrom(const std::vector<ConstraintRow>& rows, Vec3 v, int m
   for (int it = 0; it < std::max(1, max_iterations); ++it) {
     sample.clear();
     for (size_t i = 0; i < n; ++i) {
-      g[i] = std::sqrt(std::max(0.0, v.dot(NN[i] * v)));
-      r[i] = g[i] > 0.0 ? rows[i].a.dot(v) / g[i] : 0.0;
+      g[i] = std::sqrt(std::max(0.0, quad(P[i].nn, v)));
+      r[i] = g[i] > 0.0 ? (P[i].a[0] * v.x() + P[i].a[1] * v.y() + P[i].a[2] * v.z()) / g[i] : 0.0;
       if (i % stride == 0) sample.push_back(r[i]);
     }
     const double scale = 1.4826 * medianAbs(sample);
     const double thr = huber_k * std::max(scale, 1e-15);
-    Mat3 Ma = Mat3::Zero(), Mn = Mat3::Zero();
+    double sa[6] = {0, 0, 0, 0, 0, 0}, sn[6] = {0, 0, 0, 0, 0, 0};
     for (size_t i = 0; i < n; ++i) {
       if (!(g[i] > 1e-300)) continue;
       const double huber = std::abs(r[i]) <= thr ? 1.0 : thr / std::abs(r[i]);
       const double w = huber / (g[i] * g[i]);
-      Ma.noalias() += w * AA[i];
-      Mn.noalias() += w * NN[i];
+      for (int k = 0; k < 6; ++k) {
+        sa[k] += w * P[i].aa[k];
+        sn[k] += w * P[i].nn[k];
+      }
     }
+    const Mat3 Ma = unpack(sa), Mn = unpack(sn);
     eig.compute(Ma, Mn);
     if (eig.info() != Eigen::Success) return out;
     Vec3 next = eig.eigenvectors().col(0).normalized();
@@ -113,7 +149,7 @@ NullspaceSolution irlsFrom(const std::vector<ConstraintRow>& rows, Vec3 v, int m
     if (delta < tolerance) break;
   }
   out.v = v;
-  out.scale = robustScale(rows, v, r);
+  out.scale = sampledScale(P, v);
   out.ok = v.allFinite() && v.norm() > 0.5;
   return out;
 }
@@ -137,11 +173,14 @@ NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
   std::vector<Vec3> starts;
   // Start 1: minimise sum (a_i.v)^2 / sum |N_i v|^2, the generalised eigenproblem
   // (sum a a^T) v = lambda (sum N^T N) v.
-  Mat3 Ma = Mat3::Zero(), Mn = Mat3::Zero();
-  for (const auto& row : rows) {
-    Ma.noalias() += row.a * row.a.transpose();
-    Mn.noalias() += row.N.transpose() * row.N;
-  }
+  const std::vector<Packed> P = pack(rows);
+  double sa[6] = {0, 0, 0, 0, 0, 0}, sn[6] = {0, 0, 0, 0, 0, 0};
+  for (const auto& p : P)
+    for (int k = 0; k < 6; ++k) {
+      sa[k] += p.aa[k];
+      sn[k] += p.nn[k];
+    }
+  const Mat3 Ma = unpack(sa), Mn = unpack(sn);
   Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> gen(Ma, Mn);
   if (gen.info() == Eigen::Success) starts.push_back(gen.eigenvectors().col(0).normalized());
   // Further starts: the best directions of a coarse grid over the hemisphere,
@@ -166,7 +205,7 @@ NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
   NullspaceSolution best;
   for (const Vec3& s : starts) {
     if (!s.allFinite()) continue;
-    NullspaceSolution sol = irlsFrom(rows, s, opt.max_iterations, opt.huber_k, opt.tolerance);
+    NullspaceSolution sol = irlsFrom(P, s, opt.max_iterations, opt.huber_k, opt.tolerance);
     if (sol.ok && (!best.ok || sol.scale < best.scale)) best = sol;
   }
   return best;
