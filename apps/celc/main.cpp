@@ -1,4 +1,5 @@
 // celc: event-camera linear velocity from the Continuous Event-Line Constraint.
+#include <glog/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -15,6 +16,10 @@ void configureLogging(bool quiet, bool verbose) {
 }  // namespace celc::app
 
 int main(int argc, char** argv) {
+  // Ceres logs through glog: its step-rejection warnings are not for users
+  // (a refinement that fails is reported as a status).
+  FLAGS_minloglevel = google::GLOG_ERROR;
+  FLAGS_logtostderr = true;
   auto logger = spdlog::stderr_color_mt("celc");
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
