@@ -227,15 +227,24 @@ bool validInput(const WindowObservations& obs, const MotionModel& motion, Solver
   return true;
 }
 
+// Options and inputs shared by every linear entry point; true (and `r` set)
+// when they cannot be used.
+bool rejectInput(const WindowObservations& obs, const MotionModel& motion,
+                 const LinearOptions& opt, SolverResult& r) {
+  if (const std::string err = opt.validate(); !err.empty()) {
+    r = fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
+    return true;
+  }
+  return !validInput(obs, motion, r);
+}
+
 }  // namespace
 
 SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& motion,
                              const LinearOptions& opt) {
   const auto start = Clock::now();
   SolverResult result;
-  if (const std::string err = opt.validate(); !err.empty())
-    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
-  if (!validInput(obs, motion, result)) return result;
+  if (rejectInput(obs, motion, opt, result)) return result;
   const std::vector<int> usable = detail::usableClusters(obs, opt.min_cluster_events);
   if (checkDegenerate(obs, motion, usable, opt, result)) {
     result.time_us = microsecondsSince(start);
@@ -265,9 +274,7 @@ SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion
                         const LinearOptions& opt) {
   const auto start = Clock::now();
   SolverResult result;
-  if (const std::string err = opt.validate(); !err.empty())
-    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
-  if (!validInput(obs, motion, result)) return result;
+  if (rejectInput(obs, motion, opt, result)) return result;
   std::vector<int> usable;
   for (int c : detail::usableClusters(obs, 0 + 2)) {
     const auto& cl = obs.clusters[c];
@@ -338,9 +345,7 @@ SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motio
                          const LinearOptions& opt) {
   const auto start = Clock::now();
   SolverResult result;
-  if (const std::string err = opt.validate(); !err.empty())
-    return fail(SolveStatus::InvalidInput, Degeneracy::None, "options: " + err);
-  if (!validInput(obs, motion, result)) return result;
+  if (rejectInput(obs, motion, opt, result)) return result;
   if (!checkDegenerate(obs, motion, detail::usableClusters(obs, opt.min_cluster_events), opt,
                        result))
     result.status = SolveStatus::Ok;
