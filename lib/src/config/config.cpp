@@ -95,6 +95,7 @@ void readScene(Section s, LineSceneOptions& o) {
   s.get("line_noise_px", o.line_noise_px);
   s.get("omega_noise", o.omega_noise);
   s.get("outlier_fraction", o.outlier_fraction);
+  s.get("edge_offset_px", o.edge_offset_px);
   s.getVec2("x_range", o.x_range);
   s.getVec2("y_range", o.y_range);
   s.getVec2("z_range", o.z_range);
@@ -180,7 +181,7 @@ std::string toYaml(const SimulateConfig& c) {
     << "  # [m/s]\n  omega: " << yamlList(s.omega) << "  # [rad/s]\n  event_noise_px: "
     << s.event_noise_px << "\n  line_noise_px: " << s.line_noise_px
     << "\n  omega_noise: " << s.omega_noise << "  # [rad/s]\n  outlier_fraction: "
-    << s.outlier_fraction << "\n  x_range: [" << s.x_range.x() << ", " << s.x_range.y()
+    << s.outlier_fraction << "\n  edge_offset_px: " << s.edge_offset_px << "  # [px]\n  x_range: [" << s.x_range.x() << ", " << s.x_range.y()
     << "]\n  y_range: [" << s.y_range.x() << ", " << s.y_range.y() << "]\n  z_range: ["
     << s.z_range.x() << ", " << s.z_range.y() << "]\n  motion_model: " << toString(s.motion)
     << "\n  omega_wobble: " << yamlList(s.omega_wobble) << "\n  gyro_rate_hz: " << s.gyro_rate_hz

@@ -15,6 +15,7 @@ std::string LineSceneOptions::validate() const {
   if (!(event_noise_px >= 0.0) || !(line_noise_px >= 0.0) || !(omega_noise >= 0.0))
     e << "noise levels must be >= 0; ";
   if (!(outlier_fraction >= 0.0 && outlier_fraction < 1.0)) e << "outlier_fraction must be in [0, 1); ";
+  if (!(edge_offset_px >= 0.0 && edge_offset_px < 100.0)) e << "edge_offset_px must be in [0, 100); ";
   if (!(x_range[1] >= x_range[0] && y_range[1] >= y_range[0] && z_range[1] >= z_range[0]))
     e << "ranges must be [min, max]; ";
   if (!(z_range[0] > 0.0)) e << "z_range must be in front of the camera (> 0); ";
@@ -87,6 +88,11 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
     c.l3 = noisyLine(seg, te);
     c.has_l2 = true;
   }
+  // Side of each line's edge offset (drawn only when there is one, so that
+  // the other draws do not depend on it).
+  std::vector<double> offset(static_cast<size_t>(n_lines), 0.0);
+  if (o.edge_offset_px > 0.0)
+    for (double& d : offset) d = u01(rng) < 0.5 ? -o.edge_offset_px : o.edge_offset_px;
   // Events: a random line, a random time, a random point on the segment.
   const int n_events = n_lines * o.events_per_line;
   struct Raw {
@@ -105,7 +111,12 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
     const int line = static_cast<int>(u01(rng) * n_lines) % n_lines;
     const auto& seg = trial.segments[static_cast<size_t>(line)];
     const double s = u01(rng);
-    const Vec2 px = pixelAt(seg[0] + s * (seg[1] - seg[0]), t) + Vec2(ev_noise(rng), ev_noise(rng));
+    Vec2 px = pixelAt(seg[0] + s * (seg[1] - seg[0]), t) + Vec2(ev_noise(rng), ev_noise(rng));
+    if (offset[static_cast<size_t>(line)] != 0.0) {
+      const Vec2 along = pixelAt(seg[1], t) - pixelAt(seg[0], t);
+      if (along.norm() > 0.0)
+        px += offset[static_cast<size_t>(line)] * Vec2(-along.y(), along.x()).normalized();
+    }
     raw.push_back({t, px, line});
   }
   std::sort(raw.begin(), raw.end(), [](const Raw& a, const Raw& b) { return a.t < b.t; });

@@ -29,6 +29,10 @@ struct LineSceneOptions {
   double line_noise_px = 2.0;         ///< std of line endpoint noise [px]
   double omega_noise = 0.0;           ///< std per axis of the angular velocity given to the solvers [rad/s]
   double outlier_fraction = 0.0;      ///< share of events replaced by uniform random pixels and times
+  /// Every event of a line moved this far along the line's image normal, to a
+  /// side drawn per line [px]: how real and rendered events sit off their edge
+  /// (they fire part-way up the blurred log-intensity ramp). 0 = on the line.
+  double edge_offset_px = 0.0;
   Vec2 x_range{-2.0, 2.0};            ///< segment endpoints x [m] (reference frame)
   Vec2 y_range{-2.0, 2.0};            ///< y [m]
   Vec2 z_range{3.0, 6.0};             ///< z (depth) [m]
