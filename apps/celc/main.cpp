@@ -16,10 +16,12 @@ void configureLogging(bool quiet, bool verbose) {
 }  // namespace celc::app
 
 int main(int argc, char** argv) {
-  // Ceres logs through glog: its step-rejection warnings are not for users
-  // (a refinement that fails is reported as a status).
-  FLAGS_minloglevel = google::GLOG_ERROR;
+  // Ceres logs through glog: its warnings and its "evaluation failed" errors
+  // are not for users (a refinement that fails is reported as a per-window
+  // status with Ceres' message); only fatal errors are printed.
+  FLAGS_minloglevel = google::GLOG_FATAL;
   FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
   auto logger = spdlog::stderr_color_mt("celc");
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
