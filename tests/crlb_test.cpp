@@ -104,3 +104,37 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
   EXPECT_GT(ratio, 0.75);
   EXPECT_LT(ratio, 1.35);
 }
+
+// celc_ml from extra hemisphere starts (SolverOptions::ml_grid_starts): on the
+// peer scene at parallax 0.125 (V = 1 m/s), 0.5 px, the single-start joint
+// refinement ends in a wrong basin in about a quarter of the trials
+// (docs/peers.md). With 16 more starts, keeping the lowest robust cost, the
+// cost never gets worse and the error spread shrinks (measured on these 24
+// trials: RMS 19.0 -> 10.7 deg, trials above 15 deg 4 -> 2; asserted: RMS
+// below 0.7x, no more trials above 15 deg).
+TEST(MultiStart, JointRefinementEscapesWrongBasins) {
+  std::mt19937_64 rng(11);
+  SolverOptions one, many;
+  many.ml_grid_starts = 16;
+  double ss_one = 0.0, ss_many = 0.0;
+  int far_one = 0, far_many = 0, n = 0;
+  for (int i = 0; i < 24; ++i) {
+    const PeerSceneTrial tr = scene(rng, 1.0, 0.5, 5, 200);
+    ASSERT_TRUE(tr.ok) << tr.message;
+    const SolverResult a = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, one)[0];
+    const SolverResult b = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, many)[0];
+    if (!a.ok() || !b.ok()) continue;
+    ++n;
+    // The multi-start keeps the single start's end point unless one costs less.
+    EXPECT_LE(b.residual_px, a.residual_px * (1.0 + 1e-9)) << "trial " << i;
+    const double pa = angleBetweenSignAgnostic(a.v, tr.true_direction) * 180.0 / M_PI;
+    const double pb = angleBetweenSignAgnostic(b.v, tr.true_direction) * 180.0 / M_PI;
+    ss_one += pa * pa;
+    ss_many += pb * pb;
+    far_one += pa > 15.0;
+    far_many += pb > 15.0;
+  }
+  ASSERT_GE(n, 20);
+  EXPECT_LT(std::sqrt(ss_many / n), 0.7 * std::sqrt(ss_one / n));
+  EXPECT_LE(far_many, far_one);
+}

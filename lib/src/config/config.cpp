@@ -38,6 +38,7 @@ void readSolverSection(Section s, SolverOptions& o) {
   r.get("function_tolerance", o.refine.function_tolerance);
   r.get("num_threads", o.refine.num_threads);
   r.finish();
+  s.get("ml_grid_starts", o.ml_grid_starts);
   s.finish();
 }
 
@@ -70,7 +71,8 @@ std::string solverYaml(const SolverOptions& o, const std::string& in) {
     << in << "    balance_clusters: " << (r.balance_clusters ? "true" : "false") << "\n"
     << in << "    seed: " << r.seed << "\n"
     << in << "    function_tolerance: " << r.function_tolerance << "\n"
-    << in << "    num_threads: " << r.num_threads << "\n";
+    << in << "    num_threads: " << r.num_threads << "\n"
+    << in << "  ml_grid_starts: " << o.ml_grid_starts << "\n";
   return y.str();
 }
 

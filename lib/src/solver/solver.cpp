@@ -107,6 +107,7 @@ std::string SolverOptions::validate() const {
   std::string e = linear.validate() + refine.validate() + npt.validate();
   if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
   if (!(ml_second_start_max_twist >= 0.0)) e += "ml_second_start_max_twist must be >= 0; ";
+  if (ml_grid_starts < 0 || ml_grid_starts > 10000) e += "ml_grid_starts must be in [0, 10000]; ";
   return e;
 }
 
@@ -353,6 +354,65 @@ SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motio
   return result;
 }
 
+namespace {
+// celc_ml: the joint refinement from several starts, keeping the end point of
+// lowest robust cost (the joint problem has several minima, docs/peers.md).
+// Starts: the CELC linear estimate; npt's (when given); ml_grid_starts
+// directions of a hemisphere lattice. A start within ml_second_start_deg of
+// an end point already found is skipped (same basin). The winner keeps its
+// start's singular values and sign margin; a lattice start's sign is resolved
+// by cheirality.
+SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionModel& motion,
+                                   const SolverResult& linear, const SolverResult* npt,
+                                   const SolverOptions& options) {
+  struct Start {
+    Vec3 v;
+    const SolverResult* from;  // null: a lattice direction
+  };
+  std::vector<Start> starts;
+  if (linear.ok()) starts.push_back({linear.v, &linear});
+  if (npt && npt->ok()) starts.push_back({npt->v, npt});
+  if (starts.empty()) return linear;  // neither start: the linear stage's status
+  for (const Vec3& d : detail::hemisphereDirections(options.ml_grid_starts)) starts.push_back({d, nullptr});
+  double time_us = linear.time_us + (npt ? npt->time_us : 0.0);
+  SolverResult best;
+  const SolverResult* best_from = nullptr;
+  bool have = false;
+  std::vector<Vec3> ends;
+  for (const Start& s : starts) {
+    bool seen = false;
+    for (const Vec3& e : ends)
+      seen = seen || angleBetweenSignAgnostic(s.v, e) * 180.0 / M_PI < options.ml_second_start_deg;
+    if (seen) continue;
+    SolverResult r = refineVelocity(obs, motion, s.v, true, options.refine);
+    time_us += r.time_us;
+    if (!r.ok()) continue;
+    ends.push_back(r.v);
+    if (!have || r.residual_px < best.residual_px) {
+      best = r;
+      best_from = s.from;
+      have = true;
+    }
+  }
+  if (!have) return linear.ok() ? linear : *npt;
+  if (best_from) {
+    best.sigma_min = best_from->sigma_min;
+    best.sigma_second = best_from->sigma_second;
+    best.sign_margin = best_from->sign_margin;
+  } else {
+    best.sigma_min = linear.sigma_min;
+    best.sigma_second = linear.sigma_second;
+    if (options.linear.resolve_sign) {
+      const SignDecision sd = resolveSign(obs, motion, best.v);
+      best.v *= sd.sign;
+      best.sign_margin = sd.margin * sd.sign;
+    }
+  }
+  best.time_us = time_us;
+  return best;
+}
+}  // namespace
+
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options_in) {
@@ -393,47 +453,10 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Ce3lc: out.push_back(solveCe3lc(obs, motion, options.linear)); break;
       case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcMl: {
-        const SolverResult& init = getLinear();
-        if (!options.ml_second_start || !nptModelHolds(obs, motion, options.ml_second_start_max_twist)) {
-          if (!init.ok()) {
-            out.push_back(init);
-            break;
-          }
-          SolverResult r = refineVelocity(obs, motion, init.v, true, options.refine);
-          r.time_us += init.time_us;
-          r.sigma_min = init.sigma_min;
-          r.sigma_second = init.sigma_second;
-          r.sign_margin = init.sign_margin;
-          out.push_back(r);
-          break;
-        }
-        const SolverResult& second = getNpt();
-        if (!init.ok() && !second.ok()) {
-          out.push_back(init);
-          break;
-        }
-        SolverResult best;
-        bool have = false;
-        double time_us = init.time_us + second.time_us;
-        for (const SolverResult* start : {&init, &second}) {
-          if (!start->ok()) continue;
-          if (have && angleBetweenSignAgnostic(start->v, best.v) * 180.0 / M_PI <
-                          options.ml_second_start_deg)
-            continue;  // same basin as the result so far
-          SolverResult r = refineVelocity(obs, motion, start->v, true, options.refine);
-          time_us += r.time_us;
-          if (!r.ok()) continue;
-          if (!have || r.residual_px < best.residual_px) {
-            best = r;
-            best.sigma_min = start->sigma_min;
-            best.sigma_second = start->sigma_second;
-            best.sign_margin = start->sign_margin;
-          }
-          have = true;
-        }
-        if (!have) best = init.ok() ? init : second;
-        if (have) best.time_us = time_us;
-        out.push_back(best);
+        const bool npt_start =
+            options.ml_second_start && nptModelHolds(obs, motion, options.ml_second_start_max_twist);
+        out.push_back(solveCelcMlMultiStart(obs, motion, getLinear(),
+                                            npt_start ? &getNpt() : nullptr, options));
         break;
       }
       case Method::CelcOpt: {

@@ -36,14 +36,17 @@ struct RunConfig {
   io::GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;
-  /// The solvers' defaults, except the linear stage's global start: on
-  /// clustered real or rendered events the robust cost has local minima that
-  /// the plain IRLS start falls into (measured on simulated rooms: celc_ml
-  /// median 0.70 rad without, 0.009 rad with; docs/results.md).
+  /// The solvers' defaults, except the global starts: on clustered real or
+  /// rendered events the linear stage's robust cost and the joint refinement
+  /// both have local minima that a single start falls into (measured on
+  /// simulated rooms, docs/synth.md: celc_ml median 0.70 rad without the
+  /// linear lattice, 0.009 rad with it; 0.80 rad without the refinement's
+  /// lattice on 0.15 s windows, 0.059 rad with it).
   SolverOptions solver = [] {
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
+    s.ml_grid_starts = 8;
     return s;
   }();
   std::vector<Method> methods = allMethods();

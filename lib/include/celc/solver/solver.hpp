@@ -128,6 +128,10 @@ struct SolverOptions {
   bool ml_second_start = true;
   double ml_second_start_max_twist = 0.02;
   double ml_second_start_deg = 2.0;  ///< [deg]
+  /// celc_ml also starts from this many directions of a hemisphere lattice
+  /// (0 = off) and keeps the end point of lowest robust cost; each start costs
+  /// one joint refinement.
+  int ml_grid_starts = 0;
   std::string validate() const;
 };
 
