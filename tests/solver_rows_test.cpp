@@ -68,3 +68,65 @@ TEST(GeneralizedEigen3, RejectsIndefiniteB) {
   EXPECT_FALSE(detail::generalizedEigen3(Mat3::Identity(), B, values, vectors));
   EXPECT_FALSE(detail::generalizedEigen3(Mat3::Identity(), Mat3::Zero(), values, vectors));
 }
+
+namespace {
+// The sign test counting every vote (24 per cluster), as resolveSign did
+// before it stopped counting once a cluster's majority is decided.
+SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionModel& motion,
+                                 const Vec3& v) {
+  int votes = 0, voters = 0;
+  long event_balance = 0;
+  for (int c : detail::usableClusters(obs, 2)) {
+    const auto& cl = obs.clusters[c];
+    const auto fr = detail::makeClusterFrame(cl, motion);
+    const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
+    const size_t stride = std::max<size_t>(1, cl.size() / 24);
+    long pos = 0, neg = 0;
+    for (size_t k = 0; k < cl.size(); k += stride) {
+      Mat3 Rk, Pk;
+      motion.pose(cl.times[k], Rk, Pk);
+      const Vec3 fp = Rk * cl.bearings[k], pk = Pk * v;
+      const double a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
+      const double den = a1 * a1 + a3 * a3;
+      if (!(den > 1e-24)) continue;
+      const double lambda = (a1 * fr.m1.dot(ps - pk) + a3 * fr.m3.dot(pe - pk)) / den;
+      if (lambda > 0) ++pos;
+      else if (lambda < 0) ++neg;
+    }
+    if (pos == neg) continue;
+    ++voters;
+    votes += pos > neg ? 1 : -1;
+    event_balance += pos - neg;
+  }
+  SignDecision d;
+  if (voters == 0) return d;
+  d.margin = static_cast<double>(votes) / voters;
+  d.sign = votes > 0 || (votes == 0 && event_balance >= 0) ? 1 : -1;
+  return d;
+}
+}  // namespace
+
+// The sequential sign test decides exactly as counting every vote: for the
+// true direction, its opposite and random directions (mixed votes, ties), on
+// scenes with 2 to 6 lines (even numbers of voters can tie).
+TEST(SignTest, SequentialCountMatchesFullCount) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int ties = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    LineSceneOptions o;
+    o.n_lines = 2 + trial % 5;
+    o.events_per_line = 20 + 30 * (trial % 4);
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    std::vector<Vec3> dirs{tr.true_direction, -tr.true_direction};
+    for (int k = 0; k < 8; ++k) dirs.push_back(Vec3(n(rng), n(rng), n(rng)).normalized());
+    for (const Vec3& v : dirs) {
+      const SignDecision a = resolveSign(tr.observations, tr.given_motion, v);
+      const SignDecision b = resolveSignAllVotes(tr.observations, tr.given_motion, v);
+      EXPECT_EQ(a.sign, b.sign) << "trial " << trial;
+      EXPECT_EQ(a.margin, b.margin) << "trial " << trial;
+      if (b.margin == 0.0) ++ties;
+    }
+  }
+  EXPECT_GT(ties, 0);  // the tie-break by event balance was exercised
+}
