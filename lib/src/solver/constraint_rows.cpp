@@ -31,6 +31,8 @@ Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double
   return transferFromP(frame, motion.positionMatrix(t));
 }
 
+Mat3 transferMatrix(const ClusterFrame& frame, const Mat3& P) { return transferFromP(frame, P); }
+
 ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, double t,
                       const Vec3& f) {
   Mat3 Rk, Pk;

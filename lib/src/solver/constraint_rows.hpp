@@ -34,6 +34,8 @@ ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, doub
 
 /// B_ref at time t (reference frame): l_ref(t) = B_ref v.
 Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double t);
+/// The same from P(t) (when the pose at t is at hand).
+Mat3 transferMatrix(const ClusterFrame& frame, const Mat3& P);
 
 /// The symmetric-definite generalised eigenproblem A x = lambda B x in closed
 /// form (A symmetric, B symmetric positive definite): B = L L^T (Cholesky),

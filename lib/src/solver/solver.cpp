@@ -165,9 +165,25 @@ bool checkDegenerate(const WindowObservations& obs, const MotionModel& motion,
   return false;
 }
 
+// Cluster frames a solver has already computed, by cluster index, for the
+// sign test to reuse (an empty cache: compute every frame).
+struct FrameCache {
+  std::vector<ClusterFrame> frames;
+  std::vector<char> have;
+  explicit FrameCache(size_t clusters = 0) : frames(clusters), have(clusters, 0) {}
+  void put(size_t c, const ClusterFrame& f) {
+    frames[c] = f;
+    have[c] = 1;
+  }
+  const ClusterFrame* get(size_t c) const { return c < have.size() && have[c] ? &frames[c] : nullptr; }
+};
+SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel& motion,
+                               const Vec3& v, const FrameCache& cache);
+
 // Fills the result from a nullspace solution: degeneracy by singular values, sign.
 SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservations& obs,
-                    const MotionModel& motion, const LinearOptions& opt, int rows) {
+                    const MotionModel& motion, const LinearOptions& opt, int rows,
+                    const FrameCache& cache = FrameCache()) {
   if (!ns.ok) return fail(SolveStatus::Failed, Degeneracy::None, "robust nullspace did not converge");
   SolverResult r;
   r.sigma_min = ns.sigma_min;
@@ -184,7 +200,7 @@ SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservation
   }
   r.v = ns.v.normalized();
   if (opt.resolve_sign) {
-    const SignDecision s = resolveSign(obs, motion, r.v);
+    const SignDecision s = resolveSignCached(obs, motion, r.v, cache);
     r.v *= s.sign;
     r.sign_margin = s.margin * s.sign;
   }
@@ -288,11 +304,15 @@ SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion
   // [m2]_x B_ref v = 0, three rows (rank two), each normalised by |B_ref v|.
   std::vector<ConstraintRow> rows;
   rows.reserve(3 * usable.size());
+  FrameCache cache(obs.clusters.size());
   for (int c : usable) {
     const auto& cl = obs.clusters[c];
     const ClusterFrame frame = detail::makeClusterFrame(cl, motion);
-    const Mat3 B = detail::transferMatrix(frame, motion, cl.l2.t);
-    const Vec3 m2 = (motion.rotation(cl.l2.t) * cl.l2.normal).normalized();
+    cache.put(static_cast<size_t>(c), frame);
+    Mat3 R2, P2;
+    motion.pose(cl.l2.t, R2, P2);
+    const Mat3 B = detail::transferMatrix(frame, P2);
+    const Vec3 m2 = (R2 * cl.l2.normal).normalized();
     Mat3 m2x;
     m2x << 0, -m2.z(), m2.y(), m2.z(), 0, -m2.x(), -m2.y(), m2.x(), 0;
     const Mat3 C = m2x * B;
@@ -301,7 +321,7 @@ SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion
   detail::NullspaceOptions nopt = nullspaceOptions(opt);
   nopt.closed_form_eigen = true;  // 15 rows: the 3x3 eigen solves are much of the cost
   const auto ns = detail::robustNullspace(rows, nopt);
-  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));
+  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()), cache);
   result.time_us = microsecondsSince(start);
   return result;
 }
@@ -335,9 +355,8 @@ struct SignVotes {
     }
   }
 };
-}  // namespace
-
-SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v) {
+SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel& motion,
+                               const Vec3& v, const FrameCache& cache) {
   // Depth of event k along its ray from the camera at t_k, where the ray meets
   // the planes of l1 and l3 (least squares over both planes):
   //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
@@ -349,7 +368,8 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   for (int c : detail::usableClusters(obs, 2)) {
     SignVotes s;
     s.cl = &obs.clusters[c];
-    s.fr = detail::makeClusterFrame(*s.cl, motion);
+    const ClusterFrame* cached = cache.get(static_cast<size_t>(c));
+    s.fr = cached ? *cached : detail::makeClusterFrame(*s.cl, motion);
     s.ps = s.fr.Ps * v;
     s.pe = s.fr.Pe * v;
     s.stride = std::max<size_t>(1, s.cl->size() / 24);  // 24 votes per cluster
@@ -376,6 +396,11 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   }
   d.sign = event_balance >= 0 ? 1 : -1;
   return d;
+}
+}  // namespace
+
+SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v) {
+  return resolveSignCached(obs, motion, v, FrameCache());
 }
 
 SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motion,
