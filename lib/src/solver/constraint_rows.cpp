@@ -218,9 +218,9 @@ void huberWeights(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, double th
 // weighted normaliser on the right-hand side penalises that collapse, and at a
 // fixed point lambda is the weighted squared geometric residual.
 //
-// Per row, with d = a.v and g2 = |N v|^2 (r = d / sqrt(g2)):
-//   inlier (d^2 <= thr^2 g2):  w = 1 / g2,  else  w = thr / sqrt(d^2 g2),
-// the Huber weight divided by |N v|^2 without a square root for the inliers.
+// An iteration is a few passes over the packed columns: d = a.v and
+// g2 = |N v|^2 (matrix-vector products), the weights from them (huberWeights)
+// and the weighted sums (one transposed product); the scale from a sample.
 NullspaceSolution irlsFrom(const Packed& P, Vec3 v, const NullspaceOptions& opt) {
   NullspaceSolution out;
   const Eigen::Index n = P.rows();
