@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <unordered_set>
 
@@ -10,10 +11,11 @@ namespace celc::detail {
 
 ClusterFrame makeClusterFrame(const ClusterObservation& c, const MotionModel& motion) {
   ClusterFrame f;
-  f.m1 = motion.rotation(c.l1.t) * c.l1.normal;
-  f.m3 = motion.rotation(c.l3.t) * c.l3.normal;
-  f.Ps = motion.positionMatrix(c.l1.t);
-  f.Pe = motion.positionMatrix(c.l3.t);
+  Mat3 R1, R3;
+  motion.pose(c.l1.t, R1, f.Ps);
+  motion.pose(c.l3.t, R3, f.Pe);
+  f.m1 = R1 * c.l1.normal;
+  f.m3 = R3 * c.l3.normal;
   return f;
 }
 
@@ -28,6 +30,8 @@ Mat3 transferFromP(const ClusterFrame& frame, const Mat3& Pk) {
 Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double t) {
   return transferFromP(frame, motion.positionMatrix(t));
 }
+
+Mat3 transferMatrix(const ClusterFrame& frame, const Mat3& P) { return transferFromP(frame, P); }
 
 ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, double t,
                       const Vec3& f) {
@@ -50,6 +54,77 @@ double medianAbs(std::vector<double>& x) {
 }
 
 namespace {
+// Polishes an eigen-decomposition C ~ Y diag(d) Y^T of a symmetric 3x3 C by
+// cyclic Jacobi sweeps on D = Y^T C Y until D is diagonal to rounding. Eigen's
+// closed-form computeDirect is fast but loses digits on a small eigenvalue's
+// eigenvector (errors ~1e-5 rad when it is 1e-8 of the largest); from its
+// nearly diagonal D one sweep, rarely two, restores full accuracy.
+void jacobiPolish(const Mat3& C, Mat3& Y, Vec3& d) {
+  Mat3 D = Y.transpose() * C * Y;
+  const double tiny = 1e-18 * D.cwiseAbs().maxCoeff();
+  for (int sweep = 0; sweep < 6; ++sweep) {
+    bool rotated = false;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        const double apq = D(p, q);
+        if (!(std::abs(apq) > tiny)) continue;
+        rotated = true;
+        // Rotation in the (p, q) plane that zeroes D(p, q):
+        // t = tan(angle), the smaller root of t^2 + 2 theta t - 1 = 0.
+        const double theta = (D(q, q) - D(p, p)) / (2.0 * apq);
+        const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        Mat3 J = Mat3::Identity();
+        J(p, p) = c, J(q, q) = c, J(p, q) = s, J(q, p) = -s;
+        D = (J.transpose() * D * J).eval();
+        D(p, q) = D(q, p) = 0.0;
+        Y = (Y * J).eval();
+      }
+    if (!rotated) break;
+  }
+  d = D.diagonal();
+}
+}  // namespace
+
+bool generalizedEigen3(const Mat3& A, const Mat3& B, Vec3& values, Mat3& vectors) {
+  // B = L L^T, L lower triangular with a positive diagonal.
+  const double l00s = B(0, 0);
+  if (!(l00s > 0.0)) return false;
+  const double l00 = std::sqrt(l00s), l10 = B(1, 0) / l00, l20 = B(2, 0) / l00;
+  const double l11s = B(1, 1) - l10 * l10;
+  if (!(l11s > 0.0)) return false;
+  const double l11 = std::sqrt(l11s), l21 = (B(2, 1) - l20 * l10) / l11;
+  const double l22s = B(2, 2) - l20 * l20 - l21 * l21;
+  if (!(l22s > 0.0)) return false;
+  const double l22 = std::sqrt(l22s);
+  // L^-1 by forward substitution; C = L^-1 A L^-T is symmetric with the same
+  // eigenvalues, and its eigenvectors y give x = L^-T y (x^T B x = y^T y = 1).
+  Mat3 Linv = Mat3::Zero();
+  Linv(0, 0) = 1.0 / l00;
+  Linv(1, 1) = 1.0 / l11;
+  Linv(2, 2) = 1.0 / l22;
+  Linv(1, 0) = -l10 * Linv(0, 0) / l11;
+  Linv(2, 1) = -l21 * Linv(1, 1) / l22;
+  Linv(2, 0) = -(l20 * Linv(0, 0) + l21 * Linv(1, 0)) / l22;
+  Mat3 C = Linv * A * Linv.transpose();
+  C = 0.5 * (C + C.transpose()).eval();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(C);
+  if (eig.info() != Eigen::Success || !C.allFinite()) return false;
+  Mat3 Y = eig.eigenvectors();
+  Vec3 d;
+  jacobiPolish(C, Y, d);
+  // Ascending order.
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int i, int j) { return d(i) < d(j); });
+  for (int i = 0; i < 3; ++i) {
+    values(i) = d(order[i]);
+    vectors.col(i) = Linv.transpose() * Y.col(order[i]);
+  }
+  return values.allFinite() && vectors.allFinite();
+}
+
+namespace {
 // Robust geometric cost of v: 1.4826 * median |a_i.v / |N_i v||.
 double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::vector<double>& r) {
   r.resize(rows.size());
@@ -60,43 +135,79 @@ double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::v
   return 1.4826 * medianAbs(r);
 }
 
-// The 6 distinct entries of a a^T and of N^T N (symmetric) of each row,
-// packed contiguously once, so an IRLS iteration is ~30 flops per row.
-struct Packed {
-  double a[3];
-  double aa[6];  // xx yy zz xy xz yz
-  double nn[6];
-};
-std::vector<Packed> pack(const std::vector<ConstraintRow>& rows) {
-  std::vector<Packed> P(rows.size());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Vec3& a = rows[i].a;
-    const Mat3 NN = rows[i].N.transpose() * rows[i].N;
-    P[i] = {{a.x(), a.y(), a.z()},
-            {a.x() * a.x(), a.y() * a.y(), a.z() * a.z(), a.x() * a.y(), a.x() * a.z(), a.y() * a.z()},
-            {NN(0, 0), NN(1, 1), NN(2, 2), NN(0, 1), NN(0, 2), NN(1, 2)}};
+// The rows packed once as structure of arrays: column j holds, for every row,
+// a (j = 0..2), the 6 distinct entries of a a^T (3..8: xx yy zz xy xz yz) and
+// those of N^T N (9..14, same order). Column-major, so every per-row pass of
+// an IRLS iteration is a few matrix-vector products over contiguous columns.
+using Packed = Eigen::Matrix<double, Eigen::Dynamic, 15>;
+using Sums = Eigen::Matrix<double, 12, 1>;  // sum of w a a^T (0..5) and of w N^T N (6..11)
+
+Packed pack(const std::vector<ConstraintRow>& rows) {
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  Packed P(n, 15);
+  double* c[15];
+  for (int j = 0; j < 15; ++j) c[j] = P.col(j).data();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vec3& a = rows[static_cast<size_t>(i)].a;
+    const Mat3& N = rows[static_cast<size_t>(i)].N;
+    c[0][i] = a.x(), c[1][i] = a.y(), c[2][i] = a.z();
+    c[3][i] = a.x() * a.x(), c[4][i] = a.y() * a.y(), c[5][i] = a.z() * a.z();
+    c[6][i] = a.x() * a.y(), c[7][i] = a.x() * a.z(), c[8][i] = a.y() * a.z();
+    c[9][i] = N.col(0).squaredNorm(), c[10][i] = N.col(1).squaredNorm(), c[11][i] = N.col(2).squaredNorm();
+    c[12][i] = N.col(0).dot(N.col(1)), c[13][i] = N.col(0).dot(N.col(2)), c[14][i] = N.col(1).dot(N.col(2));
   }
   return P;
 }
-double quad(const double* q, const Vec3& v) {
-  return q[0] * v.x() * v.x() + q[1] * v.y() * v.y() + q[2] * v.z() * v.z() +
-         2.0 * (q[3] * v.x() * v.y() + q[4] * v.x() * v.z() + q[5] * v.y() * v.z());
+// q(v) such that the packed symmetric entries s give v^T S v = s . q(v).
+Eigen::Matrix<double, 6, 1> quadWeights(const Vec3& v) {
+  Eigen::Matrix<double, 6, 1> q;
+  q << v.x() * v.x(), v.y() * v.y(), v.z() * v.z(), 2.0 * v.x() * v.y(), 2.0 * v.x() * v.z(),
+      2.0 * v.y() * v.z();
+  return q;
 }
 Mat3 unpack(const double* q) {
   Mat3 M;
   M << q[0], q[3], q[4], q[3], q[1], q[5], q[4], q[5], q[2];
   return M;
 }
-// Robust scale of the geometric residuals at v from a strided sample of at
-// most 256 rows (relative standard error ~5%).
-double sampledScale(const std::vector<Packed>& P, const Vec3& v) {
-  const size_t stride = std::max<size_t>(1, P.size() / 256);
-  std::vector<double> r;
-  for (size_t i = 0; i < P.size(); i += stride) {
-    const double g = std::sqrt(std::max(0.0, quad(P[i].nn, v)));
-    r.push_back(g > 0.0 ? (P[i].a[0] * v.x() + P[i].a[1] * v.y() + P[i].a[2] * v.z()) / g : 1e300);
-  }
-  return 1.4826 * medianAbs(r);
+// The MAD scale 1.4826 * median |r| of r = a.v / |N v| over every stride-th
+// row, from d = a.v and g2 = |N v|^2 (median of r^2: no square root per row).
+// Rows with |N v| = 0 count as r = r_degenerate.
+double sampledMad(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, size_t stride,
+                  double r_degenerate, std::vector<double>& r2) {
+  const double r2_degenerate = std::min(r_degenerate * r_degenerate, std::numeric_limits<double>::max());
+  r2.clear();
+  for (Eigen::Index i = 0; i < d.size(); i += static_cast<Eigen::Index>(stride))
+    r2.push_back(g2[i] > 0.0 ? d[i] * d[i] / g2[i] : r2_degenerate);
+  if (r2.empty()) return 0.0;
+  auto mid = r2.begin() + static_cast<long>(r2.size() / 2);
+  std::nth_element(r2.begin(), mid, r2.end());
+  return 1.4826 * (*mid == r2_degenerate ? r_degenerate : std::sqrt(*mid));
+}
+// The MAD scale from a strided subset of at most 256 rows (its relative
+// standard error is ~5%, well inside what the Huber threshold needs).
+size_t madStride(Eigen::Index n) { return std::max<size_t>(1, static_cast<size_t>(n) / 256); }
+
+// The generalised eigenproblem in closed form or by Eigen's iterative solver.
+bool generalizedEigen(const Mat3& A, const Mat3& B, bool closed_form, Vec3& values, Mat3& vectors) {
+  if (closed_form) return generalizedEigen3(A, B, values, vectors);
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> eig(A, B);
+  if (eig.info() != Eigen::Success) return false;
+  values = eig.eigenvalues();
+  vectors = eig.eigenvectors();
+  return true;
+}
+
+// Huber weight over |N v|^2 of every row, from d = a.v and g2 = |N v|^2:
+// min(1, thr / |r|) / g2 = min(1 / g2, thr / sqrt(d^2 g2)) (r = d / sqrt(g2)),
+// branch-free so that it vectorises; rows with |N v| = 0 get no weight.
+void huberWeights(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, double thr,
+                  Eigen::VectorXd& w) {
+  const auto g = g2.array();
+  w.array() = g.inverse().min(thr * (d.array().square() * g).sqrt().inverse());
+  if (!(g.minCoeff() > 0.0))
+    for (Eigen::Index i = 0; i < w.size(); ++i)
+      if (!(g[i] > 0.0)) w[i] = 0.0;
 }
 
 // IRLS from a starting direction. Each step solves the generalised
@@ -106,50 +217,44 @@ double sampledScale(const std::vector<Packed>& P, const Vec3& v) {
 // transferred lines collapse (|N v| -> 0 makes a.v -> 0 too); keeping the
 // weighted normaliser on the right-hand side penalises that collapse, and at a
 // fixed point lambda is the weighted squared geometric residual.
-NullspaceSolution irlsFrom(const std::vector<Packed>& P, Vec3 v, int max_iterations,
-                           double huber_k, double tolerance) {
+//
+// An iteration is a few passes over the packed columns: d = a.v and
+// g2 = |N v|^2 (matrix-vector products), the weights from them (huberWeights)
+// and the weighted sums (one transposed product); the scale from a sample.
+NullspaceSolution irlsFrom(const Packed& P, Vec3 v, const NullspaceOptions& opt) {
   NullspaceSolution out;
-  const size_t n = P.size();
-  // The MAD scale from a strided subset of at most 256 rows (its relative
-  // standard error is ~5%, well inside what the Huber threshold needs).
-  const size_t stride = std::max<size_t>(1, n / 256);
-  std::vector<double> r(n), g(n), sample;
-  Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> eig;
-  for (int it = 0; it < std::max(1, max_iterations); ++it) {
-    sample.clear();
-    for (size_t i = 0; i < n; ++i) {
-      g[i] = std::sqrt(std::max(0.0, quad(P[i].nn, v)));
-      r[i] = g[i] > 0.0 ? (P[i].a[0] * v.x() + P[i].a[1] * v.y() + P[i].a[2] * v.z()) / g[i] : 0.0;
-      if (i % stride == 0) sample.push_back(r[i]);
-    }
-    const double scale = 1.4826 * medianAbs(sample);
-    const double thr = huber_k * std::max(scale, 1e-15);
-    double sa[6] = {0, 0, 0, 0, 0, 0}, sn[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t i = 0; i < n; ++i) {
-      if (!(g[i] > 1e-300)) continue;
-      const double huber = std::abs(r[i]) <= thr ? 1.0 : thr / std::abs(r[i]);
-      const double w = huber / (g[i] * g[i]);
-      for (int k = 0; k < 6; ++k) {
-        sa[k] += w * P[i].aa[k];
-        sn[k] += w * P[i].nn[k];
-      }
-    }
-    const Mat3 Ma = unpack(sa), Mn = unpack(sn);
-    eig.compute(Ma, Mn);
-    if (eig.info() != Eigen::Success) return out;
-    Vec3 next = eig.eigenvectors().col(0).normalized();
+  const Eigen::Index n = P.rows();
+  const size_t stride = madStride(n);
+  Eigen::VectorXd d(n), g2(n), w(n);
+  std::vector<double> sample;
+  sample.reserve(static_cast<size_t>(n / static_cast<Eigen::Index>(stride)) + 1);
+  Vec3 lambda;
+  Mat3 X;
+  for (int it = 0; it < std::max(1, opt.max_iterations); ++it) {
+    d.noalias() = P.leftCols<3>() * v;
+    g2.noalias() = P.rightCols<6>() * quadWeights(v);
+    const double scale = sampledMad(d, g2, stride, 0.0, sample);
+    const double thr = opt.huber_k * std::max(scale, 1e-15);
+    huberWeights(d, g2, thr, w);
+    const Sums s = P.rightCols<12>().transpose() * w;
+    const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
+    if (!generalizedEigen(Ma, Mn, opt.closed_form_eigen, lambda, X)) return out;
+    Vec3 next = X.col(0).normalized();
     if (next.dot(v) < 0.0) next = -next;
     // Singular values of the normalised system: sqrt of the generalised
     // eigenvalues, the weighted RMS geometric residual along each direction.
-    out.sigma_min = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
-    out.sigma_second = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+    out.sigma_min = std::sqrt(std::max(0.0, lambda(0)));
+    out.sigma_second = std::sqrt(std::max(0.0, lambda(1)));
     out.iterations = it + 1;
     const double delta = std::acos(std::min(1.0, next.dot(v)));
     v = next;
-    if (delta < tolerance) break;
+    if (delta < opt.tolerance) break;
   }
   out.v = v;
-  out.scale = sampledScale(P, v);
+  // Robust scale at the end point (rows with |N v| = 0 count as outliers).
+  d.noalias() = P.leftCols<3>() * v;
+  g2.noalias() = P.rightCols<6>() * quadWeights(v);
+  out.scale = sampledMad(d, g2, stride, 1e300, sample);
   out.ok = v.allFinite() && v.norm() > 0.5;
   return out;
 }
@@ -173,16 +278,12 @@ NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
   std::vector<Vec3> starts;
   // Start 1: minimise sum (a_i.v)^2 / sum |N_i v|^2, the generalised eigenproblem
   // (sum a a^T) v = lambda (sum N^T N) v.
-  const std::vector<Packed> P = pack(rows);
-  double sa[6] = {0, 0, 0, 0, 0, 0}, sn[6] = {0, 0, 0, 0, 0, 0};
-  for (const auto& p : P)
-    for (int k = 0; k < 6; ++k) {
-      sa[k] += p.aa[k];
-      sn[k] += p.nn[k];
-    }
-  const Mat3 Ma = unpack(sa), Mn = unpack(sn);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> gen(Ma, Mn);
-  if (gen.info() == Eigen::Success) starts.push_back(gen.eigenvectors().col(0).normalized());
+  const Packed P = pack(rows);
+  const Sums s = P.rightCols<12>().colwise().sum().transpose();
+  const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
+  Vec3 lambda;
+  Mat3 X;
+  if (generalizedEigen(Ma, Mn, opt.closed_form_eigen, lambda, X)) starts.push_back(X.col(0).normalized());
   // Further starts: the best directions of a coarse grid over the hemisphere,
   // scored by the robust geometric cost on a strided subset of rows. The cost
   // has a local minimum near each cluster's own line direction (there the
@@ -205,7 +306,7 @@ NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
   NullspaceSolution best;
   for (const Vec3& s : starts) {
     if (!s.allFinite()) continue;
-    NullspaceSolution sol = irlsFrom(P, s, opt.max_iterations, opt.huber_k, opt.tolerance);
+    NullspaceSolution sol = irlsFrom(P, s, opt);
     if (sol.ok && (!best.ok || sol.scale < best.scale)) best = sol;
   }
   return best;

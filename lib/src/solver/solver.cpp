@@ -166,9 +166,25 @@ bool checkDegenerate(const WindowObservations& obs, const MotionModel& motion,
   return false;
 }
 
+// Cluster frames a solver has already computed, by cluster index, for the
+// sign test to reuse (an empty cache: compute every frame).
+struct FrameCache {
+  std::vector<ClusterFrame> frames;
+  std::vector<char> have;
+  explicit FrameCache(size_t clusters = 0) : frames(clusters), have(clusters, 0) {}
+  void put(size_t c, const ClusterFrame& f) {
+    frames[c] = f;
+    have[c] = 1;
+  }
+  const ClusterFrame* get(size_t c) const { return c < have.size() && have[c] ? &frames[c] : nullptr; }
+};
+SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel& motion,
+                               const Vec3& v, const FrameCache& cache);
+
 // Fills the result from a nullspace solution: degeneracy by singular values, sign.
 SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservations& obs,
-                    const MotionModel& motion, const LinearOptions& opt, int rows) {
+                    const MotionModel& motion, const LinearOptions& opt, int rows,
+                    const FrameCache& cache = FrameCache()) {
   if (!ns.ok) return fail(SolveStatus::Failed, Degeneracy::None, "robust nullspace did not converge");
   SolverResult r;
   r.sigma_min = ns.sigma_min;
@@ -185,7 +201,7 @@ SolverResult finish(const detail::NullspaceSolution& ns, const WindowObservation
   }
   r.v = ns.v.normalized();
   if (opt.resolve_sign) {
-    const SignDecision s = resolveSign(obs, motion, r.v);
+    const SignDecision s = resolveSignCached(obs, motion, r.v, cache);
     r.v *= s.sign;
     r.sign_margin = s.margin * s.sign;
   }
@@ -289,39 +305,47 @@ SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion
   // [m2]_x B_ref v = 0, three rows (rank two), each normalised by |B_ref v|.
   std::vector<ConstraintRow> rows;
   rows.reserve(3 * usable.size());
+  FrameCache cache(obs.clusters.size());
   for (int c : usable) {
     const auto& cl = obs.clusters[c];
     const ClusterFrame frame = detail::makeClusterFrame(cl, motion);
-    const Mat3 B = detail::transferMatrix(frame, motion, cl.l2.t);
-    const Vec3 m2 = (motion.rotation(cl.l2.t) * cl.l2.normal).normalized();
+    cache.put(static_cast<size_t>(c), frame);
+    Mat3 R2, P2;
+    motion.pose(cl.l2.t, R2, P2);
+    const Mat3 B = detail::transferMatrix(frame, P2);
+    const Vec3 m2 = (R2 * cl.l2.normal).normalized();
     Mat3 m2x;
     m2x << 0, -m2.z(), m2.y(), m2.z(), 0, -m2.x(), -m2.y(), m2.x(), 0;
     const Mat3 C = m2x * B;
     for (int j = 0; j < 3; ++j) rows.push_back({C.row(j).transpose(), B});
   }
-  const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
-  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));
+  detail::NullspaceOptions nopt = nullspaceOptions(opt);
+  nopt.closed_form_eigen = true;  // 15 rows: the 3x3 eigen solves are much of the cost
+  const auto ns = detail::robustNullspace(rows, nopt);
+  result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()), cache);
   result.time_us = microsecondsSince(start);
   return result;
 }
 
-SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v) {
-  // Depth of event k along its ray from the camera at t_k, where the ray meets
-  // the planes of l1 and l3 (least squares over both planes):
-  //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
-  // lambda is odd in v, so exactly one sign puts the line in front (lambda > 0).
-  int votes = 0, voters = 0;
-  long event_balance = 0;
-  for (int c : detail::usableClusters(obs, 2)) {
-    const auto& cl = obs.clusters[c];
-    const ClusterFrame fr = detail::makeClusterFrame(cl, motion);
-    const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
-    const size_t stride = std::max<size_t>(1, cl.size() / 24);  // 24 votes per cluster
-    long pos = 0, neg = 0;
-    for (size_t k = 0; k < cl.size(); k += stride) {
+namespace {
+// One cluster's cheirality votes: every stride-th event votes for the sign of
+// its depth lambda. Counted sequentially, so that the count can stop as soon as
+// the majority is decided and resume when the exact event balance is needed.
+struct SignVotes {
+  const ClusterObservation* cl = nullptr;
+  ClusterFrame fr;
+  Vec3 ps, pe;     // P(t_s) v, P(t_e) v
+  size_t stride = 1, next = 0;
+  long pos = 0, neg = 0;
+
+  size_t remaining() const { return next < cl->size() ? (cl->size() - 1 - next) / stride + 1 : 0; }
+  // Counts votes until the majority cannot change (or all are counted).
+  void count(const MotionModel& motion, const Vec3& v, bool all) {
+    for (; next < cl->size(); next += stride) {
+      if (!all && static_cast<size_t>(std::abs(pos - neg)) > remaining()) return;
       Mat3 Rk, Pk;
-      motion.pose(cl.times[k], Rk, Pk);
-      const Vec3 fp = Rk * cl.bearings[k];
+      motion.pose(cl->times[next], Rk, Pk);
+      const Vec3 fp = Rk * cl->bearings[next];
       const Vec3 pk = Pk * v;
       const double a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
       const double den = a1 * a1 + a3 * a3;
@@ -330,16 +354,54 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
       if (lambda > 0) ++pos;
       else if (lambda < 0) ++neg;
     }
-    if (pos == neg) continue;
+  }
+};
+SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel& motion,
+                               const Vec3& v, const FrameCache& cache) {
+  // Depth of event k along its ray from the camera at t_k, where the ray meets
+  // the planes of l1 and l3 (least squares over both planes):
+  //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
+  // lambda is odd in v, so exactly one sign puts the line in front (lambda > 0).
+  // Each cluster votes by the majority of 24 of its events; a cluster's count
+  // stops once its majority is decided (unanimous: after 13 events), and is
+  // completed only when the clusters tie and the event balance decides.
+  std::vector<SignVotes> clusters;
+  for (int c : detail::usableClusters(obs, 2)) {
+    SignVotes s;
+    s.cl = &obs.clusters[c];
+    const ClusterFrame* cached = cache.get(static_cast<size_t>(c));
+    s.fr = cached ? *cached : detail::makeClusterFrame(*s.cl, motion);
+    s.ps = s.fr.Ps * v;
+    s.pe = s.fr.Pe * v;
+    s.stride = std::max<size_t>(1, s.cl->size() / 24);  // 24 votes per cluster
+    s.count(motion, v, false);
+    clusters.push_back(s);
+  }
+  int votes = 0, voters = 0;
+  for (const auto& s : clusters) {
+    if (s.pos == s.neg) continue;
     ++voters;
-    votes += pos > neg ? 1 : -1;
-    event_balance += pos - neg;
+    votes += s.pos > s.neg ? 1 : -1;
   }
   SignDecision d;
   if (voters == 0) return d;
   d.margin = static_cast<double>(votes) / voters;
-  d.sign = votes > 0 || (votes == 0 && event_balance >= 0) ? 1 : -1;
+  if (votes != 0) {
+    d.sign = votes > 0 ? 1 : -1;
+    return d;
+  }
+  long event_balance = 0;
+  for (auto& s : clusters) {
+    s.count(motion, v, true);
+    if (s.pos != s.neg) event_balance += s.pos - s.neg;
+  }
+  d.sign = event_balance >= 0 ? 1 : -1;
   return d;
+}
+}  // namespace
+
+SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v) {
+  return resolveSignCached(obs, motion, v, FrameCache());
 }
 
 SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motion,

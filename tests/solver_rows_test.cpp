@@ -1,0 +1,132 @@
+// The linear solvers' building blocks: the closed-form 3x3 generalised
+// eigensolver against Eigen's iterative one, and the robust nullspace.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <random>
+
+#include "celc/sim/line_scene.hpp"
+#include "celc/solver/solver.hpp"
+#include "solver/constraint_rows.hpp"
+
+using namespace celc;
+
+namespace {
+
+Mat3 randomMatrix(std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Mat3 M;
+  for (int i = 0; i < 9; ++i) M(i) = n(rng);
+  return M;
+}
+
+// Random SPD matrix with eigenvalues 10^[-e, 0] in a random basis.
+Mat3 randomSpd(std::mt19937_64& rng, double max_exponent) {
+  std::uniform_real_distribution<double> u(-max_exponent, 0.0);
+  const Mat3 Q = Eigen::HouseholderQR<Mat3>(randomMatrix(rng)).householderQ();
+  const Vec3 d(std::pow(10.0, u(rng)), std::pow(10.0, u(rng)), std::pow(10.0, u(rng)));
+  return Q * d.asDiagonal() * Q.transpose();
+}
+
+}  // namespace
+
+// Random SPD pairs, well and badly conditioned (A like an IRLS system near its
+// nullspace: one eigenvalue 1e-8 of the others): same eigenvalues and the
+// same smallest eigenvector (up to sign) as GeneralizedSelfAdjointEigenSolver.
+TEST(GeneralizedEigen3, MatchesEigenOnRandomSpd) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Mat3 A = randomSpd(rng, trial % 2 ? 8.0 : 2.0);
+    const Mat3 B = randomSpd(rng, 2.0);
+    Vec3 values;
+    Mat3 vectors;
+    ASSERT_TRUE(detail::generalizedEigen3(A, B, values, vectors));
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> ref(A, B);
+    ASSERT_EQ(ref.info(), Eigen::Success);
+    const double scale = ref.eigenvalues().cwiseAbs().maxCoeff();
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(values(i), ref.eigenvalues()(i), 1e-12 * scale);
+    EXPECT_LE(values(0), values(1));
+    EXPECT_LE(values(1), values(2));
+    // B-orthonormal, and A x = lambda B x.
+    EXPECT_LT((vectors.transpose() * B * vectors - Mat3::Identity()).norm(), 1e-9);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_LT((A * vectors.col(i) - values(i) * B * vectors.col(i)).norm(), 1e-9 * scale);
+    // The smallest eigenvector is the one IRLS uses: it must match to 1e-9 rad
+    // when it is well separated from the second.
+    if (ref.eigenvalues()(1) > 2.0 * ref.eigenvalues()(0) + 1e-6 * scale) {
+      const Vec3 x = vectors.col(0).normalized(), y = ref.eigenvectors().col(0).normalized();
+      EXPECT_LT(std::min((x - y).norm(), (x + y).norm()), 1e-9) << "trial " << trial;
+    }
+  }
+}
+
+TEST(GeneralizedEigen3, RejectsIndefiniteB) {
+  Vec3 values;
+  Mat3 vectors;
+  const Mat3 B = Vec3(1.0, -1.0, 1.0).asDiagonal();
+  EXPECT_FALSE(detail::generalizedEigen3(Mat3::Identity(), B, values, vectors));
+  EXPECT_FALSE(detail::generalizedEigen3(Mat3::Identity(), Mat3::Zero(), values, vectors));
+}
+
+namespace {
+// The sign test counting every vote (24 per cluster), as resolveSign did
+// before it stopped counting once a cluster's majority is decided.
+SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionModel& motion,
+                                 const Vec3& v) {
+  int votes = 0, voters = 0;
+  long event_balance = 0;
+  for (int c : detail::usableClusters(obs, 2)) {
+    const auto& cl = obs.clusters[c];
+    const auto fr = detail::makeClusterFrame(cl, motion);
+    const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
+    const size_t stride = std::max<size_t>(1, cl.size() / 24);
+    long pos = 0, neg = 0;
+    for (size_t k = 0; k < cl.size(); k += stride) {
+      Mat3 Rk, Pk;
+      motion.pose(cl.times[k], Rk, Pk);
+      const Vec3 fp = Rk * cl.bearings[k], pk = Pk * v;
+      const double a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
+      const double den = a1 * a1 + a3 * a3;
+      if (!(den > 1e-24)) continue;
+      const double lambda = (a1 * fr.m1.dot(ps - pk) + a3 * fr.m3.dot(pe - pk)) / den;
+      if (lambda > 0) ++pos;
+      else if (lambda < 0) ++neg;
+    }
+    if (pos == neg) continue;
+    ++voters;
+    votes += pos > neg ? 1 : -1;
+    event_balance += pos - neg;
+  }
+  SignDecision d;
+  if (voters == 0) return d;
+  d.margin = static_cast<double>(votes) / voters;
+  d.sign = votes > 0 || (votes == 0 && event_balance >= 0) ? 1 : -1;
+  return d;
+}
+}  // namespace
+
+// The sequential sign test decides exactly as counting every vote: for the
+// true direction, its opposite and random directions (mixed votes, ties), on
+// scenes with 2 to 6 lines (even numbers of voters can tie).
+TEST(SignTest, SequentialCountMatchesFullCount) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int ties = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    LineSceneOptions o;
+    o.n_lines = 2 + trial % 5;
+    o.events_per_line = 20 + 30 * (trial % 4);
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    std::vector<Vec3> dirs{tr.true_direction, -tr.true_direction};
+    for (int k = 0; k < 8; ++k) dirs.push_back(Vec3(n(rng), n(rng), n(rng)).normalized());
+    for (const Vec3& v : dirs) {
+      const SignDecision a = resolveSign(tr.observations, tr.given_motion, v);
+      const SignDecision b = resolveSignAllVotes(tr.observations, tr.given_motion, v);
+      EXPECT_EQ(a.sign, b.sign) << "trial " << trial;
+      EXPECT_EQ(a.margin, b.margin) << "trial " << trial;
+      if (b.margin == 0.0) ++ties;
+    }
+  }
+  EXPECT_GT(ties, 0);  // the tie-break by event balance was exercised
+}
