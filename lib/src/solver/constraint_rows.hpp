@@ -53,7 +53,7 @@ bool generalizedEigen3(const Mat3& A, const Mat3& B, Vec3& values, Mat3& vectors
 struct NullspaceOptions {
   int max_iterations = 20;
   double huber_k = 1.345;
-  double tolerance = 1e-4;
+  double tolerance = 1e-3;
   int grid_directions = 0;   // hemisphere grid size (0 = no grid)
   int grid_starts = 2;       // IRLS runs from the best grid directions
   int grid_rows = 200;       // rows used to score the grid

@@ -63,7 +63,7 @@ struct LinearOptions {
   std::uint64_t seed = 1;        ///< seed of the row subset
   int max_iterations = 20;       ///< IRLS iterations
   double huber_k = 1.345;        ///< Huber threshold in units of the robust scale
-  double tolerance = 1e-4;       ///< stop when the direction moves less than this [rad] (100x below the error at the paper's noise)
+  double tolerance = 1e-3;       ///< stop when the direction moves less than this [rad] (100x below the error at the paper's noise, 0.1 rad)
   /// Global start: the robust cost is scored on this many hemisphere
   /// directions (0 = off) and IRLS also runs from the best grid_starts of them.
   /// Off by default: on the paper's scene it changes the median error by < 2%
