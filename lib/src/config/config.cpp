@@ -39,6 +39,7 @@ void readSolverSection(Section s, SolverOptions& o) {
   r.get("num_threads", o.refine.num_threads);
   r.finish();
   s.get("ml_grid_starts", o.ml_grid_starts);
+  s.get("ml_screen_events", o.ml_screen_events);
   s.finish();
 }
 
@@ -72,7 +73,8 @@ std::string solverYaml(const SolverOptions& o, const std::string& in) {
     << in << "    seed: " << r.seed << "\n"
     << in << "    function_tolerance: " << r.function_tolerance << "\n"
     << in << "    num_threads: " << r.num_threads << "\n"
-    << in << "  ml_grid_starts: " << o.ml_grid_starts << "\n";
+    << in << "  ml_grid_starts: " << o.ml_grid_starts << "\n"
+    << in << "  ml_screen_events: " << o.ml_screen_events << "\n";
   return y.str();
 }
 

@@ -108,6 +108,7 @@ std::string SolverOptions::validate() const {
   if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
   if (!(ml_second_start_max_twist >= 0.0)) e += "ml_second_start_max_twist must be >= 0; ";
   if (ml_grid_starts < 0 || ml_grid_starts > 10000) e += "ml_grid_starts must be in [0, 10000]; ";
+  if (ml_screen_events < 0) e += "ml_screen_events must be >= 0; ";
   return e;
 }
 
@@ -437,6 +438,14 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
   if (starts.empty()) return linear;  // neither start: the linear stage's status
   for (const Vec3& d : detail::hemisphereDirections(options.ml_grid_starts)) starts.push_back({d, nullptr});
   double time_us = linear.time_us + (npt ? npt->time_us : 0.0);
+  // With a lattice, the starts are screened on a subset of ml_screen_events
+  // events (the basins are coarse; every start sees the same subset, so the
+  // costs compare) and only the winner is refined on all of them.
+  const int full = options.refine.max_events;
+  const bool screen = options.ml_grid_starts > 0 && options.ml_screen_events > 0 &&
+                      (full == 0 || full > options.ml_screen_events);
+  RefineOptions screen_options = options.refine;
+  if (screen) screen_options.max_events = options.ml_screen_events;
   SolverResult best;
   const SolverResult* best_from = nullptr;
   bool have = false;
@@ -446,7 +455,7 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
     for (const Vec3& e : ends)
       seen = seen || angleBetweenSignAgnostic(s.v, e) * 180.0 / M_PI < options.ml_second_start_deg;
     if (seen) continue;
-    SolverResult r = refineVelocity(obs, motion, s.v, true, options.refine);
+    SolverResult r = refineVelocity(obs, motion, s.v, true, screen_options);
     time_us += r.time_us;
     if (!r.ok()) continue;
     ends.push_back(r.v);
@@ -457,6 +466,11 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
     }
   }
   if (!have) return linear.ok() ? linear : *npt;
+  if (screen) {
+    SolverResult r = refineVelocity(obs, motion, best.v, true, options.refine);
+    time_us += r.time_us;
+    if (r.ok()) best = r;
+  }
   if (best_from) {
     best.sigma_min = best_from->sigma_min;
     best.sigma_second = best_from->sigma_second;

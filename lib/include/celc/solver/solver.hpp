@@ -132,6 +132,10 @@ struct SolverOptions {
   /// (0 = off) and keeps the end point of lowest robust cost; each start costs
   /// one joint refinement.
   int ml_grid_starts = 0;
+  /// With ml_grid_starts: every start is refined on a seeded subset of this
+  /// many events, and only the lowest-cost end point on all (max_events) of
+  /// them (0 = every start on all events).
+  int ml_screen_events = 1000;
   std::string validate() const;
 };
 
