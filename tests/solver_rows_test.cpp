@@ -70,7 +70,7 @@ TEST(GeneralizedEigen3, RejectsIndefiniteB) {
 }
 
 namespace {
-// The sign test counting every vote (24 per cluster), as resolveSign did
+// The sign test counting every vote (kSignVotesPerCluster per cluster), as resolveSign did
 // before it stopped counting once a cluster's majority is decided.
 SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionModel& motion,
                                  const Vec3& v) {
@@ -80,7 +80,7 @@ SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionMode
     const auto& cl = obs.clusters[c];
     const auto fr = detail::makeClusterFrame(cl, motion);
     const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
-    const size_t stride = std::max<size_t>(1, cl.size() / 24);
+    const size_t stride = std::max<size_t>(1, cl.size() / detail::kSignVotesPerCluster);
     long pos = 0, neg = 0;
     for (size_t k = 0; k < cl.size(); k += stride) {
       Mat3 Rk, Pk;

@@ -363,8 +363,8 @@ SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel&
   // the planes of l1 and l3 (least squares over both planes):
   //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
   // lambda is odd in v, so exactly one sign puts the line in front (lambda > 0).
-  // Each cluster votes by the majority of 24 of its events; a cluster's count
-  // stops once its majority is decided (unanimous: after 13 events), and is
+  // Each cluster votes by the majority of kSignVotesPerCluster of its events; a
+  // cluster's count stops once its majority is decided, and is
   // completed only when the clusters tie and the event balance decides.
   std::vector<SignVotes> clusters;
   for (int c : detail::usableClusters(obs, 2)) {
@@ -374,7 +374,7 @@ SignDecision resolveSignCached(const WindowObservations& obs, const MotionModel&
     s.fr = cached ? *cached : detail::makeClusterFrame(*s.cl, motion);
     s.ps = s.fr.Ps * v;
     s.pe = s.fr.Pe * v;
-    s.stride = std::max<size_t>(1, s.cl->size() / 24);  // 24 votes per cluster
+    s.stride = std::max<size_t>(1, s.cl->size() / detail::kSignVotesPerCluster);
     s.count(motion, v, false);
     clusters.push_back(s);
   }
