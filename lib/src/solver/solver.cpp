@@ -441,9 +441,14 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
   // With a lattice, the starts are screened on a subset of ml_screen_events
   // events (the basins are coarse; every start sees the same subset, so the
   // costs compare) and only the winner is refined on all of them.
+  // No screening when the subset would hold every event anyway (refining the
+  // winner again would repeat its work).
+  size_t events = 0;
+  for (const auto& c : obs.clusters) events += c.size();
   const int full = options.refine.max_events;
   const bool screen = options.ml_grid_starts > 0 && options.ml_screen_events > 0 &&
-                      (full == 0 || full > options.ml_screen_events);
+                      (full == 0 || full > options.ml_screen_events) &&
+                      events > static_cast<size_t>(options.ml_screen_events);
   RefineOptions screen_options = options.refine;
   if (screen) screen_options.max_events = options.ml_screen_events;
   SolverResult best;
