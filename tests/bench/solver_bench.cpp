@@ -4,6 +4,7 @@
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
 #include "solver/constraint_rows.hpp"
+#include "solver/irls_kernel.hpp"
 
 using namespace celc;
 
@@ -26,9 +27,10 @@ std::vector<detail::ConstraintRow> rowsOf(const LineSceneTrial& tr) {
 }
 }  // namespace
 
-// The robust nullspace (IRLS) alone on 1000 prebuilt rows.
+// The robust nullspace (IRLS) alone on 1000 prebuilt rows, packed as the
+// CELC solver builds them (BM_PackRows1000: packing rows built apart).
 static void BM_CelcLinearSolve1000Rows(benchmark::State& state) {
-  const auto rows = rowsOf(scene(200));
+  const detail::PackedRows rows(rowsOf(scene(200)));
   detail::NullspaceOptions opt;
   int iterations = 0;
   for (auto _ : state) {
@@ -39,6 +41,20 @@ static void BM_CelcLinearSolve1000Rows(benchmark::State& state) {
   state.counters["irls_iterations"] = iterations;
 }
 BENCHMARK(BM_CelcLinearSolve1000Rows)->Unit(benchmark::kMicrosecond);
+
+// Its parts: packing the rows once, and one IRLS pass over them.
+static void BM_PackRows1000(benchmark::State& state) {
+  const auto rows = rowsOf(scene(200));
+  for (auto _ : state) benchmark::DoNotOptimize(detail::PackedRows(rows));
+}
+BENCHMARK(BM_PackRows1000)->Unit(benchmark::kMicrosecond);
+
+static void BM_HuberPass1000Rows(benchmark::State& state) {
+  const detail::PackedRows rows(rowsOf(scene(200)));
+  const Vec3 v = Vec3(1.0, 2.0, 0.1).normalized();
+  for (auto _ : state) benchmark::DoNotOptimize(detail::huberWeightedSums(rows, v, 1e-3));
+}
+BENCHMARK(BM_HuberPass1000Rows)->Unit(benchmark::kMicrosecond);
 
 // Building the 1000 rows (rotations, left Jacobians, transfer matrices).
 static void BM_CelcBuildRows1000(benchmark::State& state) {

@@ -1,5 +1,7 @@
 #include "constraint_rows.hpp"
 
+#include "irls_kernel.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -125,68 +127,22 @@ bool generalizedEigen3(const Mat3& A, const Mat3& B, Vec3& values, Mat3& vectors
 }
 
 namespace {
-// Robust geometric cost of v: 1.4826 * median |a_i.v / |N_i v||.
-double robustScale(const std::vector<ConstraintRow>& rows, const Vec3& v, std::vector<double>& r) {
-  r.resize(rows.size());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const double g = (rows[i].N * v).norm();
-    r[i] = g > 0.0 ? rows[i].a.dot(v) / g : 1e300;
-  }
-  return 1.4826 * medianAbs(r);
-}
-
-// The rows packed once as structure of arrays: column j holds, for every row,
-// a (j = 0..2), the 6 distinct entries of a a^T (3..8: xx yy zz xy xz yz) and
-// those of N^T N (9..14, same order). Column-major, so every per-row pass of
-// an IRLS iteration is a few matrix-vector products over contiguous columns.
-using Packed = Eigen::Matrix<double, Eigen::Dynamic, 15>;
-using Sums = Eigen::Matrix<double, 12, 1>;  // sum of w a a^T (0..5) and of w N^T N (6..11)
-
-Packed pack(const std::vector<ConstraintRow>& rows) {
-  const auto n = static_cast<Eigen::Index>(rows.size());
-  Packed P(n, 15);
-  double* c[15];
-  for (int j = 0; j < 15; ++j) c[j] = P.col(j).data();
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Vec3& a = rows[static_cast<size_t>(i)].a;
-    const Mat3& N = rows[static_cast<size_t>(i)].N;
-    c[0][i] = a.x(), c[1][i] = a.y(), c[2][i] = a.z();
-    c[3][i] = a.x() * a.x(), c[4][i] = a.y() * a.y(), c[5][i] = a.z() * a.z();
-    c[6][i] = a.x() * a.y(), c[7][i] = a.x() * a.z(), c[8][i] = a.y() * a.z();
-    c[9][i] = N.col(0).squaredNorm(), c[10][i] = N.col(1).squaredNorm(), c[11][i] = N.col(2).squaredNorm();
-    c[12][i] = N.col(0).dot(N.col(1)), c[13][i] = N.col(0).dot(N.col(2)), c[14][i] = N.col(1).dot(N.col(2));
-  }
-  return P;
-}
-// q(v) such that the packed symmetric entries s give v^T S v = s . q(v).
-Eigen::Matrix<double, 6, 1> quadWeights(const Vec3& v) {
-  Eigen::Matrix<double, 6, 1> q;
-  q << v.x() * v.x(), v.y() * v.y(), v.z() * v.z(), 2.0 * v.x() * v.y(), 2.0 * v.x() * v.z(),
-      2.0 * v.y() * v.z();
-  return q;
-}
 Mat3 unpack(const double* q) {
   Mat3 M;
   M << q[0], q[3], q[4], q[3], q[1], q[5], q[4], q[5], q[2];
   return M;
 }
-// The MAD scale 1.4826 * median |r| of r = a.v / |N v| over every stride-th
-// row, from d = a.v and g2 = |N v|^2 (median of r^2: no square root per row).
-// Rows with |N v| = 0 count as r = r_degenerate.
-double sampledMad(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, size_t stride,
-                  double r_degenerate, std::vector<double>& r2) {
-  const double r2_degenerate = std::min(r_degenerate * r_degenerate, std::numeric_limits<double>::max());
-  r2.clear();
-  for (Eigen::Index i = 0; i < d.size(); i += static_cast<Eigen::Index>(stride))
-    r2.push_back(g2[i] > 0.0 ? d[i] * d[i] / g2[i] : r2_degenerate);
+// The MAD scale 1.4826 * median |r| of r = a.v / |N v| over the scale sample
+// of the rows (median of r^2: no square root per row). Rows with |N v| = 0
+// count as r = r_degenerate.
+double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::vector<double>& r2) {
+  P.scaleSample().squaredResiduals(v, r_degenerate, r2);
   if (r2.empty()) return 0.0;
   auto mid = r2.begin() + static_cast<long>(r2.size() / 2);
   std::nth_element(r2.begin(), mid, r2.end());
+  const double r2_degenerate = std::min(r_degenerate * r_degenerate, std::numeric_limits<double>::max());
   return 1.4826 * (*mid == r2_degenerate ? r_degenerate : std::sqrt(*mid));
 }
-// The MAD scale from a strided subset of at most 256 rows (its relative
-// standard error is ~5%, well inside what the Huber threshold needs).
-size_t madStride(Eigen::Index n) { return std::max<size_t>(1, static_cast<size_t>(n) / 256); }
 
 // The generalised eigenproblem in closed form or by Eigen's iterative solver.
 bool generalizedEigen(const Mat3& A, const Mat3& B, bool closed_form, Vec3& values, Mat3& vectors) {
@@ -198,18 +154,6 @@ bool generalizedEigen(const Mat3& A, const Mat3& B, bool closed_form, Vec3& valu
   return true;
 }
 
-// Huber weight over |N v|^2 of every row, from d = a.v and g2 = |N v|^2:
-// min(1, thr / |r|) / g2 = min(1 / g2, thr / sqrt(d^2 g2)) (r = d / sqrt(g2)),
-// branch-free so that it vectorises; rows with |N v| = 0 get no weight.
-void huberWeights(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, double thr,
-                  Eigen::VectorXd& w) {
-  const auto g = g2.array();
-  w.array() = g.inverse().min(thr * (d.array().square() * g).sqrt().inverse());
-  if (!(g.minCoeff() > 0.0))
-    for (Eigen::Index i = 0; i < w.size(); ++i)
-      if (!(g[i] > 0.0)) w[i] = 0.0;
-}
-
 // IRLS from a starting direction. Each step solves the generalised
 // eigenproblem (sum w_i a_i a_i^T) v = lambda (sum w_i N_i^T N_i) v with
 // w_i = Huber(r_i / scale) / |N_i v_prev|^2. A plain weighted eigenvector
@@ -218,25 +162,17 @@ void huberWeights(const Eigen::VectorXd& d, const Eigen::VectorXd& g2, double th
 // weighted normaliser on the right-hand side penalises that collapse, and at a
 // fixed point lambda is the weighted squared geometric residual.
 //
-// An iteration is a few passes over the packed columns: d = a.v and
-// g2 = |N v|^2 (matrix-vector products), the weights from them (huberWeights)
-// and the weighted sums (one transposed product); the scale from a sample.
-NullspaceSolution irlsFrom(const Packed& P, Vec3 v, const NullspaceOptions& opt) {
+// An iteration is the scale from a strided sample of rows, then one fused
+// pass over every row for the weights and the weighted sums (irls_kernel).
+NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const NullspaceOptions& opt) {
   NullspaceSolution out;
-  const Eigen::Index n = P.rows();
-  const size_t stride = madStride(n);
-  Eigen::VectorXd d(n), g2(n), w(n);
   std::vector<double> sample;
-  sample.reserve(static_cast<size_t>(n / static_cast<Eigen::Index>(stride)) + 1);
   Vec3 lambda;
   Mat3 X;
   for (int it = 0; it < std::max(1, opt.max_iterations); ++it) {
-    d.noalias() = P.leftCols<3>() * v;
-    g2.noalias() = P.rightCols<6>() * quadWeights(v);
-    const double scale = sampledMad(d, g2, stride, 0.0, sample);
+    const double scale = sampledMad(P, v, 0.0, sample);
     const double thr = opt.huber_k * std::max(scale, 1e-15);
-    huberWeights(d, g2, thr, w);
-    const Sums s = P.rightCols<12>().transpose() * w;
+    const PackedSums s = huberWeightedSums(P, v, thr);
     const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
     if (!generalizedEigen(Ma, Mn, opt.closed_form_eigen, lambda, X)) return out;
     Vec3 next = X.col(0).normalized();
@@ -252,9 +188,7 @@ NullspaceSolution irlsFrom(const Packed& P, Vec3 v, const NullspaceOptions& opt)
   }
   out.v = v;
   // Robust scale at the end point (rows with |N v| = 0 count as outliers).
-  d.noalias() = P.leftCols<3>() * v;
-  g2.noalias() = P.rightCols<6>() * quadWeights(v);
-  out.scale = sampledMad(d, g2, stride, 1e300, sample);
+  out.scale = sampledMad(P, v, 1e300, sample);
   out.ok = v.allFinite() && v.norm() > 0.5;
   return out;
 }
@@ -274,29 +208,34 @@ std::vector<Vec3> hemisphereDirections(int n) {
 
 NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
                                   const NullspaceOptions& opt) {
-  if (rows.size() < 3) return {};
+  return robustNullspace(PackedRows(rows), opt);
+}
+
+NullspaceSolution robustNullspace(const PackedRows& P, const NullspaceOptions& opt) {
+  if (P.size() < 3) return {};
   std::vector<Vec3> starts;
   // Start 1: minimise sum (a_i.v)^2 / sum |N_i v|^2, the generalised eigenproblem
   // (sum a a^T) v = lambda (sum N^T N) v.
-  const Packed P = pack(rows);
-  const Sums s = P.rightCols<12>().colwise().sum().transpose();
+  const PackedSums& s = P.plainSums();
   const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
   Vec3 lambda;
   Mat3 X;
   if (generalizedEigen(Ma, Mn, opt.closed_form_eigen, lambda, X)) starts.push_back(X.col(0).normalized());
   // Further starts: the best directions of a coarse grid over the hemisphere,
-  // scored by the robust geometric cost on a strided subset of rows. The cost
-  // has a local minimum near each cluster's own line direction (there the
-  // transferred lines of that cluster become blends of l1 and l3 and fit its
-  // events well), so a single local start is not enough.
+  // scored by the robust geometric cost (the MAD scale) on a strided subset
+  // of rows. The cost has a local minimum near each cluster's own line
+  // direction (there the transferred lines of that cluster become blends of
+  // l1 and l3 and fit its events well), so a single local start is not enough.
   if (opt.grid_directions > 0 && opt.grid_starts > 0) {
-    std::vector<ConstraintRow> sub;
-    const size_t stride = std::max<size_t>(1, rows.size() / std::max(1, opt.grid_rows));
-    for (size_t i = 0; i < rows.size(); i += stride) sub.push_back(rows[i]);
+    const PackedRows sub = P.strided(P.size() / static_cast<size_t>(std::max(1, opt.grid_rows)));
     std::vector<std::pair<double, Vec3>> scored;
-    std::vector<double> r;
-    for (const Vec3& d : hemisphereDirections(opt.grid_directions))
-      scored.emplace_back(robustScale(sub, d, r), d);
+    std::vector<double> r2;
+    for (const Vec3& d : hemisphereDirections(opt.grid_directions)) {
+      sub.squaredResiduals(d, 1e300, r2);
+      auto mid = r2.begin() + static_cast<long>(r2.size() / 2);
+      std::nth_element(r2.begin(), mid, r2.end());
+      scored.emplace_back(*mid, d);  // the median r^2 ranks as the MAD does
+    }
     const size_t keep = std::min(scored.size(), static_cast<size_t>(opt.grid_starts));
     std::partial_sort(scored.begin(), scored.begin() + static_cast<long>(keep), scored.end(),
                       [](const auto& a, const auto& b) { return a.first < b.first; });

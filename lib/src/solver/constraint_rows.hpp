@@ -76,6 +76,9 @@ struct NullspaceSolution {
 };
 NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
                                   const NullspaceOptions& options);
+/// The same on rows already packed (and sealed) for the IRLS passes.
+class PackedRows;
+NullspaceSolution robustNullspace(const PackedRows& rows, const NullspaceOptions& options);
 std::vector<Vec3> hemisphereDirections(int n);
 
 /// Usable clusters: enough events, finite data, l3 after l1.

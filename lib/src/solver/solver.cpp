@@ -11,6 +11,7 @@
 
 #include "celc/solver/npt.hpp"
 #include "constraint_rows.hpp"
+#include "irls_kernel.hpp"
 
 namespace celc {
 
@@ -272,16 +273,20 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
   const std::vector<size_t> quota = detail::rowQuota(sizes, static_cast<size_t>(opt.max_rows), opt.balance_clusters);
-  std::vector<ConstraintRow> rows;
+  // Packed as they are built (N's third row is zero: two normaliser rows).
+  size_t capacity = 0;
+  for (size_t q : quota) capacity += q;
+  detail::PackedRows rows(capacity, 2);
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
     const ClusterFrame frame = detail::makeClusterFrame(cl, motion);
     for (size_t k : detail::sampleIndices(cl.size(), quota[ci], opt.seed + ci)) {
       if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
-      ConstraintRow row = detail::celcRow(frame, motion, cl.times[k], cl.bearings[k]);
-      if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
+      const ConstraintRow row = detail::celcRow(frame, motion, cl.times[k], cl.bearings[k]);
+      if (row.a.allFinite() && row.N.allFinite()) rows.append(row.a, row.N);
     }
   }
+  rows.seal();
   const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
   result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()));
   result.time_us = microsecondsSince(start);

@@ -1,0 +1,78 @@
+#pragma once
+// Internal: the per-row passes of the robust nullspace IRLS (constraint_rows.cpp)
+// over rows packed once as structure of arrays.
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "constraint_rows.hpp"
+
+namespace celc::detail {
+
+/// The sums of one IRLS step: sum w_i a_i a_i^T (0..5) and sum w_i N_i^T N_i
+/// (6..11), the distinct entries of each symmetric matrix in the order
+/// xx yy zz xy xz yz.
+using PackedSums = std::array<double, 12>;
+
+/// The rows a_i^T v = 0 with normalisers N_i (|N_i v| makes a_i.v a geometric
+/// residual), as structure of arrays: column j holds a_j (j = 0..2), then
+/// N's rows one after the other (column 3 + 3 r + k = N(r, k)). N's third
+/// row is left out when it is zero in every row (CELC's rows), so a pass
+/// reads 9 columns instead of 12. Products are formed on the fly: the passes
+/// are bound by reading the columns, not by arithmetic. Padded with zero
+/// rows to a multiple of kLanes (a padded row has |N v| = 0: no weight).
+class PackedRows {
+ public:
+  static constexpr size_t kLanes = 8;
+  /// Empty, for up to `capacity` rows appended one by one. normal_rows = 2
+  /// when the third row of every N is zero (CELC's rows), else 3.
+  PackedRows(size_t capacity, int normal_rows);
+  /// Packs and seals the rows (normal_rows from the rows).
+  explicit PackedRows(const std::vector<ConstraintRow>& rows);
+
+  /// Appends a row (beyond capacity: ignored, and false). With
+  /// normalRows() = 2, N's third row is not stored: it must be zero.
+  bool append(const Vec3& a, const Mat3& N);
+  /// Pads, forms the plain sums and the scale sample: once, after the last
+  /// append and before any pass.
+  void seal();
+
+  size_t size() const { return n_; }  // rows, without the padding
+  size_t paddedSize() const { return padded_; }
+  int normalRows() const { return normal_rows_; }  // rows of N kept: 2 or 3
+  const double* data() const { return data_.get(); }
+  size_t stride() const { return stride_; }  // between columns [doubles]
+
+  /// Plain sums (w_i = 1), the unweighted start.
+  const PackedSums& plainSums() const { return plain_sums_; }
+  /// Squared geometric residuals r^2 = (a.v)^2 / |N v|^2 of every row
+  /// (r_degenerate^2 where |N v| = 0), into r2.
+  void squaredResiduals(const Vec3& v, double r_degenerate, std::vector<double>& r2) const;
+  /// Every step-th row, sealed.
+  PackedRows strided(size_t step) const;
+  /// The rows the robust scale is taken from: every floor(n / kScaleSample)-th,
+  /// so 256 to 511 of them once n >= 256 (a relative standard error of the
+  /// MAD of ~5 to 7%, well inside what the Huber threshold needs).
+  const PackedRows& scaleSample() const { return sample_ ? *sample_ : *this; }
+  static constexpr size_t kScaleSample = 256;
+
+ private:
+  void sealWithoutSample();
+  size_t capacity_ = 0, n_ = 0, padded_ = 0, stride_ = 0;
+  int normal_rows_ = 3;
+  std::unique_ptr<double[]> data_;
+  PackedSums plain_sums_{};
+  std::shared_ptr<const PackedRows> sample_;  // null when every row is sampled
+};
+
+/// Sums with the Huber weight over |N_i v|^2,
+///   w_i = min(1, thr / |r_i|) / |N_i v|^2 = min(1 / g2, thr / sqrt(d^2 g2)),
+/// with r_i = d / sqrt(g2) the geometric residual (d = a_i.v, g2 = |N_i v|^2);
+/// rows with |N_i v| = 0 get no weight. One fused pass over the columns,
+/// vectorised across kLanes lanes whose partial sums are added in a fixed
+/// order, so the result is the same bit for bit on every instruction set the
+/// pass is compiled for (AVX-512, AVX2, SSE2; chosen at run time).
+PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
+
+}  // namespace celc::detail
