@@ -6,7 +6,10 @@
 
 // Runtime dispatch: GCC builds one clone of each pass per listed target and
 // picks the best the CPU supports when the program loads (an ifunc).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+// (Not when the whole build already targets AVX-512: GCC 12 fails on the
+// clones then, and there is nothing better to dispatch to.)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(__AVX512F__)
 #define CELC_MULTIVERSION \
   __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #define CELC_INLINE inline __attribute__((always_inline))
@@ -21,44 +24,62 @@ namespace {
 constexpr size_t L = PackedRows::kLanes;
 using LaneSums = double[12][L];
 
+// L doubles as one value (GCC/Clang vector extension): an instruction set
+// with narrower registers splits it (AVX2: 2 x 4, SSE2: 4 x 2 lanes), so
+// every clone computes the same lanes in the same order.
+using Lanes = double __attribute__((vector_size(L * sizeof(double))));
+
+using LaneMask = long long __attribute__((vector_size(L * sizeof(double))));
+static_assert(sizeof(long long) == sizeof(double), "lanes and masks have the same width");
+
+CELC_INLINE void loadLanes(const double* p, Lanes& x) { __builtin_memcpy(&x, p, sizeof x); }
+// out = m ? a : b lane by lane (m from a comparison: all ones or all zeros).
+CELC_INLINE void select(const LaneMask& m, const Lanes& a, const Lanes& b, Lanes& out) {
+  out = reinterpret_cast<Lanes>((m & reinterpret_cast<LaneMask>(a)) | (~m & reinterpret_cast<LaneMask>(b)));
+}
+
 // One pass over n rows (a multiple of L) stored as columns c (stride s; a,
 // then R rows of N): per row the weight w (Huber over |N v|^2, or 1 when
-// kPlain) and the sums of w a a^T and w N^T N, each lane keeping its own.
+// kPlain) and the sums of w a a^T and w N^T N, lane by lane.
 template <int R, bool kPlain>
 CELC_INLINE void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
                           LaneSums& out) {
-  double acc[12][L] = {};
+  Lanes acc[12];
+  for (Lanes& x : acc) x = Lanes{} ;
   for (size_t b = 0; b < n; b += L) {
-#pragma omp simd
-    for (size_t l = 0; l < L; ++l) {
-      const size_t i = b + l;
-      const double a0 = c[i], a1 = c[s + i], a2 = c[2 * s + i];
-      double N[R][3];
-      for (int r = 0; r < R; ++r)
-        for (int k = 0; k < 3; ++k) N[r][k] = c[(3 + 3 * r + k) * s + i];
-      double w = 1.0;
-      if (!kPlain) {
-        const double d = a0 * v[0] + a1 * v[1] + a2 * v[2];
-        double g2 = 0.0;
-        for (int r = 0; r < R; ++r) {
-          const double u = N[r][0] * v[0] + N[r][1] * v[1] + N[r][2] * v[2];
-          g2 += u * u;
-        }
-        // One square root and one division per row: w = T / sqrt(X) with
-        // (T, X) = (1, g2^2) for an inlier (sqrt(g2^2) == g2 exactly in IEEE
-        // arithmetic) and (thr, d^2 g2) for an outlier (|r| >= thr).
-        const bool inlier = d * d < thr * thr * g2;
-        const double w_row = (inlier ? 1.0 : thr) / std::sqrt(inlier ? g2 * g2 : d * d * g2);
-        w = g2 > 0.0 ? w_row : 0.0;
-      }
-      const double wa0 = w * a0, wa1 = w * a1, wa2 = w * a2;
-      acc[0][l] += wa0 * a0, acc[1][l] += wa1 * a1, acc[2][l] += wa2 * a2;
-      acc[3][l] += wa0 * a1, acc[4][l] += wa0 * a2, acc[5][l] += wa1 * a2;
+    Lanes a0, a1, a2, N[R][3];
+    loadLanes(c + b, a0), loadLanes(c + s + b, a1), loadLanes(c + 2 * s + b, a2);
+    for (int r = 0; r < R; ++r)
+      for (int k = 0; k < 3; ++k) loadLanes(c + static_cast<size_t>(3 + 3 * r + k) * s + b, N[r][k]);
+    Lanes w = Lanes{} + 1.0;
+    if (!kPlain) {
+      const Lanes d = a0 * v[0] + a1 * v[1] + a2 * v[2];
+      Lanes g2 = Lanes{};
       for (int r = 0; r < R; ++r) {
-        const double wn0 = w * N[r][0], wn1 = w * N[r][1], wn2 = w * N[r][2];
-        acc[6][l] += wn0 * N[r][0], acc[7][l] += wn1 * N[r][1], acc[8][l] += wn2 * N[r][2];
-        acc[9][l] += wn0 * N[r][1], acc[10][l] += wn0 * N[r][2], acc[11][l] += wn1 * N[r][2];
+        const Lanes u = N[r][0] * v[0] + N[r][1] * v[1] + N[r][2] * v[2];
+        g2 += u * u;
       }
+      // One square root and one division per row: w = T / sqrt(X) with
+      // (T, X) = (1, g2^2) for an inlier (sqrt(g2^2) == g2 exactly in IEEE
+      // arithmetic) and (thr, d^2 g2) for an outlier (|r| >= thr).
+      const LaneMask inlier = d * d < thr * thr * g2;
+      Lanes T, X;
+      select(inlier, Lanes{} + 1.0, Lanes{} + thr, T);
+      select(inlier, g2 * g2, d * d * g2, X);
+      double x[L];
+      __builtin_memcpy(x, &X, sizeof x);
+      for (size_t l = 0; l < L; ++l) x[l] = std::sqrt(x[l]);
+      Lanes root;
+      __builtin_memcpy(&root, x, sizeof x);
+      select(g2 > Lanes{}, T / root, Lanes{}, w);
+    }
+    const Lanes wa0 = w * a0, wa1 = w * a1, wa2 = w * a2;
+    acc[0] += wa0 * a0, acc[1] += wa1 * a1, acc[2] += wa2 * a2;
+    acc[3] += wa0 * a1, acc[4] += wa0 * a2, acc[5] += wa1 * a2;
+    for (int r = 0; r < R; ++r) {
+      const Lanes wn0 = w * N[r][0], wn1 = w * N[r][1], wn2 = w * N[r][2];
+      acc[6] += wn0 * N[r][0], acc[7] += wn1 * N[r][1], acc[8] += wn2 * N[r][2];
+      acc[9] += wn0 * N[r][1], acc[10] += wn0 * N[r][2], acc[11] += wn1 * N[r][2];
     }
   }
   for (int k = 0; k < 12; ++k)
