@@ -325,9 +325,7 @@ SolverResult solveCe3lc(const WindowObservations& obs, const MotionModel& motion
     const Mat3 C = m2x * B;
     for (int j = 0; j < 3; ++j) rows.push_back({C.row(j).transpose(), B});
   }
-  detail::NullspaceOptions nopt = nullspaceOptions(opt);
-  nopt.closed_form_eigen = true;  // 15 rows: the 3x3 eigen solves are much of the cost
-  const auto ns = detail::robustNullspace(rows, nopt);
+  const auto ns = detail::robustNullspace(rows, nullspaceOptions(opt));
   result = finish(ns, obs, motion, opt, static_cast<int>(rows.size()), cache);
   result.time_us = microsecondsSince(start);
   return result;
