@@ -71,8 +71,8 @@ class PackedRows {
 /// with r_i = d / sqrt(g2) the geometric residual (d = a_i.v, g2 = |N_i v|^2);
 /// rows with |N_i v| = 0 get no weight. One fused pass over the columns,
 /// vectorised across kLanes lanes whose partial sums are added in a fixed
-/// order, so the result is the same bit for bit on every instruction set the
-/// pass is compiled for (AVX-512, AVX2, SSE2; chosen at run time).
+/// order, built for AVX-512, AVX2 and SSE2 and chosen at run time (the
+/// three agree to rounding: only the first two fuse multiply-adds).
 PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
 
 }  // namespace celc::detail
