@@ -1,0 +1,125 @@
+// The IRLS passes over packed rows (solver/irls_kernel) against a direct,
+// row-by-row evaluation of the same sums.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "solver/irls_kernel.hpp"
+
+using namespace celc;
+using detail::ConstraintRow;
+using detail::PackedRows;
+using detail::PackedSums;
+
+namespace {
+
+// Random rows; with two_rows, N's third row is zero (as in CELC's rows).
+// Every 7th row has N = 0 (no normaliser: such a row must get no weight).
+std::vector<ConstraintRow> randomRows(size_t n, bool two_rows, std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<ConstraintRow> rows(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) rows[i].a(k) = g(rng);
+    for (int k = 0; k < 9; ++k) rows[i].N(k) = g(rng);
+    if (two_rows) rows[i].N.row(2).setZero();
+    if (i % 7 == 3) rows[i].N.setZero();
+  }
+  return rows;
+}
+
+// sum w a a^T and sum w N^T N, entries xx yy zz xy xz yz.
+PackedSums directSums(const std::vector<ConstraintRow>& rows, const Vec3& v, double thr, bool plain) {
+  Mat3 Sa = Mat3::Zero(), Sn = Mat3::Zero();
+  for (const auto& row : rows) {
+    const double d = row.a.dot(v), g2 = (row.N * v).squaredNorm();
+    double w = 1.0;
+    if (!plain) w = g2 > 0.0 ? std::min(1.0, thr / std::abs(d / std::sqrt(g2))) / g2 : 0.0;
+    Sa += w * row.a * row.a.transpose();
+    Sn += w * row.N.transpose() * row.N;
+  }
+  return {Sa(0, 0), Sa(1, 1), Sa(2, 2), Sa(0, 1), Sa(0, 2), Sa(1, 2),
+          Sn(0, 0), Sn(1, 1), Sn(2, 2), Sn(0, 1), Sn(0, 2), Sn(1, 2)};
+}
+
+void expectSumsNear(const PackedSums& got, const PackedSums& want) {
+  double scale = 0.0;
+  for (double x : want) scale = std::max(scale, std::abs(x));
+  // Sums of a few hundred O(1) products in another order: rounding ~1e-14.
+  for (size_t k = 0; k < want.size(); ++k) EXPECT_NEAR(got[k], want[k], 1e-12 * scale) << "entry " << k;
+}
+
+}  // namespace
+
+// Row counts around the 8-row blocks (padding), both layouts, thresholds that
+// make most rows inliers and most rows outliers.
+TEST(IrlsKernel, HuberSumsMatchRowByRowEvaluation) {
+  std::mt19937_64 rng(3);
+  for (const size_t n : {1u, 7u, 8u, 9u, 63u, 300u}) {
+    for (const bool two_rows : {true, false}) {
+      const auto rows = randomRows(n, two_rows, rng);
+      const PackedRows packed(rows);
+      EXPECT_EQ(packed.size(), n);
+      EXPECT_EQ(packed.normalRows(), two_rows ? 2 : 3);
+      expectSumsNear(packed.plainSums(), directSums(rows, Vec3::Zero(), 0.0, true));
+      const Vec3 v = Vec3(0.3, -0.8, 0.5).normalized();
+      for (const double thr : {0.05, 0.5, 5.0})
+        expectSumsNear(detail::huberWeightedSums(packed, v, thr), directSums(rows, v, thr, false));
+    }
+  }
+}
+
+// Rows appended one by one give the same packing as rows packed at once;
+// appending past the capacity is refused.
+TEST(IrlsKernel, AppendMatchesPackingAndRespectsCapacity) {
+  std::mt19937_64 rng(5);
+  const auto rows = randomRows(50, true, rng);
+  PackedRows appended(rows.size(), 2);
+  for (const auto& row : rows) EXPECT_TRUE(appended.append(row.a, row.N));
+  EXPECT_FALSE(appended.append(rows[0].a, rows[0].N));
+  appended.seal();
+  const PackedRows packed(rows);
+  ASSERT_EQ(appended.size(), packed.size());
+  const Vec3 v = Vec3(1.0, 2.0, 0.5).normalized();
+  const PackedSums a = detail::huberWeightedSums(appended, v, 0.3);
+  const PackedSums b = detail::huberWeightedSums(packed, v, 0.3);
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k], b[k]);
+}
+
+// Squared residuals of every row; rows without a normaliser get r_degenerate^2.
+TEST(IrlsKernel, SquaredResidualsAndDegenerateRows) {
+  std::mt19937_64 rng(7);
+  const auto rows = randomRows(40, false, rng);
+  const PackedRows packed(rows);
+  const Vec3 v = Vec3(-0.2, 0.4, 0.9).normalized();
+  std::vector<double> r2;
+  packed.squaredResiduals(v, 1e3, r2);
+  ASSERT_EQ(r2.size(), rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double g2 = (rows[i].N * v).squaredNorm();
+    if (g2 > 0.0) {
+      const double want = std::pow(rows[i].a.dot(v), 2) / g2;
+      EXPECT_NEAR(r2[i], want, 1e-12 * std::max(1.0, want)) << "row " << i;
+    } else {
+      EXPECT_EQ(r2[i], 1e6) << "row " << i;
+    }
+  }
+}
+
+// The scale sample is every floor(n / 256)-th row: all rows up to 511, then
+// 256 to 511 of them; strided(k) holds rows 0, k, 2k, ...
+TEST(IrlsKernel, ScaleSampleAndStridedRows) {
+  std::mt19937_64 rng(9);
+  const auto rows = randomRows(1000, true, rng);
+  const PackedRows packed(rows);
+  EXPECT_EQ(packed.scaleSample().size(), 334u);  // stride 3
+  const PackedRows few(randomRows(300, true, rng));
+  EXPECT_EQ(&few.scaleSample(), &few);  // stride 1: the rows themselves
+  const PackedRows sub = packed.strided(10);
+  ASSERT_EQ(sub.size(), 100u);
+  const Vec3 v = Vec3(0.6, 0.0, 0.8);
+  std::vector<double> all, some;
+  packed.squaredResiduals(v, 1.0, all);
+  sub.squaredResiduals(v, 1.0, some);
+  for (size_t k = 0; k < some.size(); ++k) EXPECT_EQ(some[k], all[10 * k]) << "row " << 10 * k;
+}
