@@ -105,7 +105,7 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
   EXPECT_LT(ratio, 1.35);
 }
 
-// celc_ml from extra hemisphere starts (SolverOptions::ml_grid_starts): on the
+// celc_ml from extra hemisphere starts (MlOptions::grid_starts): on the
 // peer scene at parallax 0.125 (V = 1 m/s), 0.5 px, the single-start joint
 // refinement ends in a wrong basin in about a quarter of the trials
 // (docs/peers.md). With 16 more starts, keeping the lowest robust cost, the
@@ -115,7 +115,7 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
 TEST(MultiStart, JointRefinementEscapesWrongBasins) {
   std::mt19937_64 rng(11);
   SolverOptions one, many;
-  many.ml_grid_starts = 16;
+  many.ml.grid_starts = 16;
   double ss_one = 0.0, ss_many = 0.0;
   int far_one = 0, far_many = 0, n = 0;
   for (int i = 0; i < 24; ++i) {

@@ -38,8 +38,13 @@ void readSolverSection(Section s, SolverOptions& o) {
   r.get("function_tolerance", o.refine.function_tolerance);
   r.get("num_threads", o.refine.num_threads);
   r.finish();
-  s.get("ml_grid_starts", o.ml_grid_starts);
-  s.get("ml_screen_events", o.ml_screen_events);
+  Section m = s.sub("ml");
+  m.get("second_start", o.ml.second_start);
+  m.get("second_start_max_twist", o.ml.second_start_max_twist);
+  m.get("second_start_deg", o.ml.second_start_deg);
+  m.get("grid_starts", o.ml.grid_starts);
+  m.get("screen_events", o.ml.screen_events);
+  m.finish();
   s.finish();
 }
 
@@ -73,8 +78,12 @@ std::string solverYaml(const SolverOptions& o, const std::string& in) {
     << in << "    seed: " << r.seed << "\n"
     << in << "    function_tolerance: " << r.function_tolerance << "\n"
     << in << "    num_threads: " << r.num_threads << "\n"
-    << in << "  ml_grid_starts: " << o.ml_grid_starts << "\n"
-    << in << "  ml_screen_events: " << o.ml_screen_events << "\n";
+    << in << "  ml:\n"
+    << in << "    second_start: " << (o.ml.second_start ? "true" : "false") << "\n"
+    << in << "    second_start_max_twist: " << o.ml.second_start_max_twist << "\n"
+    << in << "    second_start_deg: " << o.ml.second_start_deg << "\n"
+    << in << "    grid_starts: " << o.ml.grid_starts << "\n"
+    << in << "    screen_events: " << o.ml.screen_events << "\n";
   return y.str();
 }
 

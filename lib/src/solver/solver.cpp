@@ -104,13 +104,17 @@ std::string RefineOptions::validate() const {
   return e.str();
 }
 
-std::string SolverOptions::validate() const {
-  std::string e = linear.validate() + refine.validate() + npt.validate();
-  if (!(ml_second_start_deg >= 0.0)) e += "ml_second_start_deg must be >= 0; ";
-  if (!(ml_second_start_max_twist >= 0.0)) e += "ml_second_start_max_twist must be >= 0; ";
-  if (ml_grid_starts < 0 || ml_grid_starts > 10000) e += "ml_grid_starts must be in [0, 10000]; ";
-  if (ml_screen_events < 0) e += "ml_screen_events must be >= 0; ";
+std::string MlOptions::validate() const {
+  std::string e;
+  if (!(second_start_deg >= 0.0)) e += "second_start_deg must be >= 0; ";
+  if (!(second_start_max_twist >= 0.0)) e += "second_start_max_twist must be >= 0; ";
+  if (grid_starts < 0 || grid_starts > 10000) e += "grid_starts must be in [0, 10000]; ";
+  if (screen_events < 0) e += "screen_events must be >= 0; ";
   return e;
+}
+
+std::string SolverOptions::validate() const {
+  return linear.validate() + refine.validate() + npt.validate() + ml.validate();
 }
 
 double angleBetween(const Vec3& a, const Vec3& b) {
@@ -423,8 +427,8 @@ SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motio
 namespace {
 // celc_ml: the joint refinement from several starts, keeping the end point of
 // lowest robust cost (the joint problem has several minima, docs/peers.md).
-// Starts: the CELC linear estimate; npt's (when given); ml_grid_starts
-// directions of a hemisphere lattice. A start within ml_second_start_deg of
+// Starts: the CELC linear estimate; npt's (when given); ml.grid_starts
+// directions of a hemisphere lattice. A start within ml.second_start_deg of
 // an end point already found is skipped (same basin). The winner keeps its
 // start's singular values and sign margin; a lattice start's sign is resolved
 // by cheirality.
@@ -439,9 +443,9 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
   if (linear.ok()) starts.push_back({linear.v, &linear});
   if (npt && npt->ok()) starts.push_back({npt->v, npt});
   if (starts.empty()) return linear;  // neither start: the linear stage's status
-  for (const Vec3& d : detail::hemisphereDirections(options.ml_grid_starts)) starts.push_back({d, nullptr});
+  for (const Vec3& d : detail::hemisphereDirections(options.ml.grid_starts)) starts.push_back({d, nullptr});
   double time_us = linear.time_us + (npt ? npt->time_us : 0.0);
-  // With a lattice, the starts are screened on a subset of ml_screen_events
+  // With a lattice, the starts are screened on a subset of ml.screen_events
   // events (the basins are coarse; every start sees the same subset, so the
   // costs compare) and only the winner is refined on all of them.
   // No screening when the subset would hold every event anyway (refining the
@@ -449,11 +453,11 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
   size_t events = 0;
   for (const auto& c : obs.clusters) events += c.size();
   const int full = options.refine.max_events;
-  const bool screen = options.ml_grid_starts > 0 && options.ml_screen_events > 0 &&
-                      (full == 0 || full > options.ml_screen_events) &&
-                      events > static_cast<size_t>(options.ml_screen_events);
+  const bool screen = options.ml.grid_starts > 0 && options.ml.screen_events > 0 &&
+                      (full == 0 || full > options.ml.screen_events) &&
+                      events > static_cast<size_t>(options.ml.screen_events);
   RefineOptions screen_options = options.refine;
-  if (screen) screen_options.max_events = options.ml_screen_events;
+  if (screen) screen_options.max_events = options.ml.screen_events;
   SolverResult best;
   const SolverResult* best_from = nullptr;
   bool have = false;
@@ -461,7 +465,7 @@ SolverResult solveCelcMlMultiStart(const WindowObservations& obs, const MotionMo
   for (const Start& s : starts) {
     bool seen = false;
     for (const Vec3& e : ends)
-      seen = seen || angleBetweenSignAgnostic(s.v, e) * 180.0 / M_PI < options.ml_second_start_deg;
+      seen = seen || angleBetweenSignAgnostic(s.v, e) * 180.0 / M_PI < options.ml.second_start_deg;
     if (seen) continue;
     SolverResult r = refineVelocity(obs, motion, s.v, true, screen_options);
     time_us += r.time_us;
@@ -538,7 +542,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcMl: {
         const bool npt_start =
-            options.ml_second_start && nptModelHolds(obs, motion, options.ml_second_start_max_twist);
+            options.ml.second_start && nptModelHolds(obs, motion, options.ml.second_start_max_twist);
         out.push_back(solveCelcMlMultiStart(obs, motion, getLinear(),
                                             npt_start ? &getNpt() : nullptr, options));
         break;

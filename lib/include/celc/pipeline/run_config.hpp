@@ -46,7 +46,7 @@ struct RunConfig {
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
-    s.ml_grid_starts = 8;
+    s.ml.grid_starts = 8;
     return s;
   }();
   std::vector<Method> methods = allMethods();

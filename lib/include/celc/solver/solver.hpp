@@ -113,29 +113,34 @@ struct NptOptions {
   std::string validate() const;  ///< empty when valid
 };
 
+/// Options of the joint refinement `celc_ml` (v with every cluster's lines).
+struct MlOptions {
+  /// Also start from npt's estimate (sign resolved) when the celc start ends
+  /// more than second_start_deg away from it, and keep the lower robust cost;
+  /// also run from npt alone when celc fails. A remedy for the local minima of
+  /// the joint problem (docs/peers.md). Only where npt's motion model holds:
+  /// GyroIntegrated (P = tau I, exact), or a constant twist turning little,
+  /// |w| max|tau| / 2 <= second_start_max_twist (npt's relative error on the
+  /// displacement).
+  bool second_start = true;
+  double second_start_max_twist = 0.02;  ///< [-] |w| max|tau| / 2
+  double second_start_deg = 2.0;         ///< [deg]
+  /// Also start from this many directions of a hemisphere lattice (0 = off)
+  /// and keep the end point of lowest robust cost; each start costs one joint
+  /// refinement.
+  int grid_starts = 0;
+  /// With grid_starts: every start is refined on a seeded subset of this many
+  /// events, and only the lowest-cost end point on all (refine.max_events) of
+  /// them (0 = every start on all events).
+  int screen_events = 1000;
+  std::string validate() const;  ///< empty when valid
+};
+
 struct SolverOptions {
   LinearOptions linear;
   RefineOptions refine;
   NptOptions npt;
-  /// celc_ml also starts from npt's estimate (sign resolved) when it ends more
-  /// than ml_second_start_deg away from the celc start's result, and keeps the
-  /// lower robust cost; it also runs from npt alone when celc fails. A remedy
-  /// for the local minima of the joint problem (docs/peers.md). Only where
-  /// npt's motion model holds: GyroIntegrated (P = tau I, exact), or a constant
-  /// twist turning little, |w| max|tau| / 2 <= ml_second_start_max_twist (the
-  /// relative error npt makes on the displacement); on the paper's scene
-  /// (|w| T = 1 rad) npt's estimate is far off and would only cost time.
-  bool ml_second_start = true;
-  double ml_second_start_max_twist = 0.02;
-  double ml_second_start_deg = 2.0;  ///< [deg]
-  /// celc_ml also starts from this many directions of a hemisphere lattice
-  /// (0 = off) and keeps the end point of lowest robust cost; each start costs
-  /// one joint refinement.
-  int ml_grid_starts = 0;
-  /// With ml_grid_starts: every start is refined on a seeded subset of this
-  /// many events, and only the lowest-cost end point on all (max_events) of
-  /// them (0 = every start on all events).
-  int ml_screen_events = 1000;
+  MlOptions ml;
   std::string validate() const;
 };
 
