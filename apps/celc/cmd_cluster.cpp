@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
-#include "celc/cluster/cluster_yaml.hpp"
+#include "celc/pipeline/run_config.hpp"
 #include "celc/cluster/dump.hpp"
 #include "celc/io/event_reader.hpp"
 #include "celc/io/window_source.hpp"
@@ -46,12 +46,10 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   configureLogging(a.quiet, a.verbose);
   ClusterOptions opt;
   LineFitOptions lines;
-  if (!a.config.empty()) {  // the config file first, then options given on the command line
-    std::ifstream in(a.config);
-    if (!in) throw std::runtime_error(a.config + ": cannot open");
-    std::stringstream text;
-    text << in.rdbuf();
-    applyClusterYaml(text.str(), a.config, opt, &lines);
+  if (!a.config.empty()) {  // the config file first (its cluster: and lines:), then the options given
+    const RunConfig config = loadRunConfig(a.config);
+    opt = config.cluster;
+    lines = config.observations.lines;
   }
   auto given = [&](const char* name) { return a.config.empty() || cmd.count(name) > 0; };
   if (given("--method")) opt.method = parseClusterMethod(a.method);

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "celc/config/config.hpp"
+#include "celc/core/yaml.hpp"
 #include "celc/io/labelled_events.hpp"
 #include "celc/pipeline/peer_study.hpp"
 #include "celc/pipeline/simulation_study.hpp"
@@ -28,6 +29,7 @@ struct SimulateArgs {
   long long seed = -1;
   int threads = 0;
   bool force = false, no_plots = false, quiet = false, verbose = false;
+  std::vector<std::string> sets;  ///< --set key.path=value
 };
 
 // Finds scripts/<name>: $CELC_SCRIPTS_DIR, the source tree, or next to the binary.
@@ -146,6 +148,7 @@ void runSimulate(const SimulateArgs& a) {
   configureLogging(a.quiet, a.verbose);
   SimulateConfig cfg;
   if (!a.config.empty()) cfg = loadSimulateConfig(a.config);
+  for (const std::string& assignment : a.sets) applySimulateSetting(assignment, cfg);
   if (a.trials > 0) cfg.trials = a.trials;
   if (a.seed >= 0) cfg.seed = static_cast<std::uint64_t>(a.seed);
   if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
@@ -210,11 +213,16 @@ void registerSimulate(CLI::App& app) {
   cmd->add_option("-c,--config", a->config, "YAML configuration (see config/simulate.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--outdir", a->outdir, "output folder")->capture_default_str();
-  cmd->add_option("--trials", a->trials, "random trials per level (default: config, 500)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--seed", a->seed, "random seed (default: config, 1)")->check(CLI::NonNegativeNumber);
+  SimulateConfig defaults;  // help of the options that stand for a key: from the schema
+  const Describe schema = [&](FieldVisitor& v) { describe(v, defaults); };
+  cmd->add_option("--trials", a->trials, fieldHelp(schema, "study.trials"))->check(CLI::PositiveNumber);
+  cmd->add_option("--seed", a->seed, fieldHelp(schema, "study.seed"))->check(CLI::NonNegativeNumber);
+  cmd->add_option("--set", a->sets,
+                  "override any configuration key, e.g. --set scene.n_lines=8 (repeatable; YAML values; "
+                  "`celc config --show simulate --keys` lists every key)");
   cmd->add_option("--threads", a->threads, "worker threads (0 = all cores)")->capture_default_str();
-  cmd->add_option("--methods", a->methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc,npt (default all)");
+  cmd->add_option("--methods", a->methods,
+                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "study.methods"));
   cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
   cmd->add_flag("--no-plots", a->no_plots, "skip the PNG plots");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

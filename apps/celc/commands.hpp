@@ -18,6 +18,8 @@ void registerInfo(CLI::App& app);
 void registerCluster(CLI::App& app);
 /// `celc synth SCENE.yaml -o DIR`: the rendering event simulator (cmd_synth.cpp).
 void registerSynth(CLI::App& app);
+/// `celc config`: defaults and keys of the configuration schema (cmd_config.cpp).
+void registerConfig(CLI::App& app);
 
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   celc::app::registerInfo(app);
   celc::app::registerCluster(app);
   celc::app::registerSynth(app);
+  celc::app::registerConfig(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

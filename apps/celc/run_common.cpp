@@ -7,26 +7,30 @@
 #include <iostream>
 #include <sstream>
 
-#include "celc/config/config.hpp"
+#include "celc/core/yaml.hpp"
 
 namespace celc::app {
 
 void addRunOptions(CLI::App* cmd, RunOverrides& o) {
   cmd->add_option("-c,--config", o.config, "YAML configuration (see config/run.yaml)")
       ->check(CLI::ExistingFile);
+  // Help of the options that stand for a configuration key: from the schema.
+  RunConfig defaults;
+  const Describe schema = [&](FieldVisitor& v) { describe(v, defaults); };
   cmd->add_option("--window-events", o.window_events,
-                  "events per window (the paper's fixed count; overrides windows.events)");
+                  "windows by event count: " + fieldHelp(schema, "windows.events"));
   cmd->add_option("--window-seconds", o.window_seconds,
-                  "window length [s] instead of an event count (overrides windows.seconds)");
-  cmd->add_option("--methods", o.methods, "comma-separated: celc,celc_opt,celc_ml,ce3lc");
+                  "windows by duration: " + fieldHelp(schema, "windows.seconds"));
+  cmd->add_option("--methods", o.methods,
+                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "methods"));
   cmd->add_option("--omega", o.omega,
                   "assume this constant angular velocity wx,wy,wz [rad/s, camera frame] instead of "
                   "the gyroscope (recordings without IMU)");
-  cmd->add_option("--motion-model", o.motion_model, "constant_twist or gyro_integrated");
+  cmd->add_option("--motion-model", o.motion_model, fieldHelp(schema, "motion.model"));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd->add_option("--set", o.sets,
                   "override any configuration key, e.g. --set cluster.smoothness_deg=15 "
-                  "(repeatable; YAML values)");
+                  "(repeatable; YAML values; `celc config --keys` lists every key)");
   cmd->add_option("--shard", o.shard, "K/N: process only windows with index % N == K-1");
   cmd->add_flag("--force", o.force, "replace results already in the output folder");
   cmd->add_flag("--resume", o.resume, "continue a run after its last finished window");
@@ -35,20 +39,7 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
 }
 
 void applySets(const std::vector<std::string>& sets, RunConfig& c) {
-  for (const std::string& s : sets) {
-    const auto eq = s.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw std::runtime_error("--set '" + s + "': expected key.path=value");
-    std::stringstream path(s.substr(0, eq));
-    std::string part, yaml, indent;
-    std::vector<std::string> parts;
-    while (std::getline(path, part, '.')) parts.push_back(part);
-    for (size_t i = 0; i < parts.size(); ++i) {
-      yaml += indent + parts[i] + ":" + (i + 1 == parts.size() ? " " + s.substr(eq + 1) + "\n" : "\n");
-      indent += "  ";
-    }
-    applyRunConfig(yaml, "--set " + s, c);
-  }
+  for (const std::string& s : sets) applyRunSetting(s, c);
 }
 
 RunConfig buildRunConfig(const RunOverrides& o) {

@@ -1,164 +1,72 @@
 #include "celc/io/calibration.hpp"
 
-#include <yaml-cpp/yaml.h>
 
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
-#include <set>
 
+#include "celc/core/yaml.hpp"
 #include "io/text_parse.hpp"
 
 namespace celc::io {
 namespace {
 
-std::string where(const std::string& path, const YAML::Node& n) {
-  const auto m = n.Mark();
-  if (m.line >= 0) return path + ": line " + std::to_string(m.line + 1);
-  return path;
+bool isRotation(const Mat3& R) {
+  return (R.transpose() * R - Mat3::Identity()).norm() <= 1e-4 && R.determinant() > 0.0;
 }
 
-[[noreturn]] void failKey(const std::string& path, const YAML::Node& n, const std::string& key,
-                          const std::string& what) {
-  throw IoError(where(path, n) + ": key '" + key + "': " + what);
+/// A row-major matrix as a list of numbers.
+template <int Rows, int Cols>
+void matrixField(FieldVisitor& v, const FieldInfo& info, Eigen::Matrix<double, Rows, Cols>& m) {
+  const Eigen::Matrix<double, Cols, Rows> t = m.transpose();  // column-major storage = row-major m
+  std::vector<double> flat(t.data(), t.data() + Rows * Cols);
+  v.field(info, flat, {std::size_t(Rows * Cols)});
+  m = Eigen::Map<const Eigen::Matrix<double, Rows, Cols, Eigen::RowMajor>>(flat.data());
 }
 
-double getDouble(const std::string& path, const YAML::Node& n, const std::string& key) {
-  if (!n.IsScalar()) failKey(path, n, key, "expected a number");
-  double v;
-  const std::string s = n.Scalar();
-  if (!detail::parseDouble(s, v) || !std::isfinite(v))
-    failKey(path, n, key, "expected a finite number, found '" + s.substr(0, 40) + "'");
-  return v;
-}
-
-int getInt(const std::string& path, const YAML::Node& n, const std::string& key) {
-  if (!n.IsScalar()) failKey(path, n, key, "expected an integer");
-  long long v;
-  const std::string s = n.Scalar();
-  if (!detail::parseInt(s, v) || v < 1 || v > 65535)
-    failKey(path, n, key, "expected an integer in [1, 65535], found '" + s.substr(0, 40) + "'");
-  return int(v);
-}
-
-std::vector<double> getList(const std::string& path, const YAML::Node& n, const std::string& key,
-                            std::initializer_list<std::size_t> sizes) {
-  if (!n.IsSequence()) failKey(path, n, key, "expected a list of numbers");
-  std::vector<double> v;
-  for (std::size_t i = 0; i < n.size(); ++i) v.push_back(getDouble(path, n[i], key + "[" + std::to_string(i) + "]"));
-  bool ok = false;
-  std::string expect;
-  for (std::size_t s : sizes) {
-    ok |= v.size() == s;
-    expect += (expect.empty() ? "" : " or ") + std::to_string(s);
-  }
-  if (!ok) failKey(path, n, key, "expected " + expect + " numbers, found " + std::to_string(v.size()));
-  return v;
-}
-
-void checkKeys(const std::string& path, const YAML::Node& map, const std::string& section,
-               const std::set<std::string>& allowed) {
-  if (!map.IsMap()) throw IoError(where(path, map) + ": section '" + section + "' must be a mapping");
-  for (auto it = map.begin(); it != map.end(); ++it) {
-    const std::string k = it->first.as<std::string>();
-    if (!allowed.count(k)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw IoError(where(path, it->first) + ": unknown key '" + (section.empty() ? "" : section + ".") + k +
-                    "' (expected one of: " + list + ")");
+void describeCalibration(FieldVisitor& v, Calibration& c) {
+  v.require("camera");
+  v.section({"camera", "", "intrinsics"}, [&](FieldVisitor& s) {
+    for (const char* k : {"width", "height", "fx", "fy", "cx", "cy"}) s.require(k);
+    describe(s, c.camera);
+    const auto& k = c.camera.coeffs;
+    if (c.camera.distortion == DistortionModel::None && (k[0] != 0 || k[1] != 0 || k[2] != 0 || k[3] != 0 || k[4] != 0))
+      s.fail("distortion", "non-zero coefficients with distortion_model none");
+    if (c.camera.distortion == DistortionModel::Equidistant && k[4] != 0.0)
+      s.fail("distortion", "expected 4 numbers for equidistant");
+    if (const std::string err = c.camera.validate(); !err.empty()) s.fail("", err);
+  });
+  c.has_imu = v.has("imu");
+  v.section({"imu", "", "the IMU relative to the camera"}, [&](FieldVisitor& s) {
+    if (s.reading() && s.has("R_cam_imu") && s.has("T_cam_imu"))
+      s.fail("", "give either 'imu.R_cam_imu' or 'imu.T_cam_imu', not both");
+    if (!s.reading() || !s.has("T_cam_imu")) {
+      matrixField(s, {"R_cam_imu", "-", "rotation IMU -> camera, row-major 3x3"}, c.R_cam_imu);
+    } else {
+      Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+      matrixField(s, {"T_cam_imu", "m", "IMU pose in the camera frame, row-major 4x4 (rotation used)"}, T);
+      c.R_cam_imu = T.topLeftCorner<3, 3>();
     }
-  }
-}
-
-Mat3 checkRotation(const std::string& path, const YAML::Node& n, const std::string& key, const Mat3& R) {
-  if ((R.transpose() * R - Mat3::Identity()).norm() > 1e-4 || R.determinant() < 0.0)
-    failKey(path, n, key, "not a rotation matrix (R^T R != I or det < 0)");
-  return R;
+    if (!isRotation(c.R_cam_imu))
+      s.fail(s.has("T_cam_imu") ? "T_cam_imu" : "R_cam_imu", "not a rotation matrix (R^T R != I or det < 0)");
+    s.field({"time_offset", "s", "t_cam = t_imu + time_offset"}, c.time_offset);
+  });
+  c.has_body = v.has("body");
+  v.section({"body", "", "the camera relative to the body of the pose file"}, [&](FieldVisitor& s) {
+    matrixField(s, {"T_body_cam", "m", "camera pose in the body frame, row-major 4x4"}, c.T_body_cam);
+    if (!isRotation(c.T_body_cam.topLeftCorner<3, 3>()))
+      s.fail("T_body_cam", "not a rotation matrix (R^T R != I or det < 0)");
+    if ((c.T_body_cam.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
+      s.fail("T_body_cam", "last row must be 0 0 0 1");
+  });
 }
 
 }  // namespace
 
 Calibration loadCalibrationYaml(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw IoError(path + ": cannot open");
-  } catch (const YAML::Exception& e) {
-    throw IoError(path + ": line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-  }
-  if (!root.IsMap()) throw IoError(path + ": expected a mapping with 'camera', 'imu', 'body'");
   Calibration c;
-  checkKeys(path, root, "", {"camera", "imu", "body"});
-  const YAML::Node cam = root["camera"];
-  if (!cam) throw IoError(path + ": missing section 'camera'");
-  checkKeys(path, cam, "camera", {"width", "height", "fx", "fy", "cx", "cy", "distortion_model", "distortion"});
-  CameraModel& m = c.camera;
-  for (const char* k : {"width", "height", "fx", "fy", "cx", "cy"})
-    if (!cam[k]) throw IoError(where(path, cam) + ": missing key 'camera." + std::string(k) + "'");
-  m.width = getInt(path, cam["width"], "camera.width");
-  m.height = getInt(path, cam["height"], "camera.height");
-  m.fx = getDouble(path, cam["fx"], "camera.fx");
-  m.fy = getDouble(path, cam["fy"], "camera.fy");
-  m.cx = getDouble(path, cam["cx"], "camera.cx");
-  m.cy = getDouble(path, cam["cy"], "camera.cy");
-  m.distortion = DistortionModel::None;
-  if (cam["distortion_model"]) {
-    const YAML::Node dm = cam["distortion_model"];
-    if (!dm.IsScalar()) failKey(path, dm, "camera.distortion_model", "expected none | radtan | equidistant");
-    try {
-      m.distortion = parseDistortionModel(dm.Scalar());
-    } catch (const std::exception& e) {
-      failKey(path, dm, "camera.distortion_model", e.what());
-    }
-  }
-  m.coeffs = {0, 0, 0, 0, 0};
-  if (cam["distortion"]) {
-    const YAML::Node d = cam["distortion"];
-    std::vector<double> v;
-    if (m.distortion == DistortionModel::RadTan) v = getList(path, d, "camera.distortion", {4, 5});
-    else if (m.distortion == DistortionModel::Equidistant) v = getList(path, d, "camera.distortion", {4});
-    else {
-      v = getList(path, d, "camera.distortion", {0, 4, 5});
-      for (double x : v)
-        if (x != 0.0) failKey(path, d, "camera.distortion", "non-zero coefficients with distortion_model none");
-    }
-    for (std::size_t i = 0; i < v.size(); ++i) m.coeffs[i] = v[i];
-  }
-  const std::string err = m.validate();
-  if (!err.empty()) throw IoError(where(path, cam) + ": section 'camera': " + err);
-
-  if (const YAML::Node imu = root["imu"]) {
-    c.has_imu = true;
-    checkKeys(path, imu, "imu", {"R_cam_imu", "T_cam_imu", "time_offset"});
-    if (imu["R_cam_imu"] && imu["T_cam_imu"])
-      throw IoError(where(path, imu) + ": give either 'imu.R_cam_imu' or 'imu.T_cam_imu', not both");
-    if (imu["R_cam_imu"]) {
-      auto v = getList(path, imu["R_cam_imu"], "imu.R_cam_imu", {9});
-      Mat3 R;
-      for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = v[std::size_t(i)];
-      c.R_cam_imu = checkRotation(path, imu["R_cam_imu"], "imu.R_cam_imu", R);
-    }
-    if (imu["T_cam_imu"]) {
-      auto v = getList(path, imu["T_cam_imu"], "imu.T_cam_imu", {16});
-      Mat3 R;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) R(i, j) = v[std::size_t(4 * i + j)];
-      c.R_cam_imu = checkRotation(path, imu["T_cam_imu"], "imu.T_cam_imu", R);
-    }
-    if (imu["time_offset"]) c.time_offset = getDouble(path, imu["time_offset"], "imu.time_offset");
-  }
-  if (const YAML::Node body = root["body"]) {
-    c.has_body = true;
-    checkKeys(path, body, "body", {"T_body_cam"});
-    if (body["T_body_cam"]) {
-      auto v = getList(path, body["T_body_cam"], "body.T_body_cam", {16});
-      for (int i = 0; i < 16; ++i) c.T_body_cam(i / 4, i % 4) = v[std::size_t(i)];
-      checkRotation(path, body["T_body_cam"], "body.T_body_cam", c.T_body_cam.topLeftCorner<3, 3>());
-      if ((c.T_body_cam.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
-        failKey(path, body["T_body_cam"], "body.T_body_cam", "last row must be 0 0 0 1");
-    }
-  }
+  c.camera.distortion = DistortionModel::None;
+  readYamlFile(path, [&](FieldVisitor& v) { describeCalibration(v, c); });
   return c;
 }
 

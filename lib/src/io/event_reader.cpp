@@ -26,6 +26,15 @@ std::string toString(Format format) {
   return "unknown";
 }
 
+std::string toString(ImuColumns columns) {
+  switch (columns) {
+    case ImuColumns::Auto: return "auto";
+    case ImuColumns::RpgAccelFirst: return "rpg";
+    case ImuColumns::GyroFirst: return "gyro_first";
+  }
+  return "auto";
+}
+
 ImuColumns parseImuColumns(const std::string& name) {
   if (name == "auto") return ImuColumns::Auto;
   if (name == "rpg" || name == "accel_first") return ImuColumns::RpgAccelFirst;

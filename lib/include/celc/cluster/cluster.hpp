@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/types.hpp"
 
 namespace celc {
@@ -83,6 +84,9 @@ struct ClusterOptions {
 
   std::string validate() const;  ///< empty when valid, else what is wrong
 };
+/// The schema of the `cluster:` section (core/fields.hpp).
+void describe(FieldVisitor& v, ClusterOptions& options);
+
 
 enum class ClusterStatus {
   Ok,              ///< at least one cluster

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/cluster/cluster.hpp"
 #include "celc/lines/line_fit.hpp"
 #include "celc/solver/observations.hpp"
@@ -21,6 +22,10 @@ struct ObservationOptions {
   int min_events = 20;       ///< clusters with fewer usable events are skipped
   std::string validate() const;  ///< empty when valid
 };
+/// The schema of the `observations:` section; its `lines` are the top-level
+/// `lines:` section of a configuration (core/fields.hpp).
+void describe(FieldVisitor& v, ObservationOptions& options);
+
 
 /// What happened to each cluster.
 struct ObservationReport {

@@ -1,21 +1,17 @@
 #pragma once
 /// \file config.hpp
-/// YAML configuration mapped onto the options structs. One schema, units in
-/// the comments of config/*.yaml. Unknown keys and wrong types are errors
-/// that name the file, the key and its line (ConfigError).
+/// The configuration of `celc simulate`: the scene, the solvers and the study,
+/// one schema (core/fields.hpp) with units in config/simulate.yaml. Unknown
+/// keys and wrong types are ConfigError naming the file, the line and the key.
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
 
 namespace celc {
-
-struct ConfigError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// `celc simulate` configuration: the scene, the solvers and the study.
 struct SimulateConfig {
@@ -24,14 +20,20 @@ struct SimulateConfig {
   std::vector<Method> methods = allMethods();
   int trials = 500;
   std::uint64_t seed = 1;
+  std::string validate() const;  ///< empty when valid
 };
 
-/// Reads a YAML file (sections `scene`, `solver`, `study`); keys not given keep
-/// their defaults. Throws ConfigError ("FILE:LINE: key 'a.b': ...").
+/// The schema: sections `scene`, `solver`, `study` (trials, seed, methods).
+void describe(FieldVisitor& v, SimulateConfig& config);
+
+/// Reads a YAML file onto the defaults; keys not given keep their defaults.
+/// Throws ConfigError ("FILE:LINE: key 'a.b': ...").
 SimulateConfig loadSimulateConfig(const std::string& path);
 /// The same from a YAML string (`origin` names it in errors).
 SimulateConfig parseSimulateConfig(const std::string& yaml, const std::string& origin);
-/// The effective configuration as YAML (every key, with its value).
+/// Applies `key.path=value` (a YAML value) onto `config`, then validates.
+void applySimulateSetting(const std::string& assignment, SimulateConfig& config);
+/// The effective configuration as YAML (every key, with its unit and doc).
 std::string toYaml(const SimulateConfig& config);
 
 }  // namespace celc

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/types.hpp"
 
 namespace celc::eval {
@@ -22,6 +23,9 @@ struct GtVelocityOptions {
   int samples = 11;          ///< evaluation times per window
   std::string validate() const;
 };
+/// The schema of the `groundtruth:` section (core/fields.hpp).
+void describe(FieldVisitor& v, GtVelocityOptions& options);
+
 
 enum class GtStatus { Ok, NotCovered, TooFewPoses, InvalidWindow };
 std::string toString(GtStatus s);  ///< "ok", "gt_not_covered", "gt_too_few_poses", "invalid_window"

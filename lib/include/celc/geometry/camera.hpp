@@ -9,6 +9,7 @@
 #include <array>
 #include <string>
 
+#include "celc/core/fields.hpp"
 #include "celc/types.hpp"
 
 namespace celc {
@@ -44,5 +45,8 @@ struct CameraModel {
   /// Empty when valid, else what is wrong.
   std::string validate() const;
 };
+/// The schema of a camera: size, intrinsics, distortion (core/fields.hpp).
+void describe(FieldVisitor& v, CameraModel& camera);
+
 
 }  // namespace celc

@@ -23,9 +23,9 @@ struct Calibration {
   bool has_body = false;  ///< the file had a `body` section
 };
 
-/// Loads a calibration YAML. Unknown keys, wrong types, wrong list lengths,
-/// non-orthonormal rotations and invalid intrinsics are IoErrors naming the key
-/// and the file (and the line when yaml-cpp knows it).
+/// Loads a calibration YAML (docs/calibration.md). Unknown keys, wrong types,
+/// wrong list lengths, non-orthonormal rotations and invalid intrinsics are
+/// ConfigErrors naming the file, the line and the key.
 Calibration loadCalibrationYaml(const std::string& path);
 
 /// Loads an RPG calib.txt (one line `fx fy cx cy k1 k2 p1 p2 k3`; 4 values =

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/types.hpp"
 
 namespace celc::io {
@@ -44,6 +45,7 @@ enum class ImuColumns {
   GyroFirst,    ///< t wx wy wz ax ay az (UZH-FPV; a leading id column is detected by count)
 };
 ImuColumns parseImuColumns(const std::string& name);  ///< "auto" | "rpg" | "gyro_first"
+std::string toString(ImuColumns columns);             ///< "auto" | "rpg" | "gyro_first"
 
 struct ReaderOptions {
   /// Sensor size [px] when the file does not say (text formats); 0 = unknown:
@@ -62,6 +64,9 @@ struct ReaderOptions {
   /// Empty when valid, else what is wrong.
   std::string validate() const;
 };
+/// The schema of the `input:` section (core/fields.hpp).
+void describe(FieldVisitor& v, ReaderOptions& options);
+
 
 /// Counted warnings (first few messages kept verbatim).
 struct ReaderWarnings {

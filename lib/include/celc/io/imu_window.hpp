@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "celc/geometry/motion_model.hpp"
+#include "celc/core/fields.hpp"
 #include "celc/types.hpp"
 
 namespace celc::io {
@@ -24,6 +25,9 @@ struct GyroWindowOptions {
   double max_gap = 0.02;
   std::string validate() const;
 };
+/// The schema of the gyroscope window checks (core/fields.hpp).
+void describe(FieldVisitor& v, GyroWindowOptions& options);
+
 
 struct GyroWindow {
   GyroStatus status = GyroStatus::NoSamples;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/io/event_reader.hpp"
 
 namespace celc::io {
@@ -31,6 +32,9 @@ struct WindowOptions {
   bool keep_partial = false;
   std::string validate() const;
 };
+/// The schema of the `windows:` section (core/fields.hpp).
+void describe(FieldVisitor& v, WindowOptions& options);
+
 
 struct EventWindow {
   std::uint64_t index = 0;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/solver/observations.hpp"
 
 namespace celc {
@@ -26,6 +27,9 @@ struct LineFitOptions {
   double min_length_px = 3.0;
   std::string validate() const;     ///< empty when valid
 };
+/// The schema of the `lines:` section (core/fields.hpp).
+void describe(FieldVisitor& v, LineFitOptions& options);
+
 
 /// Ok; TooFewEvents (the interval, slid to the centre, still held fewer than
 /// min_events); PoorFit (RMS residual above max_rms_px or length below

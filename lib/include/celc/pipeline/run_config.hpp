@@ -22,6 +22,7 @@ enum class OmegaSource {
   Gyro,   ///< the recording's gyroscope (imu.txt or the aedat IMU), the default
   Fixed,  ///< a constant given in the configuration (recordings without IMU)
 };
+std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
 struct RunConfig {
   io::ReaderOptions reader;
@@ -38,11 +39,8 @@ struct RunConfig {
   ObservationOptions observations;
   /// The solvers' defaults, except the global starts: on clustered real or
   /// rendered events the linear stage's robust cost and the joint refinement
-  /// both have local minima that a single start falls into (measured on
-  /// simulated rooms, docs/synth.md: celc_ml median 0.70 rad without the
-  /// linear lattice, 0.009 rad with it; 0.80 rad without the refinement's
-  /// lattice on 0.15 s windows, 0.059 rad with it).
-  SolverOptions solver = [] {
+  /// both have local minima that a single start falls into.
+  SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
@@ -55,12 +53,22 @@ struct RunConfig {
   std::string validate() const;
 };
 
-/// Applies a YAML document onto `config` (absent keys keep their values).
-/// Throws ConfigError / std::runtime_error naming the origin, line and key.
+/// The schema of `celc run` / `celc batch` configurations (core/fields.hpp):
+/// input, windows, motion, cluster, lines, observations, solver, methods,
+/// groundtruth, seed.
+void describe(FieldVisitor& v, RunConfig& config);
+/// The `cluster:` and `lines:` sections alone, as in a run configuration
+/// (config/cluster.yaml; `celc cluster -c`).
+void describeClustering(FieldVisitor& v, ClusterOptions& cluster, LineFitOptions& lines);
+
+/// Applies a YAML document onto `config` (absent keys keep their values),
+/// then validates. Throws ConfigError naming the origin, line and key.
 void applyRunConfig(const std::string& yaml, const std::string& origin, RunConfig& config);
 /// Reads a file with applyRunConfig onto the defaults.
 RunConfig loadRunConfig(const std::string& path);
-/// The effective configuration as YAML (every key).
+/// Applies `key.path=value` (a YAML value) onto `config`, then validates.
+void applyRunSetting(const std::string& assignment, RunConfig& config);
+/// The effective configuration as YAML (every key, with its unit and doc).
 std::string toYaml(const RunConfig& config);
 
 }  // namespace celc

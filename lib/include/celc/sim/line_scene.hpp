@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/geometry/motion_model.hpp"
 #include "celc/solver/observations.hpp"
@@ -48,6 +49,9 @@ struct LineSceneOptions {
   std::vector<std::array<Vec3, 2>> fixed_segments;
   std::string validate() const;
 };
+/// The schema of the `scene:` section of `celc simulate` (core/fields.hpp).
+void describe(FieldVisitor& v, LineSceneOptions& options);
+
 
 /// One generated trial: what the solvers get, and the truth.
 struct LineSceneTrial {

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/sim/render.hpp"
 #include "celc/sim/scene.hpp"
@@ -95,9 +96,12 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir,
 /// no distortion. Throws std::invalid_argument for another name.
 CameraModel cameraPreset(const std::string& name);
 
-/// Reads SCENE.yaml. Unknown keys, keys that do not apply (e.g. `square` on a
-/// rectangles plane) and wrong types throw std::invalid_argument with
-/// "FILE:LINE: key 'a.b' ..." messages.
+/// The schema of SCENE.yaml (core/fields.hpp): keys that do not apply (e.g.
+/// `square` on a rectangles plane) are unknown keys.
+void describe(FieldVisitor& v, SynthConfig& config);
+
+/// Reads SCENE.yaml. Unknown keys, keys that do not apply and wrong types
+/// throw ConfigError with "FILE:LINE: key 'a.b': ..." messages.
 SynthConfig loadSynthConfig(const std::string& path);
 
 }  // namespace celc::sim

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/geometry/motion_model.hpp"
 #include "celc/solver/observations.hpp"
 
@@ -143,6 +144,13 @@ struct SolverOptions {
   MlOptions ml;
   std::string validate() const;
 };
+
+/// The schema of the `solver:` section and its parts (core/fields.hpp).
+void describe(FieldVisitor& v, LinearOptions& options);
+void describe(FieldVisitor& v, RefineOptions& options);
+void describe(FieldVisitor& v, NptOptions& options);
+void describe(FieldVisitor& v, MlOptions& options);
+void describe(FieldVisitor& v, SolverOptions& options);
 
 /// CELC linear: robust (Huber IRLS) nullspace of the stacked event rows,
 /// geometric row normalisation, sign by cheirality, degeneracy checks.

@@ -1,0 +1,21 @@
+#pragma once
+/// \file shipped_configs.hpp
+/// The configuration files shipped in config/ that list every key with its
+/// unit, doc and default: written from the schema (core/fields.hpp), never by
+/// hand. `celc config --write-defaults config/` regenerates them; a test fails
+/// when a shipped file differs from what the schema writes.
+#include <string>
+#include <vector>
+
+namespace celc {
+
+struct ShippedConfig {
+  std::string file;  ///< name inside config/, e.g. "run.yaml"
+  std::string text;  ///< its full content
+};
+
+/// config/run.yaml (RunConfig defaults), config/simulate.yaml (SimulateConfig
+/// defaults) and config/cluster.yaml (the clustering sections alone).
+std::vector<ShippedConfig> shippedConfigs();
+
+}  // namespace celc

@@ -1,0 +1,42 @@
+// The schema of the clustering options (core/fields.hpp; docs/clustering.md).
+#include "celc/cluster/cluster.hpp"
+#include "celc/cluster/to_observations.hpp"
+
+namespace celc {
+
+void describe(FieldVisitor& v, ClusterOptions& o) {
+  v.enumeration({"method", "", "grid: own region grower (fast); pcl: PCL region growing"}, o.method,
+                {ClusterMethod::Grid, ClusterMethod::Pcl});
+  v.field({"c_px_per_s", "px/s", "time scale of (x, y, c*t); 0 = estimated per window"}, o.c_px_per_s);
+  v.field({"c_min_px_per_s", "px/s", "lower clamp of the estimated time scale"}, o.c_min_px_per_s);
+  v.field({"c_max_px_per_s", "px/s", "upper clamp of the estimated time scale"}, o.c_max_px_per_s);
+  v.field({"separate_polarity", "", "cluster ON and OFF events separately (paper)"}, o.separate_polarity);
+  v.field({"neighbours", "events", "pcl: k nearest neighbours"}, o.neighbours);
+  v.field({"pcl_normal_radius_px", "px", "pcl: normals from this radius in (x, y, c*t); 0 = k nearest"},
+          o.pcl_normal_radius_px);
+  v.field({"grid_radius_px", "px", "grid: normals from a (2r+1)^2 pixel window"}, o.grid_radius_px);
+  v.field({"grow_radius_px", "px", "grid: growing visits a (2r+1)^2 pixel window"}, o.grow_radius_px);
+  v.field({"time_radius_px", "px", "grid, normals: time range in c*t units"}, o.time_radius_px);
+  v.field({"grow_time_radius_px", "px", "grid, growing: time range in c*t units"}, o.grow_time_radius_px);
+  v.field({"normal_reuse_px", "px", "grid: reuse a pixel's normal within this c*t distance (0 = never)"},
+          o.normal_reuse_px);
+  v.field({"min_neighbours", "events", "grid: fewer neighbours -> no normal"}, o.min_neighbours);
+  v.field({"smoothness_deg", "deg", "max angle between neighbouring normals"}, o.smoothness_deg);
+  v.field({"curvature_threshold", "-", "max curvature of a point grown from (0..1/3)"}, o.curvature_threshold);
+  v.field({"min_cluster_size", "events", "smaller clusters are dropped"}, o.min_cluster_size);
+  v.field({"max_cluster_size", "events", "larger regions are not clusters"}, o.max_cluster_size);
+  v.field({"max_plane_rms_px", "px", "max RMS distance to the cluster's plane"}, o.max_plane_rms_px);
+  v.field({"ransac_threshold_px", "px", "inlier distance when splitting a region"}, o.ransac_threshold_px);
+  v.field({"max_split", "", "planes extracted from one region at most"}, o.max_split);
+  v.field({"min_time_span_s", "s", "shortest cluster duration"}, o.min_time_span_s);
+  v.field({"min_extent_px", "px", "smallest spatial extent"}, o.min_extent_px);
+  v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane"}, o.min_density_per_px2);
+  v.field({"threads", "", "worker threads inside one window's clustering"}, o.threads);
+  v.field({"seed", "", "RANSAC seed"}, o.seed);
+}
+
+void describe(FieldVisitor& v, ObservationOptions& o) {
+  v.field({"min_events", "events", "clusters with fewer usable events are skipped"}, o.min_events);
+}
+
+}  // namespace celc

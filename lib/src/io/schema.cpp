@@ -1,0 +1,34 @@
+// The schema of the io module's options (core/fields.hpp).
+#include "celc/io/event_reader.hpp"
+#include "celc/io/imu_window.hpp"
+#include "celc/io/window_source.hpp"
+
+namespace celc::io {
+
+void describe(FieldVisitor& v, ReaderOptions& o) {
+  v.field({"width", "px", "sensor width when the file does not say (0 = unknown)"}, o.width);
+  v.field({"height", "px", "sensor height when the file does not say (0 = unknown)"}, o.height);
+  v.enumeration({"imu_columns", "", "column order of an IMU text file without a header"}, o.imu_columns,
+                {ImuColumns::Auto, ImuColumns::RpgAccelFirst, ImuColumns::GyroFirst});
+  v.field({"time_scale", "s/unit", "text timestamps times this give seconds (1e-6 for us)"},
+          o.text_time_scale);
+  v.field({"strict", "", "every counted warning is an error"}, o.strict);
+  v.field({"max_packet_bytes", "bytes", "largest AEDAT packet decoded"}, o.max_packet_bytes);
+  v.field({"aedat_source", "", "AEDAT 3.1: only this source id (-1 = all)"}, o.aedat_source);
+}
+
+void describe(FieldVisitor& v, WindowOptions& o) {
+  v.field({"events", "events", "events per window (0 = windows by seconds)"}, o.events_per_window);
+  v.field({"seconds", "s", "window length (0 = windows by events)"}, o.seconds_per_window);
+  v.field({"overlap", "-", "share of a window overlapping the next, in [0, 1)"}, o.overlap);
+  v.field({"t_start", "s", "first time used"}, o.t_start);
+  v.field({"t_end", "s", "end of the time used (exclusive)"}, o.t_end);
+  v.field({"read_batch", "events", "events pulled from the reader at a time"}, o.read_batch);
+  v.field({"keep_partial", "", "also emit the last, incomplete window"}, o.keep_partial);
+}
+
+void describe(FieldVisitor& v, GyroWindowOptions& o) {
+  v.field({"gyro_max_gap", "s", "largest gap between gyro samples inside a window"}, o.max_gap);
+}
+
+}  // namespace celc::io

@@ -1,0 +1,65 @@
+// The schema of the solvers' options (core/fields.hpp).
+#include "celc/solver/solver.hpp"
+
+namespace celc {
+
+void describe(FieldVisitor& v, LinearOptions& o) {
+  v.field({"max_rows", "rows", "random subset of event rows (0 = all)"}, o.max_rows);
+  v.field({"balance_clusters", "", "share the rows equally among clusters"}, o.balance_clusters);
+  v.field({"seed", "", "seed of the row subset"}, o.seed);
+  v.field({"max_iterations", "", "IRLS iterations"}, o.max_iterations);
+  v.field({"huber_k", "-", "Huber threshold in robust scales"}, o.huber_k);
+  v.field({"tolerance", "rad", "IRLS stops when the direction moves less"}, o.tolerance);
+  v.field({"grid_directions", "", "global start: hemisphere directions scored (0 = off)"}, o.grid_directions);
+  v.field({"grid_starts", "", "IRLS also runs from the best this many of them"}, o.grid_starts);
+  v.field({"grid_rows", "rows", "rows used to score the directions"}, o.grid_rows);
+  v.field({"min_clusters", "", "fewer usable clusters -> degenerate"}, o.min_clusters);
+  v.field({"min_cluster_events", "events", "a cluster needs this many events to be usable"},
+          o.min_cluster_events);
+  v.field({"max_sigma_ratio", "-", "sigma_min / sigma_second above this -> degenerate"}, o.max_sigma_ratio);
+  v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
+          o.min_parallax_ratio);
+  v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);
+  v.field({"check_parallax", "", "run the parallax test (solveMethods runs it once per window)"},
+          o.check_parallax);
+  v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
+}
+
+void describe(FieldVisitor& v, RefineOptions& o) {
+  v.field({"huber_px", "px", "Huber threshold on the point-line distance"}, o.huber_px);
+  v.field({"max_iterations", "", "Levenberg-Marquardt iterations"}, o.max_iterations);
+  v.field({"max_events", "events", "seeded subset of events (0 = all)"}, o.max_events);
+  v.field({"balance_clusters", "", "share max_events equally among clusters"}, o.balance_clusters);
+  v.field({"seed", "", "seed of the event subset"}, o.seed);
+  v.field({"function_tolerance", "-", "Ceres' relative cost change to stop"}, o.function_tolerance);
+  v.field({"num_threads", "", "Ceres threads per solve"}, o.num_threads);
+}
+
+void describe(FieldVisitor& v, NptOptions& o) {
+  v.field({"min_line_events", "events", "a line needs this many events (>= 5)"}, o.min_line_events);
+  v.field({"min_lines", "", "fewer lines with a partial velocity -> degenerate"}, o.min_lines);
+  v.field({"min_line_sigma_ratio", "-", "a line's system without a unique nullspace is dropped"},
+          o.min_line_sigma_ratio);
+  v.field({"max_sigma_ratio", "-", "averaging: sigma_min / sigma_second above this -> degenerate"},
+          o.max_sigma_ratio);
+}
+
+void describe(FieldVisitor& v, MlOptions& o) {
+  v.field({"second_start", "", "also start from npt's estimate where npt's model holds"}, o.second_start);
+  v.field({"second_start_max_twist", "-", "... when |w| max|tau| / 2 is at most this"},
+          o.second_start_max_twist);
+  v.field({"second_start_deg", "deg", "... and the celc start ends this far from it"}, o.second_start_deg);
+  v.field({"grid_starts", "", "extra starts on a hemisphere lattice, lowest cost kept (0 = off)"},
+          o.grid_starts);
+  v.field({"screen_events", "events", "lattice starts screened on this many events (0 = all)"},
+          o.screen_events);
+}
+
+void describe(FieldVisitor& v, SolverOptions& o) {
+  v.section({"linear", "", "robust linear stage (CELC, CE3LC)"}, [&](FieldVisitor& s) { describe(s, o.linear); });
+  v.section({"refine", "", "Ceres refinement (celc_opt, celc_ml)"}, [&](FieldVisitor& s) { describe(s, o.refine); });
+  v.section({"npt", "", "N-point linear solver (Gao et al. 2024)"}, [&](FieldVisitor& s) { describe(s, o.npt); });
+  v.section({"ml", "", "celc_ml: joint refinement of v and the lines"}, [&](FieldVisitor& s) { describe(s, o.ml); });
+}
+
+}  // namespace celc

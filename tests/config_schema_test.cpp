@@ -1,0 +1,255 @@
+// The one configuration schema (core/fields.hpp, core/yaml.hpp): shipped files
+// regenerate byte for byte, every registered field survives a write and a read,
+// the schema covers every member of the options structs, and bad YAML is an
+// error naming the file, the line and the key.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "celc/config/config.hpp"
+#include "celc/core/yaml.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/pipeline/shipped_configs.hpp"
+#include "celc/sim/render_sequence.hpp"
+
+namespace celc {
+namespace {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Changes every field it visits to a value different from the one it holds.
+class Perturb final : public FieldVisitor {
+ public:
+  void field(const FieldInfo&, bool& v) override { v = !v; }
+  void field(const FieldInfo&, int& v) override { v += 3; }
+  void field(const FieldInfo&, unsigned& v) override { v += 3; }
+  void field(const FieldInfo&, long& v) override { v += 3; }
+  void field(const FieldInfo&, unsigned long& v) override { v += 3; }
+  void field(const FieldInfo&, double& v) override { v = std::isfinite(v) ? v * 1.5 + 0.25 : 7.5; }
+  void field(const FieldInfo&, std::string& v) override { v += "x"; }
+  void field(const FieldInfo&, Vec2& v) override { v = v.allFinite() ? Vec2(v + Vec2(0.5, -0.25)) : Vec2(1, 2); }
+  void field(const FieldInfo&, Vec3& v) override {
+    v = v.allFinite() ? Vec3(v + Vec3(0.5, -0.25, 0.125)) : Vec3(1, 2, 3);
+  }
+  void field(const FieldInfo&, std::vector<double>& v, const std::vector<std::size_t>& sizes) override {
+    for (double& x : v) x += 0.5;
+    if (!sizes.empty() && std::find(sizes.begin(), sizes.end(), v.size()) == sizes.end()) v.resize(sizes.back(), 1.0);
+  }
+  void choice(const FieldInfo&, std::string& v, const std::vector<std::string>& allowed) override {
+    const auto it = std::find(allowed.begin(), allowed.end(), v);
+    v = allowed[(static_cast<std::size_t>(it - allowed.begin()) + 1) % allowed.size()];
+  }
+  void choices(const FieldInfo&, std::vector<std::string>& v, const std::vector<std::string>& allowed) override {
+    if (v.size() > 1) v.erase(v.begin());
+    else v.push_back(allowed.front() == (v.empty() ? "" : v[0]) ? allowed.back() : allowed.front());
+  }
+  void section(const FieldInfo&, const std::function<void(FieldVisitor&)>& body) override { body(*this); }
+  void sequence(const FieldInfo&, std::size_t& count,
+                const std::function<void(std::size_t, FieldVisitor&)>& item) override {
+    ++count;
+    for (std::size_t i = 0; i < count; ++i) item(i, *this);
+  }
+};
+
+// Records which bytes of an object the schema reaches.
+class Coverage final : public FieldVisitor {
+ public:
+  Coverage(const void* base, std::size_t size) : base_(static_cast<const char*>(base)), size_(size) {}
+  void field(const FieldInfo&, bool& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, int& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, unsigned& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, long& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, unsigned long& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, double& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, std::string& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, Vec2& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, Vec3& v) override { member(&v, sizeof v); }
+  void field(const FieldInfo&, std::vector<double>&, const std::vector<std::size_t>&) override {}
+  void choice(const FieldInfo&, std::string&, const std::vector<std::string>&) override {}
+  void choices(const FieldInfo&, std::vector<std::string>&, const std::vector<std::string>&) override {}
+  void section(const FieldInfo&, const std::function<void(FieldVisitor&)>& body) override { body(*this); }
+  void sequence(const FieldInfo&, std::size_t&, const std::function<void(std::size_t, FieldVisitor&)>&) override {}
+  void member(const void* address, std::size_t size) override {
+    const char* p = static_cast<const char*>(address);
+    if (p >= base_ && p + size <= base_ + size_) ranges_.emplace_back(p - base_, p - base_ + size);
+  }
+  /// Byte ranges of the object that no field reaches, beyond alignment padding
+  /// (< 8 bytes, or < 16 bytes before a 16-byte aligned member such as Vec2).
+  std::vector<std::pair<std::size_t, std::size_t>> gaps() const {
+    auto r = ranges_;
+    std::sort(r.begin(), r.end());
+    std::vector<std::pair<std::size_t, std::size_t>> out;
+    std::size_t end = 0;
+    for (const auto& [b, e] : r) {
+      const bool padding = b - end < 8 || (b % 16 == 0 && b - end < 16);
+      if (b > end && !padding) out.emplace_back(end, b);
+      end = std::max(end, e);
+    }
+    if (size_ > end && size_ - end >= 8) out.emplace_back(end, size_);
+    return out;
+  }
+
+ private:
+  const char* base_;
+  std::size_t size_;
+  std::vector<std::pair<std::size_t, std::size_t>> ranges_;
+};
+
+template <class Config>
+std::map<std::string, std::string> values(Config& c) {
+  std::map<std::string, std::string> m;
+  for (const FieldEntry& f : listFields([&](FieldVisitor& v) { describe(v, c); })) m[f.key] = f.value;
+  return m;
+}
+
+// Perturbs every field, writes, reads onto the defaults, compares field by field.
+template <class Config>
+void expectEveryFieldRoundTrips() {
+  Config perturbed;
+  Perturb perturb;
+  describe(perturb, perturbed);
+  const std::string yaml = writeYaml([&](FieldVisitor& v) { describe(v, perturbed); });
+  Config back;
+  readYaml(yaml, "roundtrip.yaml", [&](FieldVisitor& v) { describe(v, back); });
+  Config defaults;
+  const auto want = values(perturbed), got = values(back), before = values(defaults);
+  ASSERT_GT(want.size(), 20u);
+  for (const auto& [key, value] : want) {
+    ASSERT_TRUE(got.count(key)) << key;
+    EXPECT_EQ(got.at(key), value) << key;
+    EXPECT_NE(before.count(key) ? before.at(key) : std::string("<absent>"), value)
+        << key << ": the perturbation did not change it";
+  }
+  EXPECT_EQ(got.size(), want.size());
+}
+
+template <class Config>
+void expectSchemaCoversEveryMember() {
+  Config c;
+  Coverage coverage(&c, sizeof c);
+  describe(coverage, c);
+  for (const auto& [b, e] : coverage.gaps())
+    ADD_FAILURE() << "bytes [" << b << ", " << e << ") of a " << sizeof c
+                  << "-byte config are no registered field: a member without a schema entry";
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ConfigSchema, ShippedFilesAreWhatTheSchemaWrites) {
+  const auto files = shippedConfigs();
+  ASSERT_EQ(files.size(), 3u);
+  for (const ShippedConfig& f : files)
+    EXPECT_EQ(readText(std::string(CELC_SOURCE_DIR "/config/") + f.file), f.text)
+        << "config/" << f.file << " differs from the schema: run `celc config --write-defaults config/`";
+}
+
+TEST(ConfigSchema, ShippedFilesReadToTheDefaults) {
+  RunConfig run = loadRunConfig(CELC_SOURCE_DIR "/config/run.yaml"), run_default;
+  EXPECT_EQ(values(run), values(run_default));
+  SimulateConfig sim = loadSimulateConfig(CELC_SOURCE_DIR "/config/simulate.yaml"), sim_default;
+  EXPECT_EQ(values(sim), values(sim_default));
+}
+
+TEST(ConfigSchema, EveryRunFieldRoundTrips) { expectEveryFieldRoundTrips<RunConfig>(); }
+TEST(ConfigSchema, EverySimulateFieldRoundTrips) { expectEveryFieldRoundTrips<SimulateConfig>(); }
+
+TEST(ConfigSchema, CoversEveryMemberOfTheOptions) {
+  expectSchemaCoversEveryMember<RunConfig>();
+  expectSchemaCoversEveryMember<SimulateConfig>();
+  // The check itself: a struct with an unregistered member fails it (members
+  // that fit in alignment padding, e.g. a lone bool, can hide from it).
+  struct Partial {
+    double a = 1.0;
+    std::string unregistered = "2";
+    int b = 3;
+  };
+  Partial p;
+  Coverage coverage(&p, sizeof p);
+  coverage.field({"a", "", ""}, p.a);
+  coverage.field({"b", "", ""}, p.b);
+  EXPECT_EQ(coverage.gaps().size(), 1u);
+}
+
+TEST(ConfigSchema, ShippedScenesRoundTrip) {
+  for (const char* name : {"sample_davis346_room", "e2e_davis346_room_fast", "davis240_rectangles",
+                           "davis346_chessboard"}) {
+    sim::SynthConfig c = sim::loadSynthConfig(std::string(CELC_SOURCE_DIR "/config/scenes/") + name + ".yaml");
+    const std::string yaml = writeYaml([&](FieldVisitor& v) { describe(v, c); });
+    sim::SynthConfig back;
+    back.camera = sim::cameraPreset(back.camera_preset);
+    readYaml(yaml, name, [&](FieldVisitor& v) { describe(v, back); });
+    EXPECT_EQ(writeYaml([&](FieldVisitor& v) { describe(v, back); }), yaml) << name;
+  }
+}
+
+TEST(ConfigSchema, ErrorsNameFileLineAndKey) {
+  RunConfig c;
+  auto apply = [&](const std::string& text) { return errorOf([&] { applyRunConfig(text, "b.yaml", c); }); };
+  EXPECT_EQ(apply("cluster:\n  smoothnes_deg: 5\n").substr(0, 50), "b.yaml:2: unknown key 'cluster.smoothnes_deg' (all");
+  EXPECT_NE(apply("cluster:\n  smoothnes_deg: 5\n").find("smoothness_deg"), std::string::npos);
+  EXPECT_EQ(apply("cluster:\n  threads: two\n"), "b.yaml:2: key 'cluster.threads': expected an integer (32 bit), got 'two'");
+  EXPECT_EQ(apply("cluster:\n  method: kmeans\n"), "b.yaml:2: key 'cluster.method': expected one of grid, pcl, got 'kmeans'");
+  EXPECT_EQ(apply("windows:\n  events: -5\n"), "b.yaml:2: key 'windows.events': expected a non-negative integer, got '-5'");
+  EXPECT_EQ(apply("solver:\n  linear:\n    huber_k: .nan\n"), "b.yaml:3: key 'solver.linear.huber_k': expected a number, got '.nan'");
+  EXPECT_EQ(apply("solver:\n  linear:\n    max_rows: 1e99\n"), "b.yaml:3: key 'solver.linear.max_rows': expected an integer (32 bit), got '1e99'");
+  EXPECT_EQ(apply("motion:\n  fixed_omega: [1, 2]\n"), "b.yaml:2: key 'motion.fixed_omega': expected a list of 3 numbers, found 2");
+  EXPECT_EQ(apply("methods: [celc, magic]\n"), "b.yaml:1: key 'methods': expected one of celc, celc_opt, celc_ml, ce3lc, npt, got 'magic'");
+  EXPECT_EQ(apply("windows: 3\n"), "b.yaml:1: key 'windows': expected a map of keys, got '3'");
+  EXPECT_EQ(apply("windows:\n  events: 1\nwindows:\n  events: 2\n"), "b.yaml:3: key 'windows': given twice (first at line 1)");
+  EXPECT_EQ(apply("cluster:\n  seed: 1\n  seed: 2\n"), "b.yaml:3: key 'cluster.seed': given twice (first at line 2)");
+  EXPECT_EQ(apply("? [camera]\n: 1\n"), "b.yaml:1: keys must be names, got a list");
+  EXPECT_NE(apply("cluster: [1, 2\n").find("b.yaml:"), std::string::npos);
+  EXPECT_NE(apply("cluster:\n  smoothness_deg: 200\n").find("smoothness_deg must be"), std::string::npos);
+  EXPECT_NE(apply("lines:\n  min_events: 1\n").find("min_events"), std::string::npos);
+  // A failed apply leaves the configuration as it was.
+  EXPECT_EQ(c.cluster.c_px_per_s, ClusterOptions{}.c_px_per_s);
+  EXPECT_NE(apply("cluster:\n  c_px_per_s: 10\n  bogus: 1\n"), "");
+  EXPECT_EQ(c.cluster.c_px_per_s, ClusterOptions{}.c_px_per_s);
+  applyRunConfig("cluster:\n  c_px_per_s: 250\n  method: pcl\n", "ok.yaml", c);
+  EXPECT_EQ(c.cluster.c_px_per_s, 250.0);
+  EXPECT_EQ(c.cluster.method, ClusterMethod::Pcl);
+}
+
+TEST(ConfigSchema, SetAssignments) {
+  RunConfig c;
+  applyRunSetting("solver.ml.grid_starts=3", c);
+  EXPECT_EQ(c.solver.ml.grid_starts, 3);
+  applyRunSetting("solver.npt.min_lines=4", c);
+  EXPECT_EQ(c.solver.npt.min_lines, 4);
+  applyRunSetting("methods=[npt, celc]", c);
+  EXPECT_EQ(c.methods, (std::vector<Method>{Method::Npt, Method::Celc}));
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.grid_start=3", c); }),
+            "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
+            "second_start_max_twist, second_start_deg, grid_starts, screen_events)");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }).substr(0, 30), "--set windows.overlap=2: overl");
+  EXPECT_EQ(c.windows.overlap, 0.0);
+  SimulateConfig s;
+  applySimulateSetting("scene.camera.fx=100", s);
+  EXPECT_EQ(s.scene.camera.fx, 100.0);
+}
+
+TEST(ConfigSchema, HelpComesFromTheSchema) {
+  RunConfig c;
+  const std::string help = fieldHelp([&](FieldVisitor& v) { describe(v, c); }, "windows.seconds");
+  EXPECT_EQ(help, "window length (0 = windows by events) [s] (YAML windows.seconds, default 0.0)");
+}
+
+}  // namespace
+}  // namespace celc
