@@ -59,33 +59,42 @@ std::string stringText(const std::string& s) {
   return e.c_str();
 }
 
-template <class V>
-std::string listText(const V& items, const std::function<std::string(std::size_t)>& one) {
+std::string listText(std::size_t n, const std::function<std::string(std::size_t)>& one) {
   std::string s = "[";
-  for (std::size_t i = 0; i < static_cast<std::size_t>(items); ++i) s += (i ? ", " : "") + one(i);
+  for (std::size_t i = 0; i < n; ++i) s += (i ? ", " : "") + one(i);
   return s + "]";
 }
 
-/// Shared by the writer and the field lister: each value's YAML text.
-struct ValueText {
-  static std::string of(bool v) { return v ? "true" : "false"; }
-  static std::string of(int v) { return std::to_string(v); }
-  static std::string of(unsigned v) { return std::to_string(v); }
-  static std::string of(long v) { return std::to_string(v); }
-  static std::string of(unsigned long v) { return std::to_string(v); }
-  static std::string of(double v) { return numberText(v); }
-  static std::string of(const std::string& v) { return stringText(v); }
-  static std::string of(const Vec2& v) {
-    return listText(2, [&](std::size_t i) { return numberText(v[static_cast<int>(i)]); });
+/// The writer's and the lister's base: every value as its YAML text, handed
+/// to value(); sections and sequences stay theirs.
+class TextVisitor : public FieldVisitor {
+ public:
+  void field(const FieldInfo& i, bool& v) override { value(i, v ? "true" : "false"); }
+  void field(const FieldInfo& i, int& v) override { value(i, std::to_string(v)); }
+  void field(const FieldInfo& i, unsigned& v) override { value(i, std::to_string(v)); }
+  void field(const FieldInfo& i, long& v) override { value(i, std::to_string(v)); }
+  void field(const FieldInfo& i, unsigned long& v) override { value(i, std::to_string(v)); }
+  void field(const FieldInfo& i, double& v) override { value(i, numberText(v)); }
+  void field(const FieldInfo& i, std::string& v) override { value(i, stringText(v)); }
+  void field(const FieldInfo& i, Vec2& v) override { value(i, numbers(v.data(), 2)); }
+  void field(const FieldInfo& i, Vec3& v) override { value(i, numbers(v.data(), 3)); }
+  void field(const FieldInfo& i, std::vector<double>& v, const std::vector<std::size_t>&) override {
+    value(i, numbers(v.data(), v.size()));
   }
-  static std::string of(const Vec3& v) {
-    return listText(3, [&](std::size_t i) { return numberText(v[static_cast<int>(i)]); });
+  void choice(const FieldInfo& i, std::string& v, const std::vector<std::string>& allowed) override {
+    value(i, v, allowed);
   }
-  static std::string of(const std::vector<double>& v) {
-    return listText(v.size(), [&](std::size_t i) { return numberText(v[i]); });
+  void choices(const FieldInfo& i, std::vector<std::string>& v, const std::vector<std::string>& allowed) override {
+    value(i, listText(v.size(), [&](std::size_t k) { return v[k]; }), allowed);
   }
-  static std::string names(const std::vector<std::string>& v) {
-    return listText(v.size(), [&](std::size_t i) { return v[i]; });
+
+ protected:
+  virtual void value(const FieldInfo& info, const std::string& text,
+                     const std::vector<std::string>& allowed = {}) = 0;
+
+ private:
+  static std::string numbers(const double* x, std::size_t n) {
+    return listText(n, [&](std::size_t k) { return numberText(x[k]); });
   }
 };
 
@@ -341,47 +350,29 @@ class Reader final : public FieldVisitor {
 
 // ---- the writer ----------------------------------------------------------------
 
-class Writer final : public FieldVisitor {
+class Writer final : public TextVisitor {
  public:
   Writer(std::ostringstream& out, std::string indent, bool comments)
       : out_(out), indent_(std::move(indent)), comments_(comments) {}
 
-  void field(const FieldInfo& i, bool& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, int& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, unsigned& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, long& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, unsigned long& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, double& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, std::string& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, Vec2& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, Vec3& v) override { line(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, std::vector<double>& v, const std::vector<std::size_t>&) override {
-    line(i, ValueText::of(v));
-  }
-  void choice(const FieldInfo& i, std::string& v, const std::vector<std::string>& allowed) override {
-    line(i, v, allowed);
-  }
-  void choices(const FieldInfo& i, std::vector<std::string>& v, const std::vector<std::string>& allowed) override {
-    line(i, ValueText::names(v), allowed);
-  }
   void section(const FieldInfo& i, const std::function<void(FieldVisitor&)>& body) override {
     std::ostringstream inner;
     Writer sub(inner, indent_ + "  ", comments_);
     body(sub);
     if (inner.str().empty()) {
-      line(i, "{}");
+      value(i, "{}");
       return;
     }
-    line(i, "");
+    value(i, "");
     out_ << inner.str();
   }
   void sequence(const FieldInfo& i, std::size_t& count,
                 const std::function<void(std::size_t, FieldVisitor&)>& item) override {
     if (count == 0) {
-      line(i, "[]");
+      value(i, "[]");
       return;
     }
-    line(i, "");
+    value(i, "");
     for (std::size_t k = 0; k < count; ++k) {
       std::ostringstream inner;
       Writer sub(inner, indent_ + "    ", comments_);
@@ -394,7 +385,7 @@ class Writer final : public FieldVisitor {
   }
 
  private:
-  void line(const FieldInfo& i, const std::string& value, const std::vector<std::string>& allowed = {}) {
+  void value(const FieldInfo& i, const std::string& value, const std::vector<std::string>& allowed = {}) override {
     std::string text = indent_ + i.key + ":" + (value.empty() ? "" : " " + value);
     std::string note;
     if (comments_) {
@@ -420,33 +411,17 @@ class Writer final : public FieldVisitor {
 
 // ---- the lister ----------------------------------------------------------------
 
-class Lister final : public FieldVisitor {
+class Lister final : public TextVisitor {
  public:
   Lister(std::vector<FieldEntry>& out, std::string path) : out_(out), path_(std::move(path)) {}
 
-  void field(const FieldInfo& i, bool& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, int& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, unsigned& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, long& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, unsigned long& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, double& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, std::string& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, Vec2& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, Vec3& v) override { add(i, ValueText::of(v)); }
-  void field(const FieldInfo& i, std::vector<double>& v, const std::vector<std::size_t>&) override {
-    add(i, ValueText::of(v));
-  }
-  void choice(const FieldInfo& i, std::string& v, const std::vector<std::string>&) override { add(i, v); }
-  void choices(const FieldInfo& i, std::vector<std::string>& v, const std::vector<std::string>&) override {
-    add(i, ValueText::names(v));
-  }
   void section(const FieldInfo& i, const std::function<void(FieldVisitor&)>& body) override {
     Lister sub(out_, join(path_, i.key));
     body(sub);
   }
   void sequence(const FieldInfo& i, std::size_t& count,
                 const std::function<void(std::size_t, FieldVisitor&)>& item) override {
-    add(i, "[" + std::to_string(count) + " items]");
+    value(i, "[" + std::to_string(count) + " items]");
     for (std::size_t k = 0; k < count; ++k) {
       Lister sub(out_, join(path_, i.key) + "[" + std::to_string(k) + "]");
       item(k, sub);
@@ -454,7 +429,7 @@ class Lister final : public FieldVisitor {
   }
 
  private:
-  void add(const FieldInfo& i, const std::string& value) {
+  void value(const FieldInfo& i, const std::string& value, const std::vector<std::string>& = {}) override {
     out_.push_back({join(path_, i.key), i.unit ? i.unit : "", i.doc ? i.doc : "", value});
   }
   std::vector<FieldEntry>& out_;
