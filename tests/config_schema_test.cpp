@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -12,6 +13,7 @@
 
 #include "celc/config/config.hpp"
 #include "celc/core/yaml.hpp"
+#include "celc/pipeline/batch.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/shipped_configs.hpp"
 #include "celc/sim/render_sequence.hpp"
@@ -249,6 +251,43 @@ TEST(ConfigSchema, HelpComesFromTheSchema) {
   RunConfig c;
   const std::string help = fieldHelp([&](FieldVisitor& v) { describe(v, c); }, "windows.seconds");
   EXPECT_EQ(help, "window length (0 = windows by events) [s] (YAML windows.seconds, default 0.0)");
+}
+
+TEST(ConfigSchema, BatchFile) {
+  const auto dir = std::filesystem::temp_directory_path() / "celc_batch_schema_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "b.yaml").string();
+  auto write = [&](const std::string& text) { std::ofstream(path, std::ios::binary) << text; };
+  std::string seen_base;
+  auto base = [&](const std::string& p) {
+    seen_base = p;
+    RunConfig c;
+    c.windows.events_per_window = 1234;
+    return c;
+  };
+  write("config: run.yaml\nsequences:\n  - {path: seq, t_end: 0.5}\n"
+        "  - path: /abs/other\n    label: b\n    config:\n      windows: {events: 50}\n");
+  const BatchSpec spec = readBatch(path, base);
+  EXPECT_EQ(seen_base, (dir / "run.yaml").string());
+  ASSERT_EQ(spec.entries.size(), 2u);
+  EXPECT_EQ(spec.entries[0].label, "seq");
+  EXPECT_EQ(spec.entries[0].inputs.events, (dir / "seq").string());
+  EXPECT_EQ(spec.entries[0].t_end, 0.5);
+  EXPECT_EQ(spec.entries[0].config.windows.events_per_window, 1234u);
+  EXPECT_EQ(spec.entries[1].inputs.events, "/abs/other");
+  EXPECT_EQ(spec.entries[1].config.windows.events_per_window, 50u);
+  write("sequences:\n  - {path: a}\n  - {path: b, config: {windows: {evnts: 5}}}\n");
+  EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
+            ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: events, seconds, overlap, "
+            "t_start, t_end, read_batch, keep_partial)");
+  write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");
+  EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
+            ":3: key 'sequences[1].label': duplicate label 'x'");
+  write("sequences: []\n");
+  EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()), ":1: key 'sequences': expected a non-empty list");
+  write("sequences:\n  - {label: a}\n");
+  EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()), ":2: key 'sequences[0]': missing key 'sequences[0].path'");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
+#include "celc/core/yaml.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/cluster/dump.hpp"
 #include "celc/io/event_reader.hpp"
@@ -112,24 +113,22 @@ void registerCluster(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(size_t{1}, size_t{100000000}));
   cmd->add_option("--dump", args->dump, "directory for window_NNNNN.png (x-y and x-t views) and .ply");
-  cmd->add_option("--method", args->method, "grid (fast, default) or pcl (PCL region growing reference)")
-      ->capture_default_str();
-  cmd->add_option("--c-px-per-s", args->c, "time scale c [px/s] of the points (x, y, c t); 0 = automatic")
-      ->capture_default_str();
+  // Help of the options that stand for a key: from the schema.
+  ClusterOptions cluster_defaults;
+  LineFitOptions line_defaults;
+  const Describe schema = [&](FieldVisitor& v) { describeClustering(v, cluster_defaults, line_defaults); };
+  cmd->add_option("--method", args->method, fieldHelp(schema, "cluster.method"));
+  cmd->add_option("--c-px-per-s", args->c, fieldHelp(schema, "cluster.c_px_per_s"));
   cmd->add_flag("--merge-polarity", args->merge_polarity, "cluster ON and OFF events together");
   cmd->add_option("--threads", args->threads, "worker threads")->capture_default_str();
   cmd->add_option("--max-windows", args->max_windows, "stop after this many windows (0 = all)")
       ->capture_default_str();
   cmd->add_option("--width", args->width, "sensor width for the PNG [px] (0 = from the events)");
   cmd->add_option("--height", args->height, "sensor height for the PNG [px] (0 = from the events)");
-  cmd->add_option("--smoothness-deg", args->smoothness_deg, "max angle between neighbouring normals [deg]")
-      ->capture_default_str();
-  cmd->add_option("--curvature", args->curvature, "max curvature of a point a region grows from [-]")
-      ->capture_default_str();
-  cmd->add_option("--min-cluster-size", args->min_cluster_size, "smallest cluster [events]")
-      ->capture_default_str();
-  cmd->add_option("--max-plane-rms", args->max_plane_rms_px, "max RMS plane distance of a cluster [px]")
-      ->capture_default_str();
+  cmd->add_option("--smoothness-deg", args->smoothness_deg, fieldHelp(schema, "cluster.smoothness_deg"));
+  cmd->add_option("--curvature", args->curvature, fieldHelp(schema, "cluster.curvature_threshold"));
+  cmd->add_option("--min-cluster-size", args->min_cluster_size, fieldHelp(schema, "cluster.min_cluster_size"));
+  cmd->add_option("--max-plane-rms", args->max_plane_rms_px, fieldHelp(schema, "cluster.max_plane_rms_px"));
   cmd->add_option("-c,--config", args->config,
                   "YAML with 'cluster:' and 'lines:' sections (config/cluster.yaml); command-line "
                   "options given explicitly override it");
