@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "celc/io/sequence_layout.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 #include "run_common.hpp"
@@ -46,13 +47,14 @@ void registerRun(CLI::App& app) {
   auto a = std::make_shared<RunArgs>();
   auto* cmd = app.add_subcommand(
       "run",
-      "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (events.txt, "
-      "imu.txt, groundtruth.txt, calib.yaml|calib.txt) or an events/aedat file with --calib "
-      "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
-      "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
+      "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (" +
+          io::sequenceLayoutSummary() +
+          ") or an events/aedat file with --calib "
+          "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
+          "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");
-  cmd->add_option("--calib", a->calib, "calibration YAML (docs/calibration.md) or calib.txt")
+  cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/calibration.md) or ") + io::sequence_file::kCalibText)
       ->check(CLI::ExistingFile);
   cmd->add_option("--groundtruth", a->groundtruth, "poses `t px py pz qx qy qz qw` [s, m]")
       ->check(CLI::ExistingFile);

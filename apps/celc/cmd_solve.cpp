@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "celc/config/config.hpp"
+#include "celc/core/text.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/io/calibration.hpp"
 #include "celc/io/labelled_events.hpp"
@@ -29,10 +30,8 @@ struct SolveArgs {
 };
 
 Vec3 parseVec3(const std::string& text, const std::string& what) {
-  std::stringstream ss(text);
-  std::string item;
   std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
+  for (const std::string& item : splitList(text, ',')) {
     try {
       size_t used = 0;
       v.push_back(std::stod(item, &used));

@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "celc/io/sequence_layout.hpp"
 #include "celc/sim/render_sequence.hpp"
 #include "commands.hpp"
 
@@ -65,6 +66,13 @@ void runSynth(const SynthArgs& a) {
       summary.poses, summary.wall_seconds,
       summary.wall_seconds > 0 ? summary.events / summary.wall_seconds * 1e-6 : 0.0);
 }
+
+// "events.txt, labels.txt, ...": the files `celc synth` writes.
+std::string synthFileList() {
+  std::string list;
+  for (const char* name : io::simulatedSequenceFiles()) list += (list.empty() ? "" : ", ") + std::string(name);
+  return list;
+}
 }  // namespace
 
 void registerSynth(CLI::App& app) {
@@ -72,8 +80,8 @@ void registerSynth(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "synth",
       "Rendering event simulator: textured planes seen by a moving DAVIS-like camera; writes an\n"
-      "RPG-style sequence directory (events.txt, imu.txt, groundtruth.txt, calib.txt, calib.yaml,\n"
-      "labels.txt, twist.yaml, twist.txt, edges.txt). Schema: docs/synth.md, config/scenes/.");
+      "RPG-style sequence directory (" +
+          synthFileList() + ").\nSchema: docs/synth.md, config/scenes/.");
   cmd->add_option("scene", args->scene, "SCENE.yaml describing camera, planes, motion, events, IMU")
       ->required()
       ->check(CLI::ExistingFile);

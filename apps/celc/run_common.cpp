@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "celc/core/text.hpp"
 #include "celc/core/yaml.hpp"
 
 namespace celc::app {
@@ -56,9 +57,7 @@ RunConfig buildRunConfig(const RunOverrides& o) {
   if (!o.motion_model.empty()) c.motion = parseMotionModelKind(o.motion_model);
   if (!o.omega.empty()) {
     std::vector<double> w;
-    std::stringstream ss(o.omega);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
+    for (const std::string& item : splitList(o.omega, ',')) {
       try {
         w.push_back(std::stod(item));
       } catch (const std::exception&) {

@@ -6,7 +6,8 @@
 #include <cmath>
 #include <random>
 #include <sstream>
-#include <thread>
+
+#include "celc/core/parallel.hpp"
 
 #include "cluster/internal.hpp"
 
@@ -351,11 +352,10 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   const bool need_index = opt.method == ClusterMethod::Grid || opt.c_px_per_s <= 0.0;
   if (need_index) {
     indexes.reserve(groups.size());
-    if (groups.size() == 2 && opt.threads >= 2) {
+    if (groups.size() == 2 && opt.threads >= 2) {  // the two polarities' indexes side by side
       indexes.emplace_back(Group{});
-      std::thread other([&] { indexes[0] = cluster_detail::GridIndex(groups[0]); });
-      indexes.emplace_back(groups[1]);
-      other.join();
+      indexes.emplace_back(Group{});
+      parallelFor(2, 2, [&](std::size_t k) { indexes[k] = cluster_detail::GridIndex(groups[k]); });
     } else {
       for (const Group& g : groups) indexes.emplace_back(g);
     }
@@ -387,10 +387,9 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
         ms_normals += normals[k].ms;
       }
     }
-    std::thread other(
-        [&] { outs[1] = processGroup(events, groups[1], indexOf(1), c, opt, per, &normals[1]); });
-    outs[0] = processGroup(events, groups[0], indexOf(0), c, opt, per, &normals[0]);
-    other.join();
+    parallelFor(2, 2, [&](std::size_t k) {
+      outs[k] = processGroup(events, groups[k], indexOf(k), c, opt, per, &normals[k]);
+    });
     outs[0].ms_normals += ms_normals;
   } else {
     for (size_t k = 0; k < groups.size(); ++k)

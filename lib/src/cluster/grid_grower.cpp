@@ -7,7 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <thread>
+
+#include "celc/core/parallel.hpp"
 
 #include "cluster/internal.hpp"
 
@@ -184,20 +185,19 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
     work(0, n_pix);
     return;
   }
-  // Split the pixels so that each worker gets about the same number of events.
-  std::vector<std::thread> pool;
-  int p0 = 0;
+  // Split the pixels so that each worker gets about the same number of events;
+  // part t covers pixels [bounds[t], bounds[t + 1]).
+  std::vector<int> bounds{0};
   for (int t = 0; t < threads; ++t) {
     const size_t target = size() * static_cast<size_t>(t + 1) / static_cast<size_t>(threads);
     int p1 = t + 1 == threads
                  ? n_pix
                  : static_cast<int>(std::upper_bound(start_.begin(), start_.end(), static_cast<int>(target)) -
                                     start_.begin()) - 1;
-    p1 = std::clamp(p1, p0, n_pix);
-    pool.emplace_back(work, p0, p1);
-    p0 = p1;
+    bounds.push_back(std::clamp(p1, bounds.back(), n_pix));
   }
-  for (auto& th : pool) th.join();
+  parallelFor(static_cast<std::size_t>(threads), threads,
+              [&](std::size_t t) { work(bounds[t], bounds[t + 1]); });
 }
 
 GridNormals computeGridNormals(const GridIndex& index, double c, const ClusterOptions& opt,

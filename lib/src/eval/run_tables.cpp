@@ -1,5 +1,7 @@
 #include "celc/eval/run_tables.hpp"
 
+#include "celc/core/text.hpp"
+#include "celc/eval/metrics.hpp"
 #include "celc/eval/statistics.hpp"
 
 #include <algorithm>
@@ -17,21 +19,6 @@ std::string windowsCsvHeader() {
 }
 
 namespace {
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> f;
-  std::string cur;
-  for (char c : line) {
-    if (c == ',') {
-      f.push_back(cur);
-      cur.clear();
-    } else if (c != '\r') {
-      cur += c;
-    }
-  }
-  f.push_back(cur);
-  return f;
-}
 
 double toDouble(const std::string& s, const std::string& where, const char* col) {
   double v = 0.0;
@@ -77,7 +64,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     }
     if (l.empty()) continue;
     const bool last = i + 1 == lines.size();
-    const auto f = split(l);
+    const auto f = splitList(l, ',');
     try {
       if (f.size() != 16)
         throw std::runtime_error(where + ": expected 16 columns, got " + std::to_string(f.size()));
@@ -148,7 +135,7 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows) {
       s.resultant_length = sum.norm() / static_cast<double>(dirs.size());
       const Vec3 m = sum.norm() > 0 ? Vec3(sum.normalized()) : dirs.front();
       std::vector<double> ang;
-      for (const auto& d : dirs) ang.push_back(std::atan2(d.cross(m).norm(), d.dot(m)));
+      for (const auto& d : dirs) ang.push_back(directionAngle(d, m));
       s.spread_median = median(ang);
     }
     out.push_back(s);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "celc/io/sequence_layout.hpp"
 #include "celc/io/text_io.hpp"
 #include "io/aedat_readers.hpp"
 
@@ -71,8 +72,8 @@ bool exists(const std::string& p) {
 
 Format detectFormat(const std::string& path) {
   if (isDir(path)) {
-    if (!exists(path + "/events.txt"))
-      throw IoError(path + ": directory without events.txt (expected the RPG / UZH-FPV layout)");
+    if (!isSequenceDirectory(path))
+      throw IoError(path + ": directory without " + sequence_file::kEvents + " (expected the RPG / UZH-FPV layout)");
     return Format::RpgDirectory;
   }
   std::FILE* f = std::fopen(path.c_str(), "rb");
@@ -97,10 +98,10 @@ std::unique_ptr<EventReader> openEventSource(const std::string& path, const Read
   if (!err.empty()) throw IoError(path + ": invalid reader options: " + err);
   switch (detectFormat(path)) {
     case Format::RpgDirectory: {
-      const std::string imu = exists(path + "/imu.txt") ? path + "/imu.txt" : std::string();
-      auto reader = openTextEvents(path + "/events.txt", imu, options);
-      for (const char* f : {"imu.txt", "groundtruth.txt", "calib.txt"})
-        reader->addNote(std::string(f) + (exists(path + "/" + f) ? " present" : " absent"));
+      const SequenceLayout layout = resolveSequenceLayout(path);
+      auto reader = openTextEvents(layout.events, layout.imu, options);
+      for (const char* f : {sequence_file::kImu, sequence_file::kGroundTruth, sequence_file::kCalibText})
+        reader->addNote(std::string(f) + (exists(sequenceFilePath(path, f)) ? " present" : " absent"));
       return reader;
     }
     case Format::Text: return openTextEvents(path, "", options);

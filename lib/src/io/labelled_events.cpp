@@ -7,21 +7,15 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "celc/core/text.hpp"
+
 namespace celc {
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  const auto e = s.find_last_not_of(" \t\r");
-  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-}
-
+/// The comma-separated fields of a line, each without surrounding blanks.
 std::vector<std::string> splitComma(const std::string& line) {
-  std::vector<std::string> out;
-  std::string field;
-  std::stringstream ss(line);
-  while (std::getline(ss, field, ',')) out.push_back(trim(field));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
+  std::vector<std::string> out = splitList(line, ',');
+  for (std::string& field : out) field = trimBlanks(field);
   return out;
 }
 
@@ -51,7 +45,7 @@ std::vector<LabelledEvent> readLabelledEvents(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     const std::string where = path + ":" + std::to_string(line_no);
-    const std::string t = trim(line);
+    const std::string t = trimBlanks(line);
     if (t.empty() || t[0] == '#') continue;
     const auto f = splitComma(t);
     if (!header_seen) {

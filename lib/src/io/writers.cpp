@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -180,9 +181,35 @@ std::vector<unsigned char> compress(const std::vector<unsigned char>& in, Aedat4
 
 }  // namespace
 
+int formatEventLine(char* out, std::size_t cap, double t, int x, int y, bool on) {
+  return std::snprintf(out, cap, "%.9f %d %d %d", t, x, y, on ? 1 : 0);
+}
+
+char* putEventLineMicros(char* p, std::int64_t t_us, int x, int y, bool on) {
+  char* const end = p + kEventLineMicrosMaxChars;
+  if (t_us < 0) {
+    *p++ = '-';
+    t_us = -t_us;
+  }
+  p = std::to_chars(p, end, static_cast<std::uint64_t>(t_us / 1000000)).ptr;
+  *p++ = '.';
+  std::int64_t frac = t_us % 1000000;
+  for (std::int64_t d = 100000; d > 0; d /= 10) {
+    *p++ = static_cast<char>('0' + frac / d);
+    frac %= d;
+  }
+  *p++ = ' ';
+  p = std::to_chars(p, end, x).ptr;
+  *p++ = ' ';
+  p = std::to_chars(p, end, y).ptr;
+  *p++ = ' ';
+  *p++ = on ? '1' : '0';
+  return p;
+}
+
 void writeEventsText(const std::string& path, const std::vector<Event>& ev, const TextWriteOptions& o) {
   textLines(path, o, ev.size(), [&](std::size_t i, char* p, std::size_t cap) {
-    return std::snprintf(p, cap, "%.9f %d %d %d", ev[i].t, int(ev[i].x), int(ev[i].y), ev[i].on ? 1 : 0);
+    return formatEventLine(p, cap, ev[i].t, int(ev[i].x), int(ev[i].y), ev[i].on);
   });
 }
 

@@ -1,17 +1,14 @@
 #include "celc/pipeline/peer_study.hpp"
 
-#include "celc/eval/statistics.hpp"
-
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <map>
-#include <numeric>
 #include <random>
 #include <sstream>
-#include <thread>
 
 #include "celc/eval/crlb.hpp"
+#include "celc/eval/statistics.hpp"
+#include "celc/pipeline/study_engine.hpp"
 
 namespace celc {
 
@@ -110,54 +107,34 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
   const int n_cells = static_cast<int>(cells.size());
   const int n_trials = config.trials;
   const int n_methods = static_cast<int>(config.methods.size());
-  const int total = n_cells * n_trials;
   constexpr double kDeg = 180.0 / M_PI;
 
-  struct Outcome {
-    bool ok = false;
-    double phi = 0, agn = 0, time_us = 0;
-  };
-  std::vector<Outcome> outcomes(static_cast<size_t>(total) * n_methods);
-  std::vector<double> bounds(static_cast<size_t>(total), NAN);  // [rad], NaN when no trial
-  std::atomic<int> next{0}, done{0};
-  auto worker = [&]() {
-    for (int job = next++; job < total; job = next++) {
-      const int ci = job / n_trials, trial = job % n_trials;
-      const PeerCell& cell = cells[static_cast<size_t>(ci)];
-      PeerSceneOptions scene = config.scene;
-      cell.apply(scene);
-      std::seed_seq seq{static_cast<std::uint32_t>(config.seed),
-                        static_cast<std::uint32_t>(config.seed >> 32), cellHash(cell),
-                        static_cast<std::uint32_t>(trial)};
-      std::mt19937_64 rng(seq);
-      const PeerSceneTrial tr = generatePeerScene(scene, rng);
-      if (tr.ok) {
+  StudyPlan plan;
+  for (const PeerCell& cell : cells) plan.cells.push_back({cellHash(cell)});
+  plan.trials = n_trials;
+  plan.methods = n_methods;
+  plan.seed = config.seed;
+  plan.threads = threads;
+  // Per trial: every method's outcome, and the bound as the reference [rad]
+  // (NaN when the trial has none).
+  const StudyOutcomes outcomes = runStudy(
+      plan,
+      [&](std::size_t ci, int, std::mt19937_64& rng) {
+        PeerSceneOptions scene = config.scene;
+        cells[ci].apply(scene);
+        const PeerSceneTrial tr = generatePeerScene(scene, rng);
+        TrialOutcome out;
+        if (!tr.ok) return out;
         const CrlbResult b = velocityDirectionCrlb(tr.truth, tr.true_motion, tr.true_direction,
                                                    scene.event_noise_px);
-        if (b.ok) bounds[static_cast<size_t>(job)] = b.rms_rad;
+        if (b.ok) out.reference = b.rms_rad;
         SolverOptions so = config.solver;
         so.linear.seed = rng();
         const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, so);
-        for (int m = 0; m < n_methods; ++m) {
-          Outcome& o = outcomes[static_cast<size_t>(job) * n_methods + m];
-          const SolverResult& r = res[static_cast<size_t>(m)];
-          o.ok = r.ok();
-          if (!o.ok) continue;
-          o.phi = angleBetween(tr.true_direction, r.v);
-          o.agn = std::min(o.phi, M_PI - o.phi);
-          o.time_us = r.time_us;
-        }
-      }
-      const int d = ++done;
-      if (progress) progress(d, total);
-    }
-  };
-  const int n_threads =
-      std::max(1, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < n_threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+        out.methods = scoreResults(res, tr.true_direction);
+        return out;
+      },
+      progress);
 
   std::vector<PeerCellResult> rows;
   for (int ci = 0; ci < n_cells; ++ci) {
@@ -170,18 +147,19 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
       double sq = 0.0, bound_sq = 0.0;
       int above = 0, n_bound = 0;
       for (int t = 0; t < n_trials; ++t) {
-        const size_t job = static_cast<size_t>(ci * n_trials + t);
-        const Outcome& o = outcomes[job * n_methods + m];
+        const TrialOutcome& trial = outcomes.trial(static_cast<size_t>(ci), t);
+        const MethodOutcome& o = trial.methods[static_cast<size_t>(m)];
         if (!o.ok) continue;
         phi.push_back(o.phi * kDeg);
-        agn.push_back(o.agn * kDeg);
+        agn.push_back(o.phi_sign_agnostic * kDeg);
         time.push_back(o.time_us);
-        sq += o.agn * o.agn;
-        if (o.agn * kDeg > 5.0) ++above;
+        sq += o.phi_sign_agnostic * o.phi_sign_agnostic;
+        if (o.phi_sign_agnostic * kDeg > 5.0) ++above;
         // NaN: no bound for this trial; +inf: direction unobservable (kept).
-        if (!std::isnan(bounds[job])) {
-          bound.push_back(bounds[job] * kDeg);
-          bound_sq += bounds[job] * bounds[job];
+        const double bound_rad = trial.reference;
+        if (!std::isnan(bound_rad)) {
+          bound.push_back(bound_rad * kDeg);
+          bound_sq += bound_rad * bound_rad;
           ++n_bound;
         }
       }

@@ -2,15 +2,13 @@
 
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <filesystem>
-#include <map>
-#include <mutex>
-#include <thread>
 
+#include "celc/core/parallel.hpp"
+#include "celc/eval/metrics.hpp"
 #include "celc/geometry/undistort.hpp"
 #include "celc/io/calibration.hpp"
+#include "celc/io/sequence_layout.hpp"
 #include "celc/io/text_io.hpp"
 
 namespace fs = std::filesystem;
@@ -21,11 +19,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
-}
-std::string firstExisting(const fs::path& dir, std::initializer_list<const char*> names) {
-  for (const char* n : names)
-    if (fs::exists(dir / n)) return (dir / n).string();
-  return {};
 }
 }  // namespace
 
@@ -48,14 +41,15 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
   if (const std::string err = config.validate(); !err.empty())
     throw std::runtime_error("configuration: " + err);
   if (!fs::exists(in.events)) throw std::runtime_error(in.events + ": no such file or directory");
-  const bool is_dir = fs::is_directory(in.events);
-  const fs::path dir = is_dir ? fs::path(in.events) : fs::path(in.events).parent_path();
-  if (m.inputs.calib.empty() && is_dir)
-    m.inputs.calib = firstExisting(dir, {"calib.yaml", "calib.yml", "calib.txt"});
-  if (m.inputs.groundtruth.empty() && is_dir)
-    m.inputs.groundtruth = firstExisting(dir, {"groundtruth.txt"});
+  if (fs::is_directory(in.events)) {  // a sequence directory: what the inputs do not name
+    const io::SequenceLayout layout = io::resolveSequenceLayout(in.events);
+    if (m.inputs.calib.empty()) m.inputs.calib = layout.calib;
+    if (m.inputs.groundtruth.empty()) m.inputs.groundtruth = layout.groundtruth;
+  }
   if (m.inputs.calib.empty())
-    throw std::runtime_error(in.events + ": no calibration (give --calib, or put calib.yaml / calib.txt in the sequence directory)");
+    throw std::runtime_error(in.events + ": no calibration (give --calib, or put " +
+                             io::sequence_file::kCalibYaml + " / " + io::sequence_file::kCalibText +
+                             " in the sequence directory)");
 
   m.reader = io::openEventSource(in.events, m.config.reader);
   const int w = m.reader->width() > 0 ? m.reader->width() : 240;
@@ -178,8 +172,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     row.result = results[i];
     if (row.result.ok() && rec.has_gt) {
       row.has_metrics = true;
-      row.eps = (rec.gt - row.result.v).norm();
-      row.phi = angleBetween(rec.gt, row.result.v);
+      row.eps = eval::directionDistance(rec.gt, row.result.v);
+      row.phi = eval::directionAngle(rec.gt, row.result.v);
     }
   }
   return rec;
@@ -191,122 +185,50 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   Impl& m = *impl_;
   RunStats stats;
   const auto start = Clock::now();
-  const int n_workers = std::max(1, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()));
-
   struct Job {
-    std::uint64_t index;
-    double t0, t1;
+    std::uint64_t index = 0;
+    double t0 = 0.0, t1 = 0.0;
     std::vector<Event> events;
   };
-  std::mutex mu;
-  std::condition_variable cv_jobs, cv_done;
-  std::deque<Job> jobs;
-  std::map<std::uint64_t, WindowRecord> done;  // finished, waiting for their turn
-  bool no_more = false;
-  std::exception_ptr error;
-  const std::size_t max_in_flight = static_cast<std::size_t>(n_workers) + 2;  // memory bound
-
-  auto worker = [&]() {
-    for (;;) {
-      Job job;
-      {
-        std::unique_lock<std::mutex> lock(mu);
-        cv_jobs.wait(lock, [&] { return !jobs.empty() || no_more; });
-        if (jobs.empty()) return;
-        job = std::move(jobs.front());
-        jobs.pop_front();
-      }
-      WindowRecord rec;
-      try {
-        rec = processWindow(job.index, job.t0, job.t1, job.events);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (!error) error = std::current_exception();
-        rec.index = job.index;
-        rec.window_status = "error";
-      }
-      {
-        std::lock_guard<std::mutex> lock(mu);
-        done.emplace(job.index, std::move(rec));
-      }
-      cv_done.notify_all();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int i = 0; i < n_workers; ++i) pool.emplace_back(worker);
-
-  // Hands finished windows to the sink in order; returns how many are in flight.
-  std::vector<std::uint64_t> order;  // indices submitted, in order
-  std::size_t next_out = 0;
-  auto drain = [&](bool wait_all) {
-    for (;;) {
-      WindowRecord rec;
-      {
-        std::unique_lock<std::mutex> lock(mu);
-        const std::size_t in_flight = order.size() - next_out;
-        if (in_flight == 0) return;
-        const bool must_wait = wait_all || in_flight >= max_in_flight;
-        const std::uint64_t want = order[next_out];
-        if (!done.count(want)) {
-          if (!must_wait) return;
-          cv_done.wait(lock, [&] { return done.count(want) > 0; });
+  io::WindowSource source(*m.reader, m.config.windows);
+  io::EventWindow window;
+  // Windows read and not yet written: a bound on the memory held.
+  const std::size_t max_in_flight = static_cast<std::size_t>(resolveThreadCount(threads)) + 2;
+  orderedParallelMap<Job, WindowRecord>(
+      threads, max_in_flight,
+      [&](Job& job) {  // the next wanted window, read on this thread
+        for (;;) {
+          const auto t_read = Clock::now();
+          const bool more = source.next(window);
+          stats.seconds_reading += secondsSince(t_read);
+          if (!more) return false;
+          stats.windows_read++;
+          stats.events_read += window.events.size();
+          const auto idx = static_cast<std::int64_t>(window.index);
+          const bool wanted = idx > filter.after && filter.shard_count > 0 &&
+                              idx % filter.shard_count == filter.shard_index;
+          if (!wanted) continue;
+          job.index = window.index;
+          job.t0 = window.t0;
+          job.t1 = window.t1;
+          job.events = std::move(window.events);
+          window.events = {};
+          return true;
         }
-        rec = std::move(done[want]);
-        done.erase(want);
-        ++next_out;
-      }
-      stats.windows_processed++;
-      stats.events_processed += rec.n_events;
-      stats.stage_seconds.cluster += rec.times.cluster;
-      stats.stage_seconds.lines += rec.times.lines;
-      stats.stage_seconds.solve += rec.times.solve;
-      stats.stage_seconds.groundtruth += rec.times.groundtruth;
-      sink(rec);
-      if (progress) progress(stats.windows_processed, stats.events_processed);
-    }
-  };
-
-  try {
-    io::WindowSource source(*m.reader, m.config.windows);
-    io::EventWindow window;
-    for (;;) {
-      const auto t_read = Clock::now();
-      const bool more = source.next(window);
-      stats.seconds_reading += secondsSince(t_read);
-      if (!more) break;
-      stats.windows_read++;
-      stats.events_read += window.events.size();
-      const auto idx = static_cast<std::int64_t>(window.index);
-      const bool wanted = idx > filter.after && filter.shard_count > 0 &&
-                          idx % filter.shard_count == filter.shard_index;
-      if (!wanted) continue;
-      {
-        std::lock_guard<std::mutex> lock(mu);
-        jobs.push_back(Job{window.index, window.t0, window.t1, std::move(window.events)});
-        order.push_back(window.index);
-      }
-      window.events = {};
-      cv_jobs.notify_one();
-      drain(false);
-      {
-        std::lock_guard<std::mutex> lock(mu);
-        if (error) break;
-      }
-    }
-  } catch (...) {
-    std::lock_guard<std::mutex> lock(mu);
-    if (!error) error = std::current_exception();
-  }
-  {
-    std::lock_guard<std::mutex> lock(mu);
-    no_more = true;
-  }
-  cv_jobs.notify_all();
-  if (!error) drain(true);
-  for (auto& t : pool) t.join();
+      },
+      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events); },
+      [&](WindowRecord& rec) {  // in window order, on this thread
+        stats.windows_processed++;
+        stats.events_processed += rec.n_events;
+        stats.stage_seconds.cluster += rec.times.cluster;
+        stats.stage_seconds.lines += rec.times.lines;
+        stats.stage_seconds.solve += rec.times.solve;
+        stats.stage_seconds.groundtruth += rec.times.groundtruth;
+        sink(rec);
+        if (progress) progress(stats.windows_processed, stats.events_processed);
+      });
   stats.reader_warnings = m.reader->warnings().total();
   stats.seconds_total = secondsSince(start);
-  if (error) std::rethrow_exception(error);
   return stats;
 }
 

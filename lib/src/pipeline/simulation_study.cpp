@@ -1,15 +1,13 @@
 #include "celc/pipeline/simulation_study.hpp"
 
-#include "celc/eval/statistics.hpp"
-
 #include <algorithm>
 #include <cmath>
-#include <mutex>
-#include <numeric>
 #include <random>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
+
+#include "celc/eval/statistics.hpp"
+#include "celc/pipeline/study_engine.hpp"
 
 namespace celc {
 namespace {
@@ -61,48 +59,30 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
   const int n_levels = static_cast<int>(sweep.levels.size());
   const int n_trials = config.trials;
   const int n_methods = static_cast<int>(config.methods.size());
-  const int total = n_levels * n_trials;
   std::uint64_t sweep_id = 0;
   for (char ch : sweep.name) sweep_id = sweep_id * 131 + static_cast<unsigned char>(ch);
 
-  struct Outcome {
-    bool ok = false;
-    double eps = 0, phi = 0, phi_agn = 0, time_us = 0;
-  };
-  std::vector<Outcome> outcomes(static_cast<size_t>(total) * n_methods);
-  std::atomic<int> next{0}, done{0};
-  auto worker = [&]() {
-    for (int job = next++; job < total; job = next++) {
-      const int level = job / n_trials, trial = job % n_trials;
-      LineSceneOptions scene = config.scene;
-      sweep.apply(scene, sweep.levels[static_cast<size_t>(level)]);
-      std::seed_seq seq{static_cast<std::uint32_t>(config.seed), static_cast<std::uint32_t>(config.seed >> 32),
-                        static_cast<std::uint32_t>(sweep_id), static_cast<std::uint32_t>(level),
-                        static_cast<std::uint32_t>(trial)};
-      std::mt19937_64 rng(seq);
-      const LineSceneTrial tr = generateLineScene(scene, rng);
-      SolverOptions so = config.solver;
-      so.linear.seed = rng();
-      const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, so);
-      for (int m = 0; m < n_methods; ++m) {
-        Outcome& o = outcomes[static_cast<size_t>(job) * n_methods + m];
-        const SolverResult& r = res[static_cast<size_t>(m)];
-        o.ok = r.ok() && tr.true_direction.norm() > 0.5;
-        if (!o.ok) continue;
-        o.eps = (tr.true_direction - r.v).norm();
-        o.phi = angleBetween(tr.true_direction, r.v);
-        o.phi_agn = std::min(o.phi, M_PI - o.phi);
-        o.time_us = r.time_us;
-      }
-      const int d = ++done;
-      if (progress) progress(d, total);
-    }
-  };
-  const int n_threads = std::max(1, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < n_threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  StudyPlan plan;
+  for (int level = 0; level < n_levels; ++level)
+    plan.cells.push_back({static_cast<std::uint32_t>(sweep_id), static_cast<std::uint32_t>(level)});
+  plan.trials = n_trials;
+  plan.methods = n_methods;
+  plan.seed = config.seed;
+  plan.threads = threads;
+  const StudyOutcomes outcomes = runStudy(
+      plan,
+      [&](std::size_t level, int, std::mt19937_64& rng) {
+        LineSceneOptions scene = config.scene;
+        sweep.apply(scene, sweep.levels[level]);
+        const LineSceneTrial tr = generateLineScene(scene, rng);
+        SolverOptions so = config.solver;
+        so.linear.seed = rng();
+        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, so);
+        TrialOutcome out;
+        if (tr.true_direction.norm() > 0.5) out.methods = scoreResults(res, tr.true_direction);
+        return out;
+      },
+      progress);
 
   std::vector<SweepCell> cells;
   for (int level = 0; level < n_levels; ++level) {
@@ -113,12 +93,11 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
       c.method = config.methods[static_cast<size_t>(m)];
       c.trials = n_trials;
       std::vector<double> eps, phi, agn, time;
-      for (int trial = 0; trial < n_trials; ++trial) {
-        const Outcome& o = outcomes[static_cast<size_t>(level * n_trials + trial) * n_methods + m];
+      for (const MethodOutcome& o : outcomes.methodOutcomes(static_cast<size_t>(level), m)) {
         if (!o.ok) continue;
         eps.push_back(o.eps);
         phi.push_back(o.phi);
-        agn.push_back(o.phi_agn);
+        agn.push_back(o.phi_sign_agnostic);
         time.push_back(o.time_us);
         if (o.phi < M_PI / 2) ++c.sign_right;
       }

@@ -6,7 +6,8 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
+
+#include "celc/core/parallel.hpp"
 
 namespace celc::sim {
 
@@ -27,15 +28,15 @@ inline uint64_t splitmix64(uint64_t& state) {
 inline double uniform01(uint64_t& state) {
   return (static_cast<double>(splitmix64(state) >> 11) + 1.0) * (1.0 / 9007199254740992.0);
 }
-/// Runs f(band, y0, y1) on `threads` bands of rows [0, H), the first on the calling thread.
+/// Runs f(band, y0, y1) on `threads` bands of rows [0, H), one band per thread.
+/// The bands depend on H and the thread count only, so does the output.
 template <typename F>
 void forRowBands(int H, int threads, const F& f) {
   threads = std::max(1, std::min(threads, H));
-  std::vector<std::thread> workers;
-  for (int b = 1; b < threads; ++b)
-    workers.emplace_back(f, b, H * b / threads, H * (b + 1) / threads);
-  f(0, 0, H / threads);
-  for (auto& w : workers) w.join();
+  parallelFor(static_cast<std::size_t>(threads), threads, [&](std::size_t band) {
+    const int b = static_cast<int>(band);
+    f(b, H * b / threads, H * (b + 1) / threads);
+  });
 }
 inline bool eventLess(const SimEvent& a, const SimEvent& b) {
   if (a.t_us != b.t_us) return a.t_us < b.t_us;

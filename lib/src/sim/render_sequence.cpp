@@ -1,5 +1,6 @@
 #include "celc/sim/render_sequence.hpp"
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,9 +11,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "celc/io/sequence_layout.hpp"
+#include "celc/io/writers.hpp"
+
 namespace celc::sim {
 
 namespace fs = std::filesystem;
+namespace file = io::sequence_file;
 
 std::string ImuOptions::validate() const {
   std::ostringstream e;
@@ -165,40 +170,6 @@ class PartialFile {
   std::FILE* f_ = nullptr;
 };
 
-/// Appends a non-negative integer.
-inline char* putUint(char* p, uint64_t v) {
-  char tmp[24];
-  int n = 0;
-  do {
-    tmp[n++] = static_cast<char>('0' + v % 10);
-    v /= 10;
-  } while (v);
-  while (n) *p++ = tmp[--n];
-  return p;
-}
-inline char* putInt(char* p, int64_t v) {
-  if (v < 0) {
-    *p++ = '-';
-    return putUint(p, static_cast<uint64_t>(-v));
-  }
-  return putUint(p, static_cast<uint64_t>(v));
-}
-/// Microseconds as seconds with 6 decimals.
-inline char* putMicros(char* p, int64_t us) {
-  if (us < 0) {
-    *p++ = '-';
-    us = -us;
-  }
-  p = putUint(p, static_cast<uint64_t>(us / 1000000));
-  *p++ = '.';
-  int64_t frac = us % 1000000;
-  for (int64_t d = 100000; d > 0; d /= 10) {
-    *p++ = static_cast<char>('0' + frac / d);
-    frac %= d;
-  }
-  return p;
-}
-
 std::string num(double x) {
   std::ostringstream s;
   s << std::setprecision(12) << x;
@@ -297,8 +268,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   if (ec) throw std::runtime_error(dir.string() + ": cannot create directory: " + ec.message());
   // Remove a previous run's files first (events.txt first), so that an
   // interrupted run never leaves old and new files that look like one sequence.
-  for (const char* name : {"events.txt", "labels.txt", "imu.txt", "groundtruth.txt", "twist.txt",
-                           "calib.txt", "calib.yaml", "edges.txt", "twist.yaml"}) {
+  for (const char* name : io::simulatedSequenceFiles()) {
     fs::remove(dir / name, ec);
     if (ec) throw std::runtime_error((dir / name).string() + ": cannot remove: " + ec.message());
   }
@@ -311,7 +281,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
 
   SynthSummary summary;
   summary.duration = config.duration;
-  PartialFile events(dir, "events.txt"), labels(dir, "labels.txt");
+  PartialFile events(dir, file::kEvents), labels(dir, file::kLabels);
   std::vector<SimEvent> buf;
   std::string ebuf, lbuf;
   const double slice = 0.01;  // [s] events are written every 10 ms of simulated time
@@ -320,20 +290,14 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     const double t_next = std::min(config.duration, static_cast<double>(k) * slice);
     buf.clear();
     sim.advanceTo(t_next, buf);
-    ebuf.resize(buf.size() * 40);
-    lbuf.resize(buf.size() * 12);
+    ebuf.resize(buf.size() * (io::kEventLineMicrosMaxChars + 1));
+    lbuf.resize(buf.size() * 12);  // int32 and a line end
     char* pe = ebuf.data();
     char* pl = lbuf.data();
     for (const SimEvent& e : buf) {
-      pe = putMicros(pe, e.t_us);
-      *pe++ = ' ';
-      pe = putUint(pe, e.x);
-      *pe++ = ' ';
-      pe = putUint(pe, e.y);
-      *pe++ = ' ';
-      *pe++ = e.on ? '1' : '0';
+      pe = io::putEventLineMicros(pe, e.t_us, e.x, e.y, e.on);
       *pe++ = '\n';
-      pl = putInt(pl, e.label);
+      pl = std::to_chars(pl, pl + 11, e.label).ptr;
       *pl++ = '\n';
     }
     events.write(ebuf.data(), static_cast<size_t>(pe - ebuf.data()));
@@ -348,7 +312,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
 
   {  // IMU
     const auto imu = simulateImu(trajectory, config.imu, 0.0, config.duration, config.seed + 1);
-    PartialFile f(dir, "imu.txt");
+    PartialFile f(dir, file::kImu);
     char line[256];
     for (const ImuSample& s : imu) {
       const int n =
@@ -362,7 +326,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   }
   {  // ground truth and true twist
     const auto poses = groundTruthPoses(trajectory, config.groundtruth, 0.0, config.duration);
-    PartialFile f(dir, "groundtruth.txt"), tw(dir, "twist.txt");
+    PartialFile f(dir, file::kGroundTruth), tw(dir, file::kTwist);
     char line[256];
     for (const PoseSample& p : poses) {
       const auto& q = p.orientation;
@@ -383,7 +347,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   }
   {  // calibration
     const CameraModel& k = config.camera;
-    PartialFile f(dir, "calib.txt");
+    PartialFile f(dir, file::kCalibText);
     char line[512];
     const int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
                                 k.fx, k.fy, k.cx, k.cy, k.coeffs[0], k.coeffs[1], k.coeffs[2],
@@ -391,13 +355,13 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     f.write(line, static_cast<size_t>(n));
     f.close();
     f.commit();
-    PartialFile y(dir, "calib.yaml");
+    PartialFile y(dir, file::kCalibYaml);
     y.write(calibYaml(config));
     y.close();
     y.commit();
   }
   {  // scene edges
-    PartialFile f(dir, "edges.txt");
+    PartialFile f(dir, file::kEdges);
     char line[512];
     for (const SceneEdge& e : scene.edges()) {
       const int n = std::snprintf(line, sizeof line, "%d %.9g %.9g %.9g %.9g %.9g %.9g\n", e.id,
@@ -409,7 +373,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   }
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  PartialFile y(dir, "twist.yaml");
+  PartialFile y(dir, file::kTwistYaml);
   y.write(twistYaml(config, summary));
   y.close();
   // The event files last: a directory with events.txt is complete.

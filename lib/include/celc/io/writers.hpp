@@ -3,6 +3,8 @@
 /// Writers for every format the readers take: used by tests (well-formed and
 /// deliberately corrupted fixtures), benchmarks and the simulator. Times are
 /// rounded to whole microseconds in the binary formats. Throw IoError on I/O failure.
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,17 @@ struct TextWriteOptions {
 
 /// `t x y p` per line (p 0/1), 9 decimals for t.
 void writeEventsText(const std::string& path, const std::vector<Event>& events, const TextWriteOptions& o = {});
+
+/// The events text line `t x y p` (p 0/1, no line end): the one place that
+/// spells it. t in seconds with 9 decimals, as writeEventsText writes it; the
+/// contract of snprintf (at most `cap` chars with the NUL; returns the length).
+int formatEventLine(char* out, std::size_t cap, double t, int x, int y, bool on);
+/// Room putEventLineMicros needs.
+inline constexpr std::size_t kEventLineMicrosMaxChars = 48;
+/// The same line with t given in whole microseconds, written as seconds with
+/// exactly 6 decimals (no rounding: the simulator's events.txt, written in
+/// pieces). Returns the end of the line.
+char* putEventLineMicros(char* out, std::int64_t t_us, int x, int y, bool on);
 /// `t ax ay az gx gy gz` (gyro_first = false) or `t gx gy gz ax ay az`.
 void writeImuText(const std::string& path, const std::vector<ImuSample>& imu, bool gyro_first,
                   const TextWriteOptions& o = {});

@@ -1,0 +1,24 @@
+#include "celc/core/text.hpp"
+
+namespace celc {
+
+std::vector<std::string> splitList(std::string_view text, char separator) {
+  std::vector<std::string> fields;
+  if (text.empty()) return fields;
+  std::size_t begin = 0;
+  for (;;) {
+    const std::size_t end = text.find(separator, begin);
+    fields.emplace_back(text.substr(begin, end == std::string_view::npos ? std::string_view::npos : end - begin));
+    if (end == std::string_view::npos) return fields;
+    begin = end + 1;
+  }
+}
+
+std::string trimBlanks(std::string_view text) {
+  const std::size_t b = text.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  const std::size_t e = text.find_last_not_of(" \t\r");
+  return std::string(text.substr(b, e - b + 1));
+}
+
+}  // namespace celc
