@@ -30,9 +30,8 @@ using LaneSums = double[12][L];
 // weight w (Huber over |N v|^2, or 1 when kPlain), then w a a^T and w N^T N.
 template <int R, bool kPlain>
 inline void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
-                     LaneSums& acc) {
-  for (auto& entry : acc)
-    for (double& x : entry) x = 0.0;
+                     LaneSums& out) {
+  LaneSums acc = {};  // local: nothing the loop stores aliases the columns it reads
   const double v0 = kPlain ? 0.0 : v[0], v1 = kPlain ? 0.0 : v[1], v2 = kPlain ? 0.0 : v[2];
   const double thr2 = thr * thr;
   for (size_t b = 0; b < n; b += L) {
@@ -54,11 +53,13 @@ inline void sumsPass(const double* c, size_t n, size_t s, const double* v, doubl
         // One square root and one division per row: w = T / sqrt(X) with
         // (T, X) = (1, g2^2) for an inlier (sqrt(g2^2) == g2 exactly in IEEE
         // arithmetic) and (thr, d^2 g2) for an outlier (|r| >= thr).
-        const bool inlier = d * d < thr2 * g2;
+        // Both sides computed, then selected: the loop has no branch.
+        const double d2 = d * d;
+        const bool inlier = d2 < thr2 * g2;
         const double T = inlier ? 1.0 : thr;
-        const double X = inlier ? g2 * g2 : d * d * g2;
-        const double root = std::sqrt(X);
-        w = g2 > 0.0 ? T / root : 0.0;
+        const double X = inlier ? g2 * g2 : d2 * g2;
+        const double weight = T / std::sqrt(X);
+        w = g2 > 0.0 ? weight : 0.0;
       }
       const double wa0 = w * a0, wa1 = w * a1, wa2 = w * a2;
       acc[0][l] += wa0 * a0, acc[1][l] += wa1 * a1, acc[2][l] += wa2 * a2;
@@ -70,6 +71,7 @@ inline void sumsPass(const double* c, size_t n, size_t s, const double* v, doubl
       }
     }
   }
+  std::copy(&acc[0][0], &acc[0][0] + 12 * L, &out[0][0]);
 }
 
 // Every pass (R rows of N kept; plain or Huber weights).
