@@ -15,8 +15,11 @@
 #if defined(CELC_IRLS_ISA_DISPATCH) && defined(__GNUC__) && !defined(__clang__) && \
     defined(__x86_64__) && defined(__linux__) && !defined(__AVX512F__)
 #define CELC_ISA_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+// The passes are inlined into every clone, so that each is compiled for its ISA.
+#define CELC_PASS_INLINE inline __attribute__((always_inline))
 #else
 #define CELC_ISA_CLONES
+#define CELC_PASS_INLINE inline
 #endif
 
 namespace celc::detail {
@@ -29,7 +32,7 @@ using LaneSums = double[12][L];
 // then R rows of N). Row b + l of each block b adds to lane l's sums: the
 // weight w (Huber over |N v|^2, or 1 when kPlain), then w a a^T and w N^T N.
 template <int R, bool kPlain>
-inline void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
+CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
                      LaneSums& out) {
   LaneSums acc = {};  // local: nothing the loop stores aliases the columns it reads
   const double v0 = kPlain ? 0.0 : v[0], v1 = kPlain ? 0.0 : v[1], v2 = kPlain ? 0.0 : v[2];
@@ -86,7 +89,7 @@ CELC_ISA_CLONES void sums(int R, bool plain, const double* c, size_t n, size_t s
 // r2_k = (a_k.v)^2 / |N_k v|^2 (r2_degenerate where |N_k v| = 0) over m rows
 // stored as columns c (stride s) in PackedRows' layout.
 template <int R>
-inline void squaredResiduals(const double* c, size_t m, size_t s, const double* v,
+CELC_PASS_INLINE void squaredResiduals(const double* c, size_t m, size_t s, const double* v,
                                   double r2_degenerate, double* r2) {
 #pragma omp simd
   for (size_t k = 0; k < m; ++k) {
