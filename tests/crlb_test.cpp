@@ -86,7 +86,7 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
   double err_sq = 0.0, bound_sq = 0.0;
   int n = 0;
   SolverOptions so;
-  so.linear.check_parallax = false;
+  so.check_parallax = false;
   for (int i = 0; i < 60; ++i) {
     const PeerSceneTrial tr = scene(rng, 5.0, 0.5, 5, 400);
     ASSERT_TRUE(tr.ok);

@@ -38,7 +38,7 @@ TEST(PeerStudy, DeterministicAcrossThreadsAndConsistent) {
   clean.sigma_px = 0.0;
   PeerStudyConfig cfg;
   cfg.trials = 6;
-  cfg.solver.linear.check_parallax = false;
+  cfg.solver.check_parallax = false;
   const auto a = runPeerStudy({noisy, clean}, cfg, 1);
   const auto b = runPeerStudy({noisy, clean}, cfg, 2);
   ASSERT_EQ(a.size(), 2 * allMethods().size());

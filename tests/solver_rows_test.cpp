@@ -8,7 +8,9 @@
 
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
-#include "solver/constraint_rows.hpp"
+#include "solver/robust_nullspace.hpp"
+#include "solver/sign_test.hpp"
+#include "solver/window_checks.hpp"
 
 using namespace celc;
 
@@ -78,7 +80,7 @@ SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionMode
   long event_balance = 0;
   for (int c : detail::usableClusters(obs, 2)) {
     const auto& cl = obs.clusters[c];
-    const auto fr = detail::makeClusterFrame(cl, motion);
+    const auto fr = makeClusterFrame(cl, motion);
     const Vec3 ps = fr.Ps * v, pe = fr.Pe * v;
     const size_t stride = std::max<size_t>(1, cl.size() / detail::kSignVotesPerCluster);
     long pos = 0, neg = 0;

@@ -199,7 +199,7 @@ TEST(ConstraintRows, ResidualIsPointToLineDistance) {
   LineSceneOptions o = noiseFree();
   const auto tr = generateLineScene(o, rng);
   const auto& c = tr.observations.clusters[0];
-  const auto frame = detail::makeClusterFrame(c, tr.true_motion);
+  const auto frame = makeClusterFrame(c, tr.true_motion);
   for (size_t k = 0; k < c.size(); k += 17) {
     const auto row = detail::celcRow(frame, tr.true_motion, c.times[k], c.bearings[k]);
     EXPECT_NEAR(row.a.dot(tr.true_direction) / (row.N * tr.true_direction).norm(), 0.0, 1e-12);
@@ -222,26 +222,26 @@ TEST(Refinement, AnalyticJacobianMatchesNumeric) {
   const auto tr = generateLineScene(o, rng);
   const auto& c = tr.observations.clusters[0];
   const auto& motion = tr.given_motion;
-  const auto frame = detail::makeClusterFrame(c, motion);
+  const auto frame = makeClusterFrame(c, motion);
   const double focal = tr.observations.focal_px;
   for (size_t k = 0; k < c.size(); k += 23) {
     const Mat3 Rk = motion.rotation(c.times[k]), Pk = motion.positionMatrix(c.times[k]);
-    const detail::EventTerm e{Rk * c.bearings[k], Rk.transpose().topRows<2>(), frame.Pe - Pk,
+    const EventTerm e{Rk * c.bearings[k], Rk.transpose().topRows<2>(), frame.Pe - Pk,
                               frame.Ps - Pk};
     const Vec3 v = (tr.true_direction + 0.2 * randomUnit(rng)).normalized();
     Vec3 gv, g1, g3;
-    const double d = detail::eventDistance(e, v, frame.m1, frame.m3, focal, &gv, &g1, &g3);
+    const double d = eventDistance(e, v, frame.m1, frame.m3, focal, &gv, &g1, &g3);
     const auto row = detail::celcRow(frame, motion, c.times[k], c.bearings[k]);
     EXPECT_NEAR(d, focal * row.a.dot(v) / (row.N * v).norm(), 1e-9 * std::max(1.0, std::abs(d)));
     const double h = 1e-7;
     for (int j = 0; j < 3; ++j) {
       const Vec3 dh = Vec3::Unit(j) * h;
-      const double nv = (detail::eventDistance(e, v + dh, frame.m1, frame.m3, focal, nullptr, nullptr, nullptr) -
-                         detail::eventDistance(e, v - dh, frame.m1, frame.m3, focal, nullptr, nullptr, nullptr)) / (2 * h);
-      const double n1 = (detail::eventDistance(e, v, frame.m1 + dh, frame.m3, focal, nullptr, nullptr, nullptr) -
-                         detail::eventDistance(e, v, frame.m1 - dh, frame.m3, focal, nullptr, nullptr, nullptr)) / (2 * h);
-      const double n3 = (detail::eventDistance(e, v, frame.m1, frame.m3 + dh, focal, nullptr, nullptr, nullptr) -
-                         detail::eventDistance(e, v, frame.m1, frame.m3 - dh, focal, nullptr, nullptr, nullptr)) / (2 * h);
+      const double nv = (eventDistance(e, v + dh, frame.m1, frame.m3, focal, nullptr, nullptr, nullptr) -
+                         eventDistance(e, v - dh, frame.m1, frame.m3, focal, nullptr, nullptr, nullptr)) / (2 * h);
+      const double n1 = (eventDistance(e, v, frame.m1 + dh, frame.m3, focal, nullptr, nullptr, nullptr) -
+                         eventDistance(e, v, frame.m1 - dh, frame.m3, focal, nullptr, nullptr, nullptr)) / (2 * h);
+      const double n3 = (eventDistance(e, v, frame.m1, frame.m3 + dh, focal, nullptr, nullptr, nullptr) -
+                         eventDistance(e, v, frame.m1, frame.m3 - dh, focal, nullptr, nullptr, nullptr)) / (2 * h);
       EXPECT_NEAR(gv(j), nv, 1e-4 * std::max(1.0, std::abs(nv)));
       EXPECT_NEAR(g1(j), n1, 1e-4 * std::max(1.0, std::abs(n1)));
       EXPECT_NEAR(g3(j), n3, 1e-4 * std::max(1.0, std::abs(n3)));

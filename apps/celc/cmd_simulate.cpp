@@ -100,7 +100,7 @@ void runPeers(const SimulateArgs& a, const SimulateConfig& cfg) {
   // Every window of the peer scene moves; the parallax test (meant for real
   // data) rejects whole windows once 10% uniform outliers inflate its robust
   // scales, for every method alike. Off here, so the outlier cells are solved.
-  pc.solver.linear.check_parallax = false;
+  pc.solver.check_parallax = false;
   pc.methods = cfg.methods;
   pc.trials = a.trials > 0 ? a.trials : 200;
   pc.seed = cfg.seed;

@@ -3,8 +3,10 @@
 
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "solver/ce3lc.hpp"
 #include "solver/constraint_rows.hpp"
 #include "solver/irls_kernel.hpp"
+#include "solver/robust_nullspace.hpp"
 
 using namespace celc;
 
@@ -19,7 +21,7 @@ LineSceneTrial scene(int events_per_line) {
 std::vector<detail::ConstraintRow> rowsOf(const LineSceneTrial& tr) {
   std::vector<detail::ConstraintRow> rows;
   for (const auto& c : tr.observations.clusters) {
-    const auto frame = detail::makeClusterFrame(c, tr.given_motion);
+    const auto frame = makeClusterFrame(c, tr.given_motion);
     for (size_t k = 0; k < c.size(); ++k)
       rows.push_back(detail::celcRow(frame, tr.given_motion, c.times[k], c.bearings[k]));
   }
@@ -31,7 +33,7 @@ std::vector<detail::ConstraintRow> rowsOf(const LineSceneTrial& tr) {
 // CELC solver builds them (BM_PackRows1000: packing rows built apart).
 static void BM_CelcLinearSolve1000Rows(benchmark::State& state) {
   const detail::PackedRows rows(rowsOf(scene(200)));
-  detail::NullspaceOptions opt;
+  const LinearOptions opt;
   int iterations = 0;
   for (auto _ : state) {
     const auto sol = detail::robustNullspace(rows, opt);
@@ -72,12 +74,15 @@ static void BM_CelcLinearMethod1000Events(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
 
-// CE3LC itself (5 clusters, 15 rows); the window checks are measured apart.
+// CE3LC itself (5 clusters, 15 rows) with its cluster frames; the window
+// checks are measured apart.
 static void BM_Ce3lc5Lines(benchmark::State& state) {
   const auto tr = scene(200);
-  LinearOptions opt;
-  opt.check_parallax = false;
-  for (auto _ : state) benchmark::DoNotOptimize(solveCe3lc(tr.observations, tr.given_motion, opt));
+  const LinearOptions opt;
+  for (auto _ : state) {
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    benchmark::DoNotOptimize(detail::solveCe3lc(tr.observations, tr.given_motion, opt, frames, false));
+  }
 }
 BENCHMARK(BM_Ce3lc5Lines)->Unit(benchmark::kMicrosecond);
 

@@ -4,8 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "../solver/constraint_rows.hpp"
-#include "../solver/refine_costs.hpp"
+#include "celc/solver/celc_residual.hpp"
 
 namespace celc {
 namespace {
@@ -51,7 +50,7 @@ CrlbResult velocityDirectionCrlb(const WindowObservations& truth, const MotionMo
   Eigen::Matrix2d S = Eigen::Matrix2d::Zero();  // Schur complement, accumulated per line
   for (const auto& c : truth.clusters) {
     if (!(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
-    const detail::ClusterFrame fr = detail::makeClusterFrame(c, motion);
+    const ClusterFrame fr = makeClusterFrame(c, motion);
     const Vec3 m1 = fr.m1.normalized(), m3 = fr.m3.normalized();
     const Mat32 B1 = tangentBasis(m1), B3 = tangentBasis(m3);
     Eigen::Matrix2d Ivv = Eigen::Matrix2d::Zero();
@@ -62,10 +61,9 @@ CrlbResult velocityDirectionCrlb(const WindowObservations& truth, const MotionMo
       if (!std::isfinite(c.times[k]) || !c.bearings[k].allFinite()) continue;
       Mat3 Rk, Pk;
       motion.pose(c.times[k], Rk, Pk);
-      const detail::EventTerm e{Rk * c.bearings[k], Rk.transpose().topRows<2>(), fr.Pe - Pk,
-                                fr.Ps - Pk};
+      const EventTerm e = makeEventTerm(fr, Rk, Pk, c.bearings[k]);
       Vec3 gv, g1, g3;
-      const double d = detail::eventDistance(e, v, m1, m3, truth.focal_px, &gv, &g1, &g3);
+      const double d = eventDistance(e, v, m1, m3, truth.focal_px, &gv, &g1, &g3);
       if (!std::isfinite(d) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite()) continue;
       const Eigen::Vector2d jv = Bv.transpose() * gv;
       Eigen::Vector4d jl;

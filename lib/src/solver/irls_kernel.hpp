@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the per-row passes of the robust nullspace IRLS (constraint_rows.cpp)
+// Internal: the per-row passes of the robust nullspace IRLS (robust_nullspace.cpp)
 // over rows packed once as structure of arrays.
 #include <array>
 #include <cstddef>
@@ -69,10 +69,10 @@ class PackedRows {
 /// Sums with the Huber weight over |N_i v|^2,
 ///   w_i = min(1, thr / |r_i|) / |N_i v|^2 = min(1 / g2, thr / sqrt(d^2 g2)),
 /// with r_i = d / sqrt(g2) the geometric residual (d = a_i.v, g2 = |N_i v|^2);
-/// rows with |N_i v| = 0 get no weight. One fused pass over the columns,
-/// vectorised across kLanes lanes whose partial sums are added in a fixed
-/// order, built for AVX-512, AVX2 and SSE2 and chosen at run time (the
-/// three agree to rounding: only the first two fuse multiply-adds).
+/// rows with |N_i v| = 0 get no weight. One fused pass over the columns in
+/// blocks of kLanes rows: lane l of every block adds to its own partial sums
+/// (rows l, l + kLanes, ...), and the lanes' sums are added in lane order, so
+/// the result does not depend on how the compiler vectorises the lanes.
 PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
 
 }  // namespace celc::detail

@@ -2,23 +2,25 @@
 // Huber loss), optionally jointly with each cluster's boundary lines.
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <random>
 
-#include "celc/solver/solver.hpp"
-#include "constraint_rows.hpp"
+#include "refine.hpp"
 #include "refine_costs.hpp"
+#include "sampling.hpp"
 
 namespace celc {
+
+namespace detail {
+
 namespace {
-
 constexpr size_t kChunk = 256;  // events per residual block
-
 }  // namespace
 
 SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& motion,
-                            const Vec3& initial, bool refine_lines, const RefineOptions& opt) {
+                            const Vec3& initial, bool refine_lines, const RefineOptions& opt,
+                            const WindowFrames& frames, int max_events, std::uint64_t event_seed) {
   const auto start = std::chrono::steady_clock::now();
   SolverResult result;
   if (const std::string err = opt.validate(); !err.empty()) {
@@ -31,32 +33,29 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     result.message = "initial velocity or focal length invalid";
     return result;
   }
-  const std::vector<int> usable = detail::usableClusters(obs, 2);
+  const std::vector<int>& usable = frames.clusters();
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
   const std::vector<size_t> quota =
-      detail::rowQuota(sizes, static_cast<size_t>(opt.max_events), opt.balance_clusters);
+      rowQuota(sizes, static_cast<size_t>(std::max(0, max_events)), opt.balance_clusters);
 
   Vec3 v = initial.normalized();
   // Lines: reference-frame plane normals (unit); free parameters in joint mode.
   std::vector<Vec3> m1(usable.size()), m3(usable.size());
-  std::vector<detail::ClusterFrame> frames;
   for (size_t i = 0; i < usable.size(); ++i) {
-    frames.push_back(detail::makeClusterFrame(obs.clusters[usable[i]], motion));
-    m1[i] = frames.back().m1.normalized();
-    m3[i] = frames.back().m3.normalized();
+    m1[i] = frames[usable[i]].m1.normalized();
+    m3[i] = frames[usable[i]].m3.normalized();
   }
   // Per-event terms grouped by cluster (a seeded subset of each).
-  std::vector<std::vector<detail::EventTerm>> terms(usable.size());
+  std::vector<std::vector<EventTerm>> terms(usable.size());
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
-    for (size_t k : detail::sampleIndices(cl.size(), quota[ci], opt.seed + ci)) {
+    for (size_t k : sampleIndices(cl.size(), quota[ci], event_seed + ci)) {
       const double t = cl.times[k];
       const Vec3& f = cl.bearings[k];
       if (!f.allFinite() || !std::isfinite(t)) continue;
       const Mat3 Rk = motion.rotation(t), Pk = motion.positionMatrix(t);
-      detail::EventTerm e{Rk * f, Rk.transpose().topRows<2>(), frames[ci].Pe - Pk,
-                          frames[ci].Ps - Pk};
+      const EventTerm e = makeEventTerm(frames[usable[ci]], Rk, Pk, f);
       if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms[ci].push_back(e);
     }
   }
@@ -68,11 +67,11 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   int n_res = 0;
   for (size_t c = 0; c < terms.size(); ++c) {
     for (size_t b = 0; b < terms[c].size(); b += kChunk) {
-      std::vector<detail::EventTerm> chunk(
+      std::vector<EventTerm> chunk(
           terms[c].begin() + static_cast<long>(b),
           terms[c].begin() + static_cast<long>(std::min(terms[c].size(), b + kChunk)));
       n_res += static_cast<int>(chunk.size());
-      auto* cost = new detail::EventChunkCost(std::move(chunk), obs.focal_px, opt.huber_px,
+      auto* cost = new EventChunkCost(std::move(chunk), obs.focal_px, opt.huber_px,
                                               refine_lines);
       if (refine_lines) {
         problem.AddResidualBlock(cost, nullptr, v.data(), m1[c].data(), m3[c].data());
@@ -124,6 +123,14 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   result.time_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+}  // namespace detail
+
+SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& motion,
+                            const Vec3& initial, bool refine_lines, const RefineOptions& options) {
+  return detail::refineVelocity(obs, motion, initial, refine_lines, options,
+                                detail::WindowFrames(obs, motion), options.max_events, options.seed);
 }
 
 }  // namespace celc

@@ -3,48 +3,17 @@
 // chunks (one residual block per chunk of a cluster's events) to keep Ceres'
 // per-block overhead small.
 //
-// Event residual (distance to the transferred line, pixels):
-//   l = m1 (u.v) - m3 (s.v),  u = De^T m3,  s = Ds^T m1,   (reference frame)
-//   g = Rt01 l  (first two components of the line in the camera at t_k),
-//   d = focal * fp.l / |g|,   fp = R_k f_k.
-// Huber robustification inside the residual: r = sign(d) sqrt(rho(d^2)) with
-// rho(x) = x for x <= delta^2, 2 delta sqrt(x) - delta^2 otherwise, so that
+// The event residual d is celc_residual.hpp's (pixels). Huber robustification
+// inside the residual: r = sign(d) sqrt(rho(d^2)) with rho(x) = x for
+// x <= delta^2, 2 delta sqrt(x) - delta^2 otherwise, so that
 // sum r^2 = sum rho(d^2) exactly (the "square-rooted" Huber cost).
 #include <ceres/ceres.h>
 
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/solver/celc_residual.hpp"
 
 namespace celc::detail {
-
-/// Per-event constants of the residual.
-struct EventTerm {
-  Vec3 fp;                            // R_k f_k
-  Eigen::Matrix<double, 2, 3> Rt01;   // first two rows of R_k^T
-  Mat3 De, Ds;                        // P(t_e) - P(t_k), P(t_s) - P(t_k)
-};
-
-/// d and its gradients w.r.t. v, m1, m3 (any of the gradient pointers may be null).
-inline double eventDistance(const EventTerm& e, const Vec3& v, const Vec3& m1, const Vec3& m3,
-                            double focal, Vec3* dv, Vec3* dm1, Vec3* dm3) {
-  const Vec3 u = e.De.transpose() * m3, s = e.Ds.transpose() * m1;
-  const double uv = u.dot(v), sv = s.dot(v);
-  const Vec3 l = m1 * uv - m3 * sv;
-  const Eigen::Vector2d g = e.Rt01 * l;
-  const double gn = g.norm();
-  if (!(gn > 1e-300)) return NAN;
-  const double num = e.fp.dot(l);
-  const double d = focal * num / gn;
-  if (dv || dm1 || dm3) {
-    // dd/dl (as a column vector).
-    const Vec3 dl = focal * (e.fp / gn - num * (e.Rt01.transpose() * g) / (gn * gn * gn));
-    if (dv) *dv = (m1 * u.transpose() - m3 * s.transpose()).transpose() * dl;
-    if (dm1) *dm1 = (uv * Mat3::Identity() - m3 * (e.Ds * v).transpose()).transpose() * dl;
-    if (dm3) *dm3 = (m1 * (e.De * v).transpose() - sv * Mat3::Identity()).transpose() * dl;
-  }
-  return d;
-}
 
 /// Huber in square-root form: returns r = sign(d) sqrt(rho(d^2)) and dr/dd.
 inline double sqrtHuber(double d, double delta, double* slope) {

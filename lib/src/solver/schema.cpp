@@ -1,5 +1,5 @@
 // The schema of the solvers' options (core/fields.hpp).
-#include "celc/solver/solver.hpp"
+#include "celc/solver/options.hpp"
 
 namespace celc {
 
@@ -20,8 +20,6 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
           o.min_parallax_ratio);
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);
-  v.field({"check_parallax", "", "run the parallax test (solveMethods runs it once per window)"},
-          o.check_parallax);
   v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
 }
 
@@ -60,6 +58,8 @@ void describe(FieldVisitor& v, SolverOptions& o) {
   v.section({"refine", "", "Ceres refinement (celc_opt, celc_ml)"}, [&](FieldVisitor& s) { describe(s, o.refine); });
   v.section({"npt", "", "N-point linear solver (Gao et al. 2024)"}, [&](FieldVisitor& s) { describe(s, o.npt); });
   v.section({"ml", "", "celc_ml: joint refinement of v and the lines"}, [&](FieldVisitor& s) { describe(s, o.ml); });
+  v.field({"check_parallax", "", "degenerate (no parallax) windows are detected once per window"},
+          o.check_parallax);
 }
 
 }  // namespace celc

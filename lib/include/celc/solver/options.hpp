@@ -1,0 +1,112 @@
+#pragma once
+/// \file options.hpp
+/// Options of the solvers, one struct per stage, each with a validate() that
+/// returns what is wrong (empty when valid). Defaults are the pipeline's;
+/// docs/solver.md gives the measurements behind them.
+#include <cstdint>
+#include <string>
+
+#include "celc/core/fields.hpp"
+
+namespace celc {
+
+/// Options of the robust linear stage (CELC and CE3LC) and of the window checks.
+struct LinearOptions {
+  int max_rows = 1000;           ///< random subset of event rows (0 = all) [rows]
+  /// Share the rows equally among clusters (water-filling) instead of in
+  /// proportion to their sizes. Off: short, weakly informative clusters then dominate.
+  bool balance_clusters = false;
+  std::uint64_t seed = 1;        ///< seed of the row subset (solveMethods' SampleSeeds override it per window)
+  int max_iterations = 20;       ///< IRLS iterations
+  double huber_k = 1.345;        ///< Huber threshold in units of the robust scale
+  /// Stop when the direction moves less than this [rad]; well below the
+  /// direction error at realistic noise.
+  double tolerance = 1e-3;
+  /// Global start: the robust cost is scored on this many hemisphere
+  /// directions (0 = off) and IRLS also runs from the best grid_starts of them.
+  /// Off: the single start from the plain generalised eigenvector suffices on
+  /// the paper's scene, and the grid costs more than the rest of the solve.
+  int grid_directions = 0;
+  int grid_starts = 2;
+  int grid_rows = 200;           ///< rows used to score the grid
+  int min_clusters = 2;          ///< fewer usable clusters -> degenerate
+  int min_cluster_events = 5;    ///< a cluster needs this many events to be usable
+  /// A 2-D nullspace: sigma_min / sigma_second above this -> degenerate. The
+  /// sigmas are RMS geometric residuals along the best and second-best directions.
+  double max_sigma_ratio = 0.9;
+  /// A cluster shows parallax when its events, rotation-compensated, are this
+  /// many times farther from one static line than from a line moving linearly
+  /// in time (robust scales); fewer than min_clusters such clusters -> degenerate.
+  double min_parallax_ratio = 1.5;
+  double min_parallax_px = 0.5;  ///< and the static-line scale exceeds this [px]
+  bool resolve_sign = true;      ///< cheirality test; else the sign is arbitrary
+  std::string validate() const;
+};
+
+/// Options of the Ceres refinement.
+struct RefineOptions {
+  double huber_px = 1.5;          ///< Huber loss threshold on the point-line distance [px]
+  int max_iterations = 50;        ///< Levenberg-Marquardt iterations
+  int max_events = 5000;          ///< events used (0 = all; else a seeded random subset)
+  bool balance_clusters = false;  ///< share max_events equally among clusters (water-filling)
+  std::uint64_t seed = 1;         ///< seed of the event subset (solveMethods' SampleSeeds override it per window)
+  double function_tolerance = 1e-10;
+  int num_threads = 1;
+  std::string validate() const;
+};
+
+/// Options of the N-point linear solver `npt` (Gao et al., CVPR 2024; see npt.hpp).
+struct NptOptions {
+  int min_line_events = 5;   ///< a line needs this many events (>= 5: 6 homogeneous unknowns)
+  int min_lines = 2;         ///< fewer lines with a partial velocity -> degenerate
+  /// A line is dropped when its per-line system has no unique nullspace:
+  /// (second smallest / largest singular value) below this.
+  double min_line_sigma_ratio = 1e-10;
+  /// The averaging stage: sigma_min / sigma_second above this -> degenerate.
+  double max_sigma_ratio = 0.999;
+  std::string validate() const;  ///< empty when valid
+};
+
+/// Options of the joint refinement `celc_ml` (v with every cluster's lines).
+struct MlOptions {
+  /// Also start from npt's estimate (sign resolved) when the celc start ends
+  /// more than second_start_deg away from it, and keep the lower robust cost;
+  /// also run from npt alone when celc fails. A remedy for the local minima of
+  /// the joint problem (docs/peers.md). Only where npt's motion model holds:
+  /// GyroIntegrated (P = tau I, exact), or a constant twist turning little,
+  /// |w| max|tau| / 2 <= second_start_max_twist (npt's relative error on the
+  /// displacement).
+  bool second_start = true;
+  double second_start_max_twist = 0.02;  ///< [-] |w| max|tau| / 2
+  double second_start_deg = 2.0;         ///< [deg]
+  /// Also start from this many directions of a hemisphere lattice (0 = off)
+  /// and keep the end point of lowest robust cost; each start costs one joint
+  /// refinement.
+  int grid_starts = 0;
+  /// With grid_starts: every start is refined on a seeded subset of this many
+  /// events, and only the lowest-cost end point on all (refine.max_events) of
+  /// them (0 = every start on all events).
+  int screen_events = 1000;
+  std::string validate() const;  ///< empty when valid
+};
+
+struct SolverOptions {
+  LinearOptions linear;
+  RefineOptions refine;
+  NptOptions npt;
+  MlOptions ml;
+  /// Run the parallax test of the window checks (solveMethods, once per
+  /// window). Off where every window is known to move and outliers would
+  /// inflate the test's robust scales (the peer study).
+  bool check_parallax = true;
+  std::string validate() const;
+};
+
+/// The schema of the `solver:` section and its parts (core/fields.hpp).
+void describe(FieldVisitor& v, LinearOptions& options);
+void describe(FieldVisitor& v, RefineOptions& options);
+void describe(FieldVisitor& v, NptOptions& options);
+void describe(FieldVisitor& v, MlOptions& options);
+void describe(FieldVisitor& v, SolverOptions& options);
+
+}  // namespace celc

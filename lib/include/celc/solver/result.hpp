@@ -1,0 +1,38 @@
+#pragma once
+/// \file result.hpp
+/// What a solver returns for one window: a status (never an exception on
+/// data), the direction and what the solve saw.
+#include <string>
+
+#include "celc/types.hpp"
+
+namespace celc {
+
+enum class SolveStatus { Ok, Degenerate, InvalidInput, Failed };
+std::string toString(SolveStatus status);
+
+/// Why a window is degenerate (status Degenerate), or None.
+enum class Degeneracy { None, TooFewClusters, NoParallax, NullspaceNotUnique };
+std::string toString(Degeneracy reason);
+
+struct SolverResult {
+  SolveStatus status = SolveStatus::Failed;
+  Degeneracy degeneracy = Degeneracy::None;
+  std::string message;            ///< human-readable detail when not ok
+  Vec3 v = Vec3::Zero();          ///< unit linear velocity direction, reference camera frame
+  double sigma_min = 0.0;         ///< smallest singular value of the final weighted system
+  double sigma_second = 0.0;      ///< second smallest
+  int iterations = 0;             ///< IRLS or Levenberg-Marquardt iterations
+  int rows_used = 0;              ///< rows (events or line constraints) in the solve
+  double residual_px = 0.0;       ///< robust residual scale (1.4826 MAD) [px]
+  double sign_margin = 0.0;       ///< cheirality vote: (votes for - against) / clusters, in [0, 1] after resolution
+  double time_us = 0.0;           ///< wall time of this method alone [us]
+  bool ok() const { return status == SolveStatus::Ok; }
+};
+
+/// Angle between unit vectors [rad], atan2(|a x b|, a.b); the sign-agnostic
+/// variant is min(phi, pi - phi).
+double angleBetween(const Vec3& a, const Vec3& b);
+double angleBetweenSignAgnostic(const Vec3& a, const Vec3& b);
+
+}  // namespace celc

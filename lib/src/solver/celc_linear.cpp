@@ -1,0 +1,62 @@
+// CELC linear: the event rows of every usable cluster, their robust nullspace.
+#include "celc_linear.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "irls_kernel.hpp"
+#include "linear_method.hpp"
+#include "robust_nullspace.hpp"
+#include "sampling.hpp"
+#include "stopwatch.hpp"
+#include "window_checks.hpp"
+
+namespace celc {
+
+namespace detail {
+
+SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& motion,
+                             const LinearOptions& opt, const WindowFrames& frames,
+                             bool check_parallax, std::uint64_t row_seed) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (rejectInput(obs, motion, opt, result)) return result;
+  const std::vector<int> usable = usableClusters(obs, opt.min_cluster_events);
+  if (windowIsDegenerate(obs, motion, usable, opt, check_parallax, result)) {
+    result.time_us = microsecondsSince(start);
+    return result;
+  }
+  // Rows: a seeded subset of each usable cluster's events.
+  std::vector<size_t> sizes;
+  for (int c : usable) sizes.push_back(obs.clusters[c].size());
+  const std::vector<size_t> quota =
+      rowQuota(sizes, static_cast<size_t>(opt.max_rows), opt.balance_clusters);
+  // Packed as they are built (N's third row is zero: two normaliser rows).
+  size_t capacity = 0;
+  for (size_t q : quota) capacity += q;
+  PackedRows rows(capacity, 2);
+  for (size_t ci = 0; ci < usable.size(); ++ci) {
+    const auto& cl = obs.clusters[usable[ci]];
+    const ClusterFrame& frame = frames[usable[ci]];
+    for (size_t k : sampleIndices(cl.size(), quota[ci], row_seed + ci)) {
+      if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
+      const ConstraintRow row = celcRow(frame, motion, cl.times[k], cl.bearings[k]);
+      if (row.a.allFinite() && row.N.allFinite()) rows.append(row.a, row.N);
+    }
+  }
+  rows.seal();
+  const NullspaceSolution ns = robustNullspace(rows, opt);
+  result = nullspaceResult(ns, obs, motion, opt, static_cast<int>(rows.size()), frames);
+  result.time_us = microsecondsSince(start);
+  return result;
+}
+
+}  // namespace detail
+
+SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& motion,
+                             const LinearOptions& options) {
+  return detail::solveCelcLinear(obs, motion, options, detail::WindowFrames(obs, motion), true,
+                                 options.seed);
+}
+
+}  // namespace celc

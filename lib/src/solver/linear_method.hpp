@@ -1,0 +1,29 @@
+#pragma once
+// Internal: what the linear methods (CELC, CE3LC) and the window checks share:
+// rejecting unusable options and input, and turning a robust nullspace into a
+// result (uniqueness of the nullspace, sign).
+#include <string>
+
+#include "celc/solver/solver.hpp"
+#include "constraint_rows.hpp"
+#include "robust_nullspace.hpp"
+
+namespace celc::detail {
+
+/// A result with the status, reason and message only.
+SolverResult failure(SolveStatus status, Degeneracy reason, std::string message);
+
+/// True (and `result` set to InvalidInput) when the options are invalid, the
+/// focal length is not positive or the rotation is not finite.
+bool rejectInput(const WindowObservations& obs, const MotionModel& motion,
+                 const LinearOptions& options, SolverResult& result);
+
+/// The result of a nullspace solution over `rows` rows: Failed when it did not
+/// converge; Degenerate (NullspaceNotUnique) when
+/// sigma_min > options.max_sigma_ratio * sigma_second; else Ok with v unit and,
+/// with options.resolve_sign, its sign resolved by the cheirality test.
+SolverResult nullspaceResult(const NullspaceSolution& solution, const WindowObservations& obs,
+                             const MotionModel& motion, const LinearOptions& options, int rows,
+                             const WindowFrames& frames);
+
+}  // namespace celc::detail

@@ -1,0 +1,47 @@
+// Validation of the solver options.
+#include "celc/solver/options.hpp"
+
+#include <sstream>
+
+namespace celc {
+
+std::string LinearOptions::validate() const {
+  std::ostringstream e;
+  if (max_rows < 0) e << "max_rows must be >= 0; ";
+  if (max_iterations < 1) e << "max_iterations must be >= 1; ";
+  if (!(huber_k > 0.0)) e << "huber_k must be > 0; ";
+  if (!(tolerance > 0.0)) e << "tolerance must be > 0; ";
+  if (grid_directions < 0 || grid_starts < 0 || grid_rows < 1)
+    e << "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";
+  if (min_clusters < 1) e << "min_clusters must be >= 1; ";
+  if (min_cluster_events < 2) e << "min_cluster_events must be >= 2; ";
+  if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
+  if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
+  if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
+  return e.str();
+}
+
+std::string RefineOptions::validate() const {
+  std::ostringstream e;
+  if (!(huber_px > 0.0)) e << "huber_px must be > 0; ";
+  if (max_iterations < 1) e << "max_iterations must be >= 1; ";
+  if (max_events < 0) e << "max_events must be >= 0; ";
+  if (!(function_tolerance > 0.0)) e << "function_tolerance must be > 0; ";
+  if (num_threads < 1) e << "num_threads must be >= 1; ";
+  return e.str();
+}
+
+std::string MlOptions::validate() const {
+  std::string e;
+  if (!(second_start_deg >= 0.0)) e += "second_start_deg must be >= 0; ";
+  if (!(second_start_max_twist >= 0.0)) e += "second_start_max_twist must be >= 0; ";
+  if (grid_starts < 0 || grid_starts > 10000) e += "grid_starts must be in [0, 10000]; ";
+  if (screen_events < 0) e += "screen_events must be >= 0; ";
+  return e;
+}
+
+std::string SolverOptions::validate() const {
+  return linear.validate() + refine.validate() + npt.validate() + ml.validate();
+}
+
+}  // namespace celc

@@ -1,0 +1,61 @@
+// Seeded event subsets and robust medians.
+#include "sampling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <unordered_set>
+
+namespace celc::detail {
+
+std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed) {
+  std::vector<size_t> idx;
+  if (k == 0 || k >= n) {
+    idx.resize(n);
+    for (size_t i = 0; i < n; ++i) idx[i] = i;
+    return idx;
+  }
+  // Floyd's algorithm: k draws, no O(n) buffer.
+  std::mt19937_64 rng(seed);
+  std::unordered_set<size_t> chosen;
+  chosen.reserve(2 * k);
+  for (size_t j = n - k; j < n; ++j) {
+    const size_t t = std::uniform_int_distribution<size_t>(0, j)(rng);
+    if (!chosen.insert(t).second) chosen.insert(j);
+  }
+  idx.assign(chosen.begin(), chosen.end());
+  std::sort(idx.begin(), idx.end());
+  return idx;
+}
+
+std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bool balanced) {
+  size_t total = 0;
+  for (size_t s : sizes) total += s;
+  if (budget == 0 || total <= budget) return sizes;
+  std::vector<size_t> q(sizes.size());
+  if (!balanced) {
+    for (size_t i = 0; i < sizes.size(); ++i) q[i] = sizes[i] * budget / total;
+    return q;
+  }
+  // Water-filling from the smallest cluster up: a long edge must not outvote the others.
+  std::vector<size_t> order(sizes.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sizes[a] < sizes[b]; });
+  size_t remaining = budget;
+  for (size_t j = 0; j < order.size(); ++j) {
+    const size_t share = remaining / (order.size() - j);
+    q[order[j]] = std::min(sizes[order[j]], share);
+    remaining -= q[order[j]];
+  }
+  return q;
+}
+
+double medianAbs(std::vector<double>& x) {
+  if (x.empty()) return 0.0;
+  for (double& v : x) v = std::abs(v);
+  auto mid = x.begin() + static_cast<long>(x.size() / 2);
+  std::nth_element(x.begin(), mid, x.end());
+  return *mid;
+}
+
+}  // namespace celc::detail

@@ -1,0 +1,91 @@
+// The method dispatcher: the window checks once, the clusters' frames once,
+// then every requested method (celc computed once for the methods it starts).
+#include <vector>
+
+#include "ce3lc.hpp"
+#include "celc/solver/npt.hpp"
+#include "celc/solver/solver.hpp"
+#include "celc_linear.hpp"
+#include "celc_ml.hpp"
+#include "constraint_rows.hpp"
+#include "refine.hpp"
+#include "sign_test.hpp"
+#include "stopwatch.hpp"
+#include "window_checks.hpp"
+
+namespace celc {
+
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods,
+                                       const SolverOptions& options, const SampleSeeds& seeds) {
+  std::vector<SolverResult> out;
+  // Window-level checks once; a degenerate window is degenerate for every method.
+  const SolverResult window = detail::checkWindow(obs, motion, options.linear, options.check_parallax);
+  if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
+  const detail::WindowFrames frames(obs, motion);
+  SolverResult linear;
+  bool have_linear = false;
+  auto getLinear = [&]() -> const SolverResult& {
+    if (!have_linear) {
+      linear = detail::solveCelcLinear(obs, motion, options.linear, frames, false, seeds.linear_rows);
+      have_linear = true;
+    }
+    return linear;
+  };
+  SolverResult npt;
+  bool have_npt = false;
+  auto getNpt = [&]() -> const SolverResult& {
+    if (!have_npt) {
+      npt = solveNpt(obs, motion, options.npt);
+      if (npt.ok() && options.linear.resolve_sign) {
+        const auto t0 = detail::Clock::now();
+        const SignDecision s = detail::resolveSign(obs, motion, npt.v, frames);
+        npt.v *= s.sign;
+        npt.sign_margin = s.margin * s.sign;
+        npt.time_us += detail::microsecondsSince(t0);
+      }
+      have_npt = true;
+    }
+    return npt;
+  };
+  for (Method m : methods) {
+    switch (m) {
+      case Method::Celc: out.push_back(getLinear()); break;
+      case Method::Ce3lc:
+        out.push_back(detail::solveCe3lc(obs, motion, options.linear, frames, false));
+        break;
+      case Method::Npt: out.push_back(getNpt()); break;
+      case Method::CelcMl: {
+        const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
+        out.push_back(detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr,
+                                          options, frames, seeds.refine_events));
+        break;
+      }
+      case Method::CelcOpt: {
+        const SolverResult& init = getLinear();
+        if (!init.ok()) {
+          out.push_back(init);
+          break;
+        }
+        SolverResult r = detail::refineVelocity(obs, motion, init.v, false, options.refine, frames,
+                                                options.refine.max_events, seeds.refine_events);
+        r.time_us += init.time_us;  // a refined estimate costs its initialisation too
+        r.sigma_min = init.sigma_min;
+        r.sigma_second = init.sigma_second;
+        r.sign_margin = init.sign_margin;
+        out.push_back(r);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods,
+                                       const SolverOptions& options) {
+  return solveMethods(obs, motion, methods, options,
+                      SampleSeeds{options.linear.seed, options.refine.seed});
+}
+
+}  // namespace celc

@@ -1,0 +1,96 @@
+// The dispatcher (solveMethods) against the methods run one by one: the
+// clusters' frames it computes once per window and shares with every method
+// and sign test give the same results as each method's own frames, and the
+// per-window seeds passed as arguments the same as seeds set in the options.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "celc/sim/line_scene.hpp"
+#include "celc/solver/npt.hpp"
+#include "celc/solver/solver.hpp"
+#include "solver/constraint_rows.hpp"
+#include "solver/sign_test.hpp"
+
+using namespace celc;
+
+namespace {
+
+void expectSameResult(const SolverResult& a, const SolverResult& b, const char* what, int trial) {
+  EXPECT_EQ(a.status, b.status) << what << ", trial " << trial;
+  EXPECT_EQ(a.v, b.v) << what << ", trial " << trial;
+  EXPECT_EQ(a.sigma_min, b.sigma_min) << what << ", trial " << trial;
+  EXPECT_EQ(a.sigma_second, b.sigma_second) << what << ", trial " << trial;
+  EXPECT_EQ(a.sign_margin, b.sign_margin) << what << ", trial " << trial;
+  EXPECT_EQ(a.residual_px, b.residual_px) << what << ", trial " << trial;
+  EXPECT_EQ(a.iterations, b.iterations) << what << ", trial " << trial;
+  EXPECT_EQ(a.rows_used, b.rows_used) << what << ", trial " << trial;
+}
+
+}  // namespace
+
+// celc, ce3lc, celc_opt and npt (sign resolved) from solveMethods are exactly
+// the standalone methods' results; the sign test decides the same with the
+// window's frames as with frames of its own, for both signs of v.
+TEST(SolverDispatch, SharedFramesGiveTheStandaloneResults) {
+  std::mt19937_64 rng(23);
+  const std::vector<Method> methods{Method::Celc, Method::Ce3lc, Method::CelcOpt, Method::Npt};
+  int ok = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    LineSceneOptions o;
+    o.n_lines = 3 + trial % 4;
+    o.events_per_line = 60 + 40 * (trial % 3);
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    const auto& obs = tr.observations;
+    const auto& motion = tr.given_motion;
+    const SolverOptions so;
+    const auto all = solveMethods(obs, motion, methods, so);
+    ASSERT_EQ(all.size(), methods.size());
+    const SolverResult celc = solveCelcLinear(obs, motion, so.linear);
+    expectSameResult(all[0], celc, "celc", trial);
+    expectSameResult(all[1], solveCe3lc(obs, motion, so.linear), "ce3lc", trial);
+    if (celc.ok()) {
+      ++ok;
+      SolverResult opt = refineVelocity(obs, motion, celc.v, false, so.refine);
+      opt.sigma_min = celc.sigma_min;
+      opt.sigma_second = celc.sigma_second;
+      opt.sign_margin = celc.sign_margin;
+      expectSameResult(all[2], opt, "celc_opt", trial);
+    }
+    SolverResult npt = solveNpt(obs, motion, so.npt);
+    if (npt.ok()) {
+      const SignDecision s = resolveSign(obs, motion, npt.v);
+      npt.v *= s.sign;
+      npt.sign_margin = s.margin * s.sign;
+    }
+    expectSameResult(all[3], npt, "npt", trial);
+
+    const detail::WindowFrames frames(obs, motion);
+    for (const Vec3& v : {tr.true_direction, Vec3(-tr.true_direction)}) {
+      const SignDecision with = detail::resolveSign(obs, motion, v, frames);
+      const SignDecision without = resolveSign(obs, motion, v);
+      EXPECT_EQ(with.sign, without.sign) << "trial " << trial;
+      EXPECT_EQ(with.margin, without.margin) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(ok, 8);
+}
+
+// Seeds passed per window equal the same seeds set in the options.
+TEST(SolverDispatch, SeedsAsArgumentsEqualSeedsInOptions) {
+  std::mt19937_64 rng(29);
+  LineSceneOptions o;
+  o.events_per_line = 400;  // 2000 events: row and event subsets are drawn
+  const LineSceneTrial tr = generateLineScene(o, rng);
+  SolverOptions in_options;
+  in_options.linear.seed = 7;
+  in_options.refine.seed = 9;
+  in_options.refine.max_events = 1500;
+  SolverOptions defaults = in_options;
+  defaults.linear.seed = 1;
+  defaults.refine.seed = 1;
+  const auto a = solveMethods(tr.observations, tr.given_motion, allMethods(), in_options);
+  const auto b = solveMethods(tr.observations, tr.given_motion, allMethods(), defaults, SampleSeeds{7, 9});
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t m = 0; m < a.size(); ++m) expectSameResult(a[m], b[m], "method", static_cast<int>(m));
+}
