@@ -52,8 +52,8 @@ class PackedRows {
   /// Every step-th row, sealed.
   PackedRows strided(size_t step) const;
   /// The rows the robust scale is taken from: every floor(n / kScaleSample)-th,
-  /// so 256 to 511 of them once n >= 256 (a relative standard error of the
-  /// MAD of ~5 to 7%, well inside what the Huber threshold needs).
+  /// so 256 to 511 of them once n >= 256: enough for the Huber threshold
+  /// (docs/solver.md).
   const PackedRows& scaleSample() const { return sample_ ? *sample_ : *this; }
   static constexpr size_t kScaleSample = 256;
 
