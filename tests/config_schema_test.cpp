@@ -65,7 +65,8 @@ class Perturb final : public FieldVisitor {
 // Records which bytes of an object the schema reaches.
 class Coverage final : public FieldVisitor {
  public:
-  Coverage(const void* base, std::size_t size) : base_(static_cast<const char*>(base)), size_(size) {}
+  Coverage(const void* base, std::size_t size, std::size_t align)
+      : base_(static_cast<const char*>(base)), size_(size), align_(align) {}
   void field(const FieldInfo&, bool& v) override { member(&v, sizeof v); }
   void field(const FieldInfo&, int& v) override { member(&v, sizeof v); }
   void field(const FieldInfo&, unsigned& v) override { member(&v, sizeof v); }
@@ -85,7 +86,8 @@ class Coverage final : public FieldVisitor {
     if (p >= base_ && p + size <= base_ + size_) ranges_.emplace_back(p - base_, p - base_ + size);
   }
   /// Byte ranges of the object that no field reaches, beyond alignment padding
-  /// (< 8 bytes, or < 16 bytes before a 16-byte aligned member such as Vec2).
+  /// (< 8 bytes, or < 16 bytes before a 16-byte aligned member such as Vec2,
+  /// or the tail padding up to the object's alignment).
   std::vector<std::pair<std::size_t, std::size_t>> gaps() const {
     auto r = ranges_;
     std::sort(r.begin(), r.end());
@@ -96,13 +98,13 @@ class Coverage final : public FieldVisitor {
       if (b > end && !padding) out.emplace_back(end, b);
       end = std::max(end, e);
     }
-    if (size_ > end && size_ - end >= 8) out.emplace_back(end, size_);
+    if (size_ > end && size_ - end >= std::max<std::size_t>(8, align_)) out.emplace_back(end, size_);
     return out;
   }
 
  private:
   const char* base_;
-  std::size_t size_;
+  std::size_t size_, align_;
   std::vector<std::pair<std::size_t, std::size_t>> ranges_;
 };
 
@@ -137,7 +139,7 @@ void expectEveryFieldRoundTrips() {
 template <class Config>
 void expectSchemaCoversEveryMember() {
   Config c;
-  Coverage coverage(&c, sizeof c);
+  Coverage coverage(&c, sizeof c, alignof(Config));
   describe(coverage, c);
   for (const auto& [b, e] : coverage.gaps())
     ADD_FAILURE() << "bytes [" << b << ", " << e << ") of a " << sizeof c
@@ -182,7 +184,7 @@ TEST(ConfigSchema, CoversEveryMemberOfTheOptions) {
     int b = 3;
   };
   Partial p;
-  Coverage coverage(&p, sizeof p);
+  Coverage coverage(&p, sizeof p, alignof(Partial));
   coverage.field({"a", "", ""}, p.a);
   coverage.field({"b", "", ""}, p.b);
   EXPECT_EQ(coverage.gaps().size(), 1u);
