@@ -193,10 +193,10 @@ TEST(ConfigSchema, CoversEveryMemberOfTheOptions) {
 TEST(ConfigSchema, ShippedScenesRoundTrip) {
   for (const char* name : {"sample_davis346_room", "e2e_davis346_room_fast", "davis240_rectangles",
                            "davis346_chessboard"}) {
-    sim::SynthConfig c = sim::loadSynthConfig(std::string(CELC_SOURCE_DIR "/config/scenes/") + name + ".yaml");
+    SynthConfig c = loadSynthConfig(std::string(CELC_SOURCE_DIR "/config/scenes/") + name + ".yaml");
     const std::string yaml = writeYaml([&](FieldVisitor& v) { describe(v, c); });
-    sim::SynthConfig back;
-    back.camera = sim::cameraPreset(back.camera_preset);
+    SynthConfig back;
+    back.camera = cameraPreset(back.camera_preset);
     readYaml(yaml, name, [&](FieldVisitor& v) { describe(v, back); });
     EXPECT_EQ(writeYaml([&](FieldVisitor& v) { describe(v, back); }), yaml) << name;
   }

@@ -7,7 +7,7 @@
 #include "celc/geometry/so3.hpp"
 
 using namespace celc;
-using namespace celc::eval;
+using namespace celc;
 
 namespace {
 Eigen::Matrix4d someTBodyCam() {

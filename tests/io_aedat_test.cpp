@@ -10,8 +10,8 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using namespace celc::io;
-using celc::testing::TempDir;
+using namespace celc;
+using celc::test::TempDir;
 
 namespace {
 
@@ -45,8 +45,8 @@ struct Fixture {
 };
 Fixture fixture(std::size_t n = 20000, int w = 240, int h = 180, double t0 = 10.0) {
   Fixture f;
-  f.ev = celc::testing::randomEvents(n, w, h, 11, t0);
-  f.imu = celc::testing::randomImu(f.ev.front().t, f.ev.back().t, 12);
+  f.ev = celc::test::randomEvents(n, w, h, 11, t0);
+  f.imu = celc::test::randomImu(f.ev.front().t, f.ev.back().t, 12);
   return f;
 }
 
@@ -82,7 +82,7 @@ TEST(IoAedat, Aedat2FirstDataByteIsHash) {
   // raw y = 179 - 37 = 142: the address's first byte is 0x23 = '#'
   std::vector<Event> ev = {{1.0, 5.0f, 37.0f, true}, {1.5, 6.0f, 38.0f, false}};
   writeAedat2(d.file("h.aedat"), ev, {});
-  const std::string b = celc::testing::readBytes(d.file("h.aedat"));
+  const std::string b = celc::test::readBytes(d.file("h.aedat"));
   ASSERT_EQ(b[b.size() - 16], '#');
   auto r = openEventSource(d.file("h.aedat"));
   expectSameEvents(readAllEvents(*r), ev);
@@ -90,7 +90,7 @@ TEST(IoAedat, Aedat2FirstDataByteIsHash) {
 
 TEST(IoAedat, Aedat2TimestampWrapIsUnwrapped) {
   TempDir d;
-  auto ev = celc::testing::randomEvents(40000, 240, 180, 5, 4294.96);  // crosses 2^32 us
+  auto ev = celc::test::randomEvents(40000, 240, 180, 5, 4294.96);  // crosses 2^32 us
   ASSERT_GT(ev.back().t, 4294.967296);
   writeAedat2(d.file("w.aedat"), ev, {});
   auto r = openEventSource(d.file("w.aedat"));
@@ -184,17 +184,17 @@ TEST(IoAedat, Aedat4SeekWithDataTable) {
 
 TEST(IoAedatBad, BadMagicLines) {
   TempDir d;
-  celc::testing::writeBytes(d.file("a.aedat"), "#!AER-DAT9.9\r\n");
+  celc::test::writeBytes(d.file("a.aedat"), "#!AER-DAT9.9\r\n");
   EXPECT_IO_ERROR(openEventSource(d.file("a.aedat")), "byte 0", "unsupported AEDAT version");
   auto f = fixture(100);
   writeAedat2(d.file("b.aedat"), f.ev, {});
-  std::string b = celc::testing::readBytes(d.file("b.aedat"));
+  std::string b = celc::test::readBytes(d.file("b.aedat"));
   b[10] = '1';  // "#!AER-DAT1.0" is not 2.0
-  celc::testing::writeBytes(d.file("b.aedat"), b);
+  celc::test::writeBytes(d.file("b.aedat"), b);
   EXPECT_IO_ERROR(openEventSource(d.file("b.aedat")), "byte 0", "unsupported AEDAT version");
-  celc::testing::writeBytes(d.file("c.aedat4"), "#!AER-DAT4.0 \n");
+  celc::test::writeBytes(d.file("c.aedat4"), "#!AER-DAT4.0 \n");
   EXPECT_IO_ERROR(openEventSource(d.file("c.aedat4")), "byte 0", "bad magic");
-  celc::testing::writeBytes(d.file("d.aedat31"), "#!AER-DAT3.1x\r\n");
+  celc::test::writeBytes(d.file("d.aedat31"), "#!AER-DAT3.1x\r\n");
   EXPECT_IO_ERROR(openEventSource(d.file("d.aedat31")), "byte 0", "bad magic");
 }
 
@@ -202,19 +202,19 @@ TEST(IoAedatBad, Aedat2TruncatedRecordAndHeader) {
   TempDir d;
   auto f = fixture(1000);
   writeAedat2(d.file("a.aedat"), f.ev, {});
-  std::string b = celc::testing::readBytes(d.file("a.aedat"));
-  celc::testing::writeBytes(d.file("t.aedat"), b.substr(0, b.size() - 3));
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat")), "t.aedat: byte " + std::to_string(b.size() - 8),
+  std::string b = celc::test::readBytes(d.file("a.aedat"));
+  celc::test::writeBytes(d.file("t.aedat"), b.substr(0, b.size() - 3));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat")), "t.aedat: byte " + std::to_string(b.size() - 8),
                   "truncated event record");
   // header cut inside the preferences block
   const std::size_t prefs = b.find("#End of Preferences");
-  celc::testing::writeBytes(d.file("h.aedat"), b.substr(0, prefs));
+  celc::test::writeBytes(d.file("h.aedat"), b.substr(0, prefs));
   EXPECT_IO_ERROR(openEventSource(d.file("h.aedat")), "byte " + std::to_string(prefs), "truncated");
   // header line cut without newline
-  celc::testing::writeBytes(d.file("l.aedat"), "#!AER-DAT2.0\r\n# AEChip: DAVIS240C");
+  celc::test::writeBytes(d.file("l.aedat"), "#!AER-DAT2.0\r\n# AEChip: DAVIS240C");
   EXPECT_IO_ERROR(openEventSource(d.file("l.aedat")), "truncated");
   // unknown chip: the size is needed to flip y
-  celc::testing::writeBytes(d.file("u.aedat"), "#!AER-DAT2.0\r\n# AEChip: foo.Mystery\r\n");
+  celc::test::writeBytes(d.file("u.aedat"), "#!AER-DAT2.0\r\n# AEChip: foo.Mystery\r\n");
   EXPECT_IO_ERROR(openEventSource(d.file("u.aedat")), "sensor size unknown", "Mystery");
   ReaderOptions o;
   o.width = 240, o.height = 180;
@@ -233,7 +233,7 @@ TEST(IoAedatBad, Aedat2OutsideSensorAndBackwards) {
   pair((200u << 22) | (5u << 12), 300);   // y = 200 > 179
   pair((10u << 22) | (6u << 12), 150);    // backwards
   pair((10u << 22) | (7u << 12) | 0x400u, 400);  // external event: not a pixel
-  celc::testing::writeBytes(d.file("a.aedat"), b);
+  celc::test::writeBytes(d.file("a.aedat"), b);
   auto r = openEventSource(d.file("a.aedat"));
   auto ev = readAllEvents(*r);
   ASSERT_EQ(ev.size(), 2u);
@@ -242,46 +242,46 @@ TEST(IoAedatBad, Aedat2OutsideSensorAndBackwards) {
   EXPECT_EQ(r->warnings().backwards_time, 1u);
   ReaderOptions strict;
   strict.strict = true;
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("a.aedat"), strict), "byte ", "outside");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("a.aedat"), strict), "byte ", "outside");
 }
 
 TEST(IoAedatBad, Aedat31HostileAndTruncatedPackets) {
   TempDir d;
   auto f = fixture(1000);
   writeAedat31(d.file("a.aedat31"), f.ev, {}, "DAVIS240C", 500);
-  const std::string b = celc::testing::readBytes(d.file("a.aedat31"));
+  const std::string b = celc::test::readBytes(d.file("a.aedat31"));
   const std::size_t data = b.find("#!END-HEADER\r\n") + 14;
   // truncated inside the second packet
-  celc::testing::writeBytes(d.file("t.aedat31"), b.substr(0, b.size() - 100));
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat31")),
+  celc::test::writeBytes(d.file("t.aedat31"), b.substr(0, b.size() - 100));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat31")),
                   "byte " + std::to_string(data + 28 + 500 * 8), "beyond the end of the file");
   // hostile capacity: 2^31-1 events of 8 bytes
   std::string h = b;
   const std::int32_t huge = 0x7FFFFFFF;
   std::memcpy(&h[data + 16], &huge, 4);
-  celc::testing::writeBytes(d.file("h.aedat31"), h);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("h.aedat31")), "byte " + std::to_string(data), "beyond the end of the file");
+  celc::test::writeBytes(d.file("h.aedat31"), h);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("h.aedat31")), "byte " + std::to_string(data), "beyond the end of the file");
   // capacity == number == large, but beyond the file
   std::string h2 = b;
   const std::int32_t big = 100000000;
   std::memcpy(&h2[data + 16], &big, 4);
   std::memcpy(&h2[data + 20], &big, 4);
-  celc::testing::writeBytes(d.file("h2.aedat31"), h2);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("h2.aedat31")), "byte " + std::to_string(data), "beyond the end");
+  celc::test::writeBytes(d.file("h2.aedat31"), h2);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("h2.aedat31")), "byte " + std::to_string(data), "beyond the end");
   // wrong event size for polarity
   std::string s = b;
   const std::int32_t nine = 9;
   std::memcpy(&s[data + 4], &nine, 4);
-  celc::testing::writeBytes(d.file("s.aedat31"), s);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("s.aedat31")), "byte " + std::to_string(data));
+  celc::test::writeBytes(d.file("s.aedat31"), s);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("s.aedat31")), "byte " + std::to_string(data));
   // header without end
-  celc::testing::writeBytes(d.file("e.aedat31"), "#!AER-DAT3.1\r\n#Source 1: DAVIS240C\r\n");
+  celc::test::writeBytes(d.file("e.aedat31"), "#!AER-DAT3.1\r\n#Source 1: DAVIS240C\r\n");
   EXPECT_IO_ERROR(openEventSource(d.file("e.aedat31")), "END-HEADER");
   // pixel outside the sensor: x = 500
   std::string o = b;
   const std::uint32_t px = (500u << 17) | (3u << 2) | 1u;
   std::memcpy(&o[data + 28], &px, 4);
-  celc::testing::writeBytes(d.file("o.aedat31"), o);
+  celc::test::writeBytes(d.file("o.aedat31"), o);
   auto r = openEventSource(d.file("o.aedat31"));
   EXPECT_EQ(readAllEvents(*r).size(), 999u);
   EXPECT_EQ(r->warnings().outside_sensor, 1u);
@@ -291,7 +291,7 @@ TEST(IoAedatBad, Aedat4HostileSizesCorruptFramesAndBombs) {
   TempDir d;
   auto f = fixture(5000, 320, 240);
   writeAedat4(d.file("a.aedat4"), f.ev, f.imu, 320, 240, Aedat4Compression::Lz4, 1000, false);
-  const std::string b = celc::testing::readBytes(d.file("a.aedat4"));
+  const std::string b = celc::test::readBytes(d.file("a.aedat4"));
   std::int32_t hsize;
   std::memcpy(&hsize, &b[14], 4);
   const std::size_t first = 18 + std::size_t(hsize);
@@ -299,32 +299,32 @@ TEST(IoAedatBad, Aedat4HostileSizesCorruptFramesAndBombs) {
   std::string h = b;
   const std::int32_t huge = 0x7FFFFFF0;
   std::memcpy(&h[14], &huge, 4);
-  celc::testing::writeBytes(d.file("h.aedat4"), h);
+  celc::test::writeBytes(d.file("h.aedat4"), h);
   EXPECT_IO_ERROR(openEventSource(d.file("h.aedat4")), "byte 14", "IOHeader size");
   // hostile packet size
   std::string p = b;
   std::memcpy(&p[first + 4], &huge, 4);
-  celc::testing::writeBytes(d.file("p.aedat4"), p);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("p.aedat4")), "byte " + std::to_string(first), "packet size");
+  celc::test::writeBytes(d.file("p.aedat4"), p);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("p.aedat4")), "byte " + std::to_string(first), "packet size");
   // truncated file
-  celc::testing::writeBytes(d.file("t.aedat4"), b.substr(0, b.size() - 50));
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.aedat4")), "truncated");
+  celc::test::writeBytes(d.file("t.aedat4"), b.substr(0, b.size() - 50));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat4")), "truncated");
   // corrupt LZ4 frame (garbage in the first packet's payload)
   std::string c = b;
   for (std::size_t i = first + 8 + 10; i < first + 8 + 60; ++i) c[i] = char(0xA5);
-  celc::testing::writeBytes(d.file("c.aedat4"), c);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("c.aedat4")), "byte " + std::to_string(first));
+  celc::test::writeBytes(d.file("c.aedat4"), c);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("c.aedat4")), "byte " + std::to_string(first));
   // decompression bomb guard: a limit smaller than one decoded packet (1000 * 16 bytes)
   ReaderOptions small;
   small.max_packet_bytes = 12000;  // > the compressed packet (~9 kB), < decoded (16 kB)
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("a.aedat4"), small), "beyond the 12000-byte limit");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("a.aedat4"), small), "beyond the 12000-byte limit");
 }
 
 TEST(IoAedatBad, Aedat4FlatbufferOffsetsChecked) {
   TempDir d;
   auto f = fixture(100, 320, 240);
   writeAedat4(d.file("a.aedat4"), f.ev, {}, 320, 240, Aedat4Compression::None, 1000, false);
-  const std::string b = celc::testing::readBytes(d.file("a.aedat4"));
+  const std::string b = celc::test::readBytes(d.file("a.aedat4"));
   std::int32_t hsize;
   std::memcpy(&hsize, &b[14], 4);
   const std::size_t payload = 18 + std::size_t(hsize) + 8;
@@ -332,19 +332,19 @@ TEST(IoAedatBad, Aedat4FlatbufferOffsetsChecked) {
   std::string v = b;
   const std::uint32_t many = 0x10000000;
   std::memcpy(&v[payload + 36], &many, 4);
-  celc::testing::writeBytes(d.file("v.aedat4"), v);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("v.aedat4")), "exceeds the buffer");
+  celc::test::writeBytes(d.file("v.aedat4"), v);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("v.aedat4")), "exceeds the buffer");
   // the root offset pointing outside
   std::string r = b;
   const std::uint32_t far = 0x00FFFFFF;
   std::memcpy(&r[payload + 4], &far, 4);
-  celc::testing::writeBytes(d.file("r.aedat4"), r);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("r.aedat4")), "out of bounds");
+  celc::test::writeBytes(d.file("r.aedat4"), r);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("r.aedat4")), "out of bounds");
   // a wrong identifier
   std::string i = b;
   i[payload + 8] = 'X';
-  celc::testing::writeBytes(d.file("i.aedat4"), i);
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("i.aedat4")), "identifier");
+  celc::test::writeBytes(d.file("i.aedat4"), i);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("i.aedat4")), "identifier");
 }
 
 /// Random byte flips and truncations of small valid files: every outcome is
@@ -364,7 +364,7 @@ TEST(IoAedatBad, MutationFuzzNeverCrashes) {
   o.max_packet_bytes = 1 << 20;
   int errors = 0, oks = 0;
   for (const char* name : {"a.aedat2", "a.aedat31", "l.aedat4", "z.aedat4", "n.aedat4", "e.txt"}) {
-    const std::string good = celc::testing::readBytes(d.file(name));
+    const std::string good = celc::test::readBytes(d.file(name));
     for (int trial = 0; trial < 60; ++trial) {
       std::string m = good;
       if (trial % 4 == 3) {
@@ -375,7 +375,7 @@ TEST(IoAedatBad, MutationFuzzNeverCrashes) {
           m[std::uniform_int_distribution<std::size_t>(0, m.size() - 1)(rng)] = char(rng() & 0xFF);
       }
       const std::string p = d.file(std::string("m_") + name);
-      celc::testing::writeBytes(p, m);
+      celc::test::writeBytes(p, m);
       try {
         (void)scanFile(p, o);
         ++oks;
@@ -394,7 +394,7 @@ TEST(IoAedatBad, MutationFuzzNeverCrashes) {
 // ---- conformance with ../shared/data (README facts) --------------------------------
 
 TEST(IoAedatConformance, Davis240Aedat2) {
-  const std::string p = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  const std::string p = celc::test::sharedData("aedat/davis240c_translation_boxes.aedat2");
   SKIP_IF_NO_SHARED(p);
   auto r = openEventSource(p);
   EXPECT_EQ(r->width(), 240);
@@ -419,8 +419,8 @@ TEST(IoAedatConformance, Davis240Aedat2) {
 }
 
 TEST(IoAedatConformance, DerivedAedat31MatchesAedat2) {
-  const std::string p2 = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
-  const std::string p3 = celc::testing::sharedData("aedat/davis240c_translation_boxes.DERIVED.aedat31");
+  const std::string p2 = celc::test::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  const std::string p3 = celc::test::sharedData("aedat/davis240c_translation_boxes.DERIVED.aedat31");
   SKIP_IF_NO_SHARED(p3);
   auto r2 = openEventSource(p2);
   auto r3 = openEventSource(p3);
@@ -440,7 +440,7 @@ TEST(IoAedatConformance, DerivedAedat31MatchesAedat2) {
 }
 
 TEST(IoAedatConformance, DvxplorerAedat4AllCompressions) {
-  const std::string lz4 = celc::testing::sharedData("aedat/dvxplorer_sample_lz4.aedat4");
+  const std::string lz4 = celc::test::sharedData("aedat/dvxplorer_sample_lz4.aedat4");
   SKIP_IF_NO_SHARED(lz4);
   auto r = openEventSource(lz4);
   EXPECT_EQ(r->width(), 320);
@@ -460,7 +460,7 @@ TEST(IoAedatConformance, DvxplorerAedat4AllCompressions) {
   EXPECT_LT((g - Vec3(0.412, 0.076, -0.412)).norm(), 2e-3);
   for (const char* other : {"aedat/dvxplorer_sample_zstd.DERIVED.aedat4",
                             "aedat/dvxplorer_sample_uncompressed.DERIVED.aedat4"}) {
-    auto r2 = openEventSource(celc::testing::sharedData(other));
+    auto r2 = openEventSource(celc::test::sharedData(other));
     expectSameEvents(readAllEvents(*r2), ev);
     expectSameImu(r2->readImu(), imu, 1e-12, 1e-12);
   }
@@ -477,7 +477,7 @@ TEST(IoAedatConformance, DvxplorerAedat4AllCompressions) {
 }
 
 TEST(IoAedatConformance, HeaderOnlyTruncatedIsReported) {
-  const std::string p = celc::testing::sharedData("aedat/header_only_truncated.aedat");
+  const std::string p = celc::test::sharedData("aedat/header_only_truncated.aedat");
   SKIP_IF_NO_SHARED(p);
   EXPECT_IO_ERROR(openEventSource(p), "header_only_truncated.aedat: byte 599", "truncated");
 }
@@ -486,8 +486,8 @@ TEST(IoAedatConformance, HeaderOnlyTruncatedIsReported) {
 /// lines and records straddling a refill, IMU samples split across blocks.
 TEST(IoAedat, LargeFilesCrossBufferBoundaries) {
   TempDir d;
-  auto ev = celc::testing::randomEvents(1200000, 240, 180, 21, 1.0);  // 9.6 MB of AEDAT 2.0, ~26 MB of text
-  auto imu = celc::testing::randomImu(ev.front().t, ev.back().t, 22);
+  auto ev = celc::test::randomEvents(1200000, 240, 180, 21, 1.0);  // 9.6 MB of AEDAT 2.0, ~26 MB of text
+  auto imu = celc::test::randomImu(ev.front().t, ev.back().t, 22);
   writeAedat2(d.file("big.aedat"), ev, imu);
   auto r = openEventSource(d.file("big.aedat"));
   expectSameEvents(readAllEvents(*r), ev);

@@ -5,8 +5,8 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using namespace celc::io;
-using celc::testing::TempDir;
+using namespace celc;
+using celc::test::TempDir;
 
 namespace {
 const char* kGood = R"(camera:
@@ -28,7 +28,7 @@ body:
 
 TEST(IoCalibration, YamlFull) {
   TempDir d;
-  celc::testing::writeBytes(d.file("c.yaml"), kGood);
+  celc::test::writeBytes(d.file("c.yaml"), kGood);
   const Calibration c = loadCalibrationYaml(d.file("c.yaml"));
   EXPECT_EQ(c.camera.width, 240);
   EXPECT_EQ(c.camera.height, 180);
@@ -45,7 +45,7 @@ TEST(IoCalibration, YamlFull) {
 
 TEST(IoCalibration, YamlDefaultsAndTCamImuAndEquidistant) {
   TempDir d;
-  celc::testing::writeBytes(d.file("c.yaml"),
+  celc::test::writeBytes(d.file("c.yaml"),
                             "camera: {width: 346, height: 260, fx: 300, fy: 300, cx: 173, cy: 130,\n"
                             "  distortion_model: equidistant, distortion: [0.1, -0.01, 0.001, 0]}\n"
                             "imu:\n  T_cam_imu: [1,0,0,5, 0,0,-1,6, 0,1,0,7, 0,0,0,1]\n");
@@ -61,7 +61,7 @@ TEST(IoCalibration, YamlDefaultsAndTCamImuAndEquidistant) {
 TEST(IoCalibrationBad, UnknownKeysWrongTypesAndValues) {
   TempDir d;
   auto check = [&](const std::string& text, std::vector<std::string> frags) {
-    celc::testing::writeBytes(d.file("c.yaml"), text);
+    celc::test::writeBytes(d.file("c.yaml"), text);
     frags.push_back(d.file("c.yaml"));
     try {
       loadCalibrationYaml(d.file("c.yaml"));
@@ -97,7 +97,7 @@ TEST(IoCalibrationBad, UnknownKeysWrongTypesAndValues) {
 
 TEST(IoCalibration, CalibTxt) {
   TempDir d;
-  celc::testing::writeBytes(d.file("calib.txt"),
+  celc::test::writeBytes(d.file("calib.txt"),
                             "199.092366542 198.82882047 132.192071378 110.712660011 -0.368436311798 "
                             "0.150947243557 -0.000296130534385 -0.000759431726241 0.0\r\n");
   const Calibration c = loadCalibration(d.file("calib.txt"));
@@ -105,18 +105,18 @@ TEST(IoCalibration, CalibTxt) {
   EXPECT_EQ(c.camera.distortion, DistortionModel::RadTan);
   EXPECT_DOUBLE_EQ(c.camera.coeffs[1], 0.150947243557);
   EXPECT_DOUBLE_EQ(c.camera.coeffs[4], 0.0);
-  celc::testing::writeBytes(d.file("pin.txt"), "200 200 120 90\n");
+  celc::test::writeBytes(d.file("pin.txt"), "200 200 120 90\n");
   EXPECT_EQ(loadCalibTxt(d.file("pin.txt"), 240, 180).camera.distortion, DistortionModel::None);
-  celc::testing::writeBytes(d.file("bad.txt"), "200 200 120\n");
+  celc::test::writeBytes(d.file("bad.txt"), "200 200 120\n");
   EXPECT_IO_ERROR(loadCalibTxt(d.file("bad.txt")), "bad.txt: line 1", "found 3");
-  celc::testing::writeBytes(d.file("nan.txt"), "200 200 x 90\n");
+  celc::test::writeBytes(d.file("nan.txt"), "200 200 x 90\n");
   EXPECT_IO_ERROR(loadCalibTxt(d.file("nan.txt")), "line 1", "non-numeric", "column 3");
-  celc::testing::writeBytes(d.file("empty.txt"), "# nothing\n");
+  celc::test::writeBytes(d.file("empty.txt"), "# nothing\n");
   EXPECT_IO_ERROR(loadCalibTxt(d.file("empty.txt")), "no calibration line");
 }
 
 TEST(IoCalibrationConformance, EcdCalibTxt) {
-  const std::string p = celc::testing::sharedData("ecd_slices/boxes_translation/calib.txt");
+  const std::string p = celc::test::sharedData("ecd_slices/boxes_translation/calib.txt");
   SKIP_IF_NO_SHARED(p);
   const Calibration c = loadCalibration(p);
   EXPECT_EQ(c.camera.distortion, DistortionModel::RadTan);

@@ -10,7 +10,7 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using celc::testing::TempDir;
+using celc::test::TempDir;
 
 namespace {
 int run(const std::string& cmd, std::string& out) {
@@ -27,9 +27,9 @@ int run(const std::string& cmd, std::string& out) {
 
 TEST(IoCli, InfoPrintsCountsAndRates) {
   TempDir d;
-  auto ev = celc::testing::randomEvents(3000, 240, 180, 9, 5.0);
-  auto imu = celc::testing::randomImu(ev.front().t, ev.back().t, 10);
-  io::writeAedat4(d.file("a.aedat4"), ev, imu, 240, 180, io::Aedat4Compression::Zstd, 1000, true);
+  auto ev = celc::test::randomEvents(3000, 240, 180, 9, 5.0);
+  auto imu = celc::test::randomImu(ev.front().t, ev.back().t, 10);
+  writeAedat4(d.file("a.aedat4"), ev, imu, 240, 180, Aedat4Compression::Zstd, 1000, true);
   std::size_t on = 0;
   for (const auto& e : ev) on += e.on;
   std::string out;
@@ -44,12 +44,12 @@ TEST(IoCli, InfoPrintsCountsAndRates) {
 
 TEST(IoCli, InfoBadFileIsOneLineErrorNonZeroExit) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 x 2 1\n");
+  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 x 2 1\n");
   std::string out;
   EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("e.txt"), out), 0);
   EXPECT_NE(out.find("e.txt: line 2: non-numeric x"), std::string::npos) << out;
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
-  celc::testing::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1 1 2 1\n");
+  celc::test::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1 1 2 1\n");
   ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("w.txt"), out), 0) << out;
   EXPECT_NE(out.find("timestamps backwards 1"), std::string::npos) << out;
   EXPECT_NE(run(std::string(CELC_BINARY) + " info --strict " + d.file("w.txt"), out), 0);

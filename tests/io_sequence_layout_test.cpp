@@ -9,24 +9,24 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using namespace celc::io;
+using namespace celc;
 
 TEST(SequenceLayout, FindsTheFilesAndPrefersCalibYaml) {
-  celc::testing::TempDir d;
+  celc::test::TempDir d;
   const std::string dir = d.file("");
   EXPECT_FALSE(isSequenceDirectory(dir));
   EXPECT_TRUE(resolveSequenceLayout(dir).events.empty());
-  celc::testing::writeBytes(d.file("events.txt"), "0.1 1 2 1\n");
-  celc::testing::writeBytes(d.file("calib.txt"), "1 1 1 1\n");
+  celc::test::writeBytes(d.file("events.txt"), "0.1 1 2 1\n");
+  celc::test::writeBytes(d.file("calib.txt"), "1 1 1 1\n");
   EXPECT_TRUE(isSequenceDirectory(dir));
   SequenceLayout l = resolveSequenceLayout(dir);
   EXPECT_EQ(l.events, d.file("events.txt"));
   EXPECT_EQ(l.calib, d.file("calib.txt"));
   EXPECT_TRUE(l.imu.empty());
   EXPECT_TRUE(l.groundtruth.empty());
-  celc::testing::writeBytes(d.file("calib.yaml"), "fx: 1\n");
-  celc::testing::writeBytes(d.file("imu.txt"), "");
-  celc::testing::writeBytes(d.file("groundtruth.txt"), "");
+  celc::test::writeBytes(d.file("calib.yaml"), "fx: 1\n");
+  celc::test::writeBytes(d.file("imu.txt"), "");
+  celc::test::writeBytes(d.file("groundtruth.txt"), "");
   l = resolveSequenceLayout(dir);
   EXPECT_EQ(l.calib, d.file("calib.yaml"));
   EXPECT_EQ(l.imu, d.file("imu.txt"));

@@ -12,7 +12,7 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::testing {
+namespace celc::test {
 
 /// A fresh directory under the system temp dir, removed at destruction.
 class TempDir {
@@ -73,9 +73,9 @@ inline void writeBytes(const std::string& path, const std::string& bytes) {
 }
 
 /// Reads everything (events and IMU) from a source; throws what the reader throws.
-inline std::size_t drain(const std::string& path, const io::ReaderOptions& o = {}) {
-  auto r = io::openEventSource(path, o);
-  std::size_t n = io::readAllEvents(*r).size();
+inline std::size_t drain(const std::string& path, const ReaderOptions& o = {}) {
+  auto r = openEventSource(path, o);
+  std::size_t n = readAllEvents(*r).size();
   n += r->readImu().size();
   return n;
 }
@@ -86,7 +86,7 @@ inline std::size_t drain(const std::string& path, const io::ReaderOptions& o = {
     try {                                                                            \
       stmt;                                                                          \
       ADD_FAILURE() << "no IoError from " #stmt;                                     \
-    } catch (const celc::io::IoError& e) {                                           \
+    } catch (const celc::IoError& e) {                                           \
       const std::string msg_ = e.what();                                             \
       for (const std::string& frag_ : std::vector<std::string>{__VA_ARGS__})                                \
         EXPECT_NE(msg_.find(frag_), std::string::npos) << "message: " << msg_ << "\nmissing: " << frag_; \
@@ -101,4 +101,4 @@ inline std::string sharedData(const std::string& rel) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent (" << path                \
                                                    << "): conformance test needs ../shared/data"
 
-}  // namespace celc::testing
+}  // namespace celc::test

@@ -8,8 +8,8 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using namespace celc::io;
-using celc::testing::TempDir;
+using namespace celc;
+using celc::test::TempDir;
 
 namespace {
 void expectSameEvents(const std::vector<Event>& a, const std::vector<Event>& b) {
@@ -25,7 +25,7 @@ void expectSameEvents(const std::vector<Event>& a, const std::vector<Event>& b) 
 
 TEST(IoText, EventsRoundTripAllVariants) {
   TempDir d;
-  const auto ev = celc::testing::randomEvents(5000, 240, 180, 1);
+  const auto ev = celc::test::randomEvents(5000, 240, 180, 1);
   struct V { bool crlf, id, final_nl; std::string header; };
   const V variants[] = {{false, false, true, ""}, {true, false, true, ""}, {false, false, false, ""},
                         {true, true, false, ""},  {false, false, true, "t x y p"},
@@ -43,7 +43,7 @@ TEST(IoText, EventsRoundTripAllVariants) {
 
 TEST(IoText, HeaderGivesColumnOrderAndCommasAndSmallBatches) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.csv"), "x,y,p,t\n3,4,1,0.5\n5,6,0,0.75\r\n");
+  celc::test::writeBytes(d.file("e.csv"), "x,y,p,t\n3,4,1,0.5\n5,6,0,0.75\r\n");
   auto r = openEventSource(d.file("e.csv"));
   std::vector<Event> b;
   ASSERT_TRUE(r->next(b, 1));
@@ -61,7 +61,7 @@ TEST(IoText, HeaderGivesColumnOrderAndCommasAndSmallBatches) {
 
 TEST(IoText, PolarityMinusOneAndTimeScale) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.txt"), "1000 1 2 -1\n2000 1 2 1\n");
+  celc::test::writeBytes(d.file("e.txt"), "1000 1 2 -1\n2000 1 2 1\n");
   ReaderOptions o;
   o.text_time_scale = 1e-6;
   auto r = openEventSource(d.file("e.txt"), o);
@@ -73,7 +73,7 @@ TEST(IoText, PolarityMinusOneAndTimeScale) {
 
 TEST(IoText, ImuColumnOrders) {
   TempDir d;
-  auto imu = celc::testing::randomImu(1.0, 1.05, 2);
+  auto imu = celc::test::randomImu(1.0, 1.05, 2);
   // RPG: t ax ay az gx gy gz
   writeImuText(d.file("rpg.txt"), imu, false);
   // UZH-FPV: id t wx wy wz ax ay az with header
@@ -106,9 +106,9 @@ TEST(IoText, ImuColumnOrders) {
 
 TEST(IoText, RpgDirectoryWithImu) {
   TempDir d;
-  const auto ev = celc::testing::randomEvents(100, 240, 180, 3, 1.0);
+  const auto ev = celc::test::randomEvents(100, 240, 180, 3, 1.0);
   writeEventsText(d.file("events.txt"), ev);
-  writeImuText(d.file("imu.txt"), celc::testing::randomImu(1.0, 1.01, 4), false);
+  writeImuText(d.file("imu.txt"), celc::test::randomImu(1.0, 1.01, 4), false);
   const std::string dir = d.file("");
   EXPECT_EQ(detectFormat(dir), Format::RpgDirectory);
   auto r = openEventSource(dir);
@@ -143,43 +143,43 @@ TEST(IoText, PosesWithAndWithoutId) {
 
 TEST(IoTextBad, NonNumericFieldNamesFileAndLine) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("e.txt")), d.file("e.txt"), "line 3", "non-numeric x");
-  celc::testing::writeBytes(d.file("t.txt"), "0.1 1 2 1\n0.2x 1 2 1\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("t.txt")), "line 2", "timestamp");
-  celc::testing::writeBytes(d.file("n.txt"), "nan 1 2 1\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("n.txt")), "line 1", "timestamp");
+  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), d.file("e.txt"), "line 3", "non-numeric x");
+  celc::test::writeBytes(d.file("t.txt"), "0.1 1 2 1\n0.2x 1 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.txt")), "line 2", "timestamp");
+  celc::test::writeBytes(d.file("n.txt"), "nan 1 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("n.txt")), "line 1", "timestamp");
 }
 
 TEST(IoTextBad, WrongColumnCounts) {
   TempDir d;
-  celc::testing::writeBytes(d.file("a.txt"), "0.1 1 2 1\n0.2 1 2\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("a.txt")), "line 2", "expected 4 columns, found 3");
-  celc::testing::writeBytes(d.file("b.txt"), "0.1 1 2\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("b.txt")), "line 1", "unsupported column count 3");
-  celc::testing::writeBytes(d.file("c.txt"), "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("c.txt")), "line 1", "column count");
-  celc::testing::writeBytes(d.file("imu.txt"), "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n");
+  celc::test::writeBytes(d.file("a.txt"), "0.1 1 2 1\n0.2 1 2\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("a.txt")), "line 2", "expected 4 columns, found 3");
+  celc::test::writeBytes(d.file("b.txt"), "0.1 1 2\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("b.txt")), "line 1", "unsupported column count 3");
+  celc::test::writeBytes(d.file("c.txt"), "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("c.txt")), "line 1", "column count");
+  celc::test::writeBytes(d.file("imu.txt"), "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n");
   EXPECT_IO_ERROR(readImuText(d.file("imu.txt")), "imu.txt: line 2", "expected 7 columns");
-  celc::testing::writeBytes(d.file("gt.txt"), "0.1 1 2 3 0 0 0\n");
+  celc::test::writeBytes(d.file("gt.txt"), "0.1 1 2 3 0 0 0\n");
   EXPECT_IO_ERROR(readPosesText(d.file("gt.txt")), "gt.txt: line 1", "column count 7");
 }
 
 TEST(IoTextBad, BadPolarityHeaderAndQuaternion) {
   TempDir d;
-  celc::testing::writeBytes(d.file("p.txt"), "0.1 1 2 2\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("p.txt")), "line 1", "polarity");
-  celc::testing::writeBytes(d.file("h.txt"), "time col row sign\n0.1 1 2 1\n");
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("h.txt")), "line 1", "header");
-  celc::testing::writeBytes(d.file("q.txt"), "0.1 0 0 0 0 0 0 0\n");
+  celc::test::writeBytes(d.file("p.txt"), "0.1 1 2 2\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("p.txt")), "line 1", "polarity");
+  celc::test::writeBytes(d.file("h.txt"), "time col row sign\n0.1 1 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("h.txt")), "line 1", "header");
+  celc::test::writeBytes(d.file("q.txt"), "0.1 0 0 0 0 0 0 0\n");
   EXPECT_IO_ERROR(readPosesText(d.file("q.txt")), "line 1", "zero quaternion");
-  celc::testing::writeBytes(d.file("qt.txt"), "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n");
+  celc::test::writeBytes(d.file("qt.txt"), "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n");
   EXPECT_IO_ERROR(readPosesText(d.file("qt.txt")), "line 2", "increase");
 }
 
 TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.3 1 2 1\n0.2 1 2 1\n0.4 1 2 1\n");
+  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.3 1 2 1\n0.2 1 2 1\n0.4 1 2 1\n");
   auto r = openEventSource(d.file("e.txt"));
   EXPECT_EQ(readAllEvents(*r).size(), 4u);  // kept
   EXPECT_EQ(r->warnings().backwards_time, 1u);
@@ -187,12 +187,12 @@ TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   EXPECT_NE(r->warnings().messages[0].find("line 3"), std::string::npos);
   ReaderOptions strict;
   strict.strict = true;
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("e.txt"), strict), "line 3", "before previous");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), strict), "line 3", "before previous");
 }
 
 TEST(IoTextBad, PixelsOutsideSensorDropped) {
   TempDir d;
-  celc::testing::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 240 2 1\n0.3 -1 2 1\n0.4 239 179 0\n");
+  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 240 2 1\n0.3 -1 2 1\n0.4 239 179 0\n");
   ReaderOptions o;
   o.width = 240;
   o.height = 180;
@@ -202,7 +202,7 @@ TEST(IoTextBad, PixelsOutsideSensorDropped) {
   // without a sensor size only negative pixels (and >= 65536) are outside
   auto r2 = openEventSource(d.file("e.txt"));
   EXPECT_EQ(readAllEvents(*r2).size(), 3u);
-  celc::testing::writeBytes(d.file("huge.txt"), "0.1 1e30 2 1\n0.2 1.5 2.5 1\n");
+  celc::test::writeBytes(d.file("huge.txt"), "0.1 1e30 2 1\n0.2 1.5 2.5 1\n");
   auto r3 = openEventSource(d.file("huge.txt"));
   auto ev = readAllEvents(*r3);
   ASSERT_EQ(ev.size(), 1u);  // sub-pixel coordinates (simulators) are kept as floats
@@ -212,17 +212,17 @@ TEST(IoTextBad, PixelsOutsideSensorDropped) {
 
 TEST(IoTextBad, EmptyMissingBinaryAndHugeLine) {
   TempDir d;
-  celc::testing::writeBytes(d.file("empty.txt"), "");
+  celc::test::writeBytes(d.file("empty.txt"), "");
   auto r = openEventSource(d.file("empty.txt"));
   std::vector<Event> b;
   EXPECT_FALSE(r->next(b, 10));
   EXPECT_IO_ERROR(openEventSource(d.file("missing.txt")), "missing.txt", "cannot open");
   std::filesystem::create_directories(d.file("nodir"));
   EXPECT_IO_ERROR(openEventSource(d.file("nodir")), "nodir", "without events.txt");
-  celc::testing::writeBytes(d.file("bin.dat"), std::string("\x01\x00\x02\x03", 4));
+  celc::test::writeBytes(d.file("bin.dat"), std::string("\x01\x00\x02\x03", 4));
   EXPECT_IO_ERROR(openEventSource(d.file("bin.dat")), "byte 1", "binary");
-  celc::testing::writeBytes(d.file("long.txt"), std::string(5u << 20, '1'));
-  EXPECT_IO_ERROR(celc::testing::drain(d.file("long.txt")), "line 1", "longer than");
+  celc::test::writeBytes(d.file("long.txt"), std::string(5u << 20, '1'));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("long.txt")), "line 1", "longer than");
   ReaderOptions bad;
   bad.width = 10;  // height missing
   EXPECT_IO_ERROR(openEventSource(d.file("empty.txt"), bad), "invalid reader options");
@@ -230,7 +230,7 @@ TEST(IoTextBad, EmptyMissingBinaryAndHugeLine) {
 
 TEST(IoTextConformance, EcdSlices) {
   for (const char* seq : {"boxes_rotation", "boxes_translation", "poster_translation", "shapes_translation"}) {
-    const std::string dir = celc::testing::sharedData(std::string("ecd_slices/") + seq);
+    const std::string dir = celc::test::sharedData(std::string("ecd_slices/") + seq);
     SKIP_IF_NO_SHARED(dir);
     ReaderOptions o;
     o.width = 240;
@@ -240,7 +240,7 @@ TEST(IoTextConformance, EcdSlices) {
     EXPECT_EQ(ev.size(), 30000u) << seq;
     EXPECT_EQ(r->warnings().total(), 0u) << seq;
   }
-  const std::string dir = celc::testing::sharedData("ecd_slices/boxes_translation");
+  const std::string dir = celc::test::sharedData("ecd_slices/boxes_translation");
   auto r = openEventSource(dir);
   auto ev = readAllEvents(*r);
   EXPECT_NEAR(ev.front().t, 18.5799, 1e-4);  // README: boxes_translation starts at t = 18.5799 s

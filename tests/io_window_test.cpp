@@ -10,12 +10,12 @@
 #include "io_test_util.hpp"
 
 using namespace celc;
-using namespace celc::io;
-using celc::testing::TempDir;
+using namespace celc;
+using celc::test::TempDir;
 
 TEST(IoWindow, CountWindowsCoverTheFileInOrder) {
   TempDir d;
-  const auto ev = celc::testing::randomEvents(10500, 240, 180, 7);
+  const auto ev = celc::test::randomEvents(10500, 240, 180, 7);
   writeEventsText(d.file("e.txt"), ev);
   auto r = openEventSource(d.file("e.txt"));
   WindowOptions o;
@@ -44,7 +44,7 @@ TEST(IoWindow, CountWindowsCoverTheFileInOrder) {
 
 TEST(IoWindow, CountWindowsWithOverlap) {
   TempDir d;
-  const auto ev = celc::testing::randomEvents(5000, 240, 180, 8);
+  const auto ev = celc::test::randomEvents(5000, 240, 180, 8);
   writeAedat2(d.file("e.aedat"), ev, {});
   auto r = openEventSource(d.file("e.aedat"));
   WindowOptions o;
@@ -112,7 +112,7 @@ TEST(IoWindow, DurationWindowsOverlapAndEmptyGap) {
 
 TEST(IoWindow, InvalidOptions) {
   TempDir d;
-  writeEventsText(d.file("e.txt"), celc::testing::randomEvents(10, 10, 10, 1));
+  writeEventsText(d.file("e.txt"), celc::test::randomEvents(10, 10, 10, 1));
   auto r = openEventSource(d.file("e.txt"));
   WindowOptions o;
   EXPECT_THROW(WindowSource(*r, o), std::invalid_argument);  // neither N nor S
@@ -192,7 +192,7 @@ TEST(IoGyro, StatusInsteadOfGuess) {
 }
 
 TEST(IoGyroConformance, Davis240WindowAtRest) {
-  const std::string p = celc::testing::sharedData("aedat/davis240c_translation_boxes.aedat2");
+  const std::string p = celc::test::sharedData("aedat/davis240c_translation_boxes.aedat2");
   SKIP_IF_NO_SHARED(p);
   auto r = openEventSource(p);
   GyroTrack g(r->readImu(), Mat3::Identity(), 0.0);

@@ -30,7 +30,7 @@ TEST(EndToEnd, RenderedRoomVelocityWithinTolerance) {
                                      (d / "run").string() + "'",
                                  d);
   ASSERT_EQ(run.status, 0) << run.err;
-  const auto rows = eval::readWindowsCsv((d / "run" / "windows.csv").string(), false);
+  const auto rows = readWindowsCsv((d / "run" / "windows.csv").string(), false);
   const Vec3 twist = Vec3(3.2, -0.6, 2.4).normalized();  // the scene's v
   int windows = 0;
   for (const auto& row : rows) {
@@ -39,7 +39,7 @@ TEST(EndToEnd, RenderedRoomVelocityWithinTolerance) {
     if (row.method == "celc_ml") ++windows;
   }
   EXPECT_EQ(windows, 4);
-  for (const auto& s : eval::summarize(rows)) {
+  for (const auto& s : summarize(rows)) {
     if (s.method != "celc_ml") continue;
     EXPECT_EQ(s.ok, 4);
     EXPECT_LE(s.phi_median, 0.05) << "celc_ml median phi [rad]";

@@ -59,7 +59,7 @@ TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
   const fs::path d = test::freshTempDir("pipe_run");
   const auto r = test::runCelc("run '" + kSample + "' -o '" + (d / "o").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto rows = eval::readWindowsCsv((d / "o" / "windows.csv").string(), false);
+  const auto rows = readWindowsCsv((d / "o" / "windows.csv").string(), false);
   const size_t n_methods = RunConfig{}.methods.size();
   ASSERT_GE(rows.size(), n_methods * 3);  // >= 3 windows x every method
   std::map<std::int64_t, int> per_window;
@@ -166,7 +166,7 @@ TEST(Pipeline, BadInputsGiveOneLineErrorsOrStatuses) {
   fs::copy_file(kSample + "/calib.yaml", d / "seq" / "calib.yaml");
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "o2").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const auto& row : eval::readWindowsCsv((d / "o2" / "windows.csv").string())) {
+  for (const auto& row : readWindowsCsv((d / "o2" / "windows.csv").string())) {
     EXPECT_EQ(row.status, "no_gyro");
     EXPECT_FALSE(row.has_v);
   }
@@ -180,7 +180,7 @@ TEST(Pipeline, BadInputsGiveOneLineErrorsOrStatuses) {
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "o3").string() + "'" + kFast, d);
   ASSERT_EQ(r.status, 0) << r.err;
   std::set<std::string> statuses;
-  for (const auto& row : eval::readWindowsCsv((d / "o3" / "windows.csv").string())) statuses.insert(row.status);
+  for (const auto& row : readWindowsCsv((d / "o3" / "windows.csv").string())) statuses.insert(row.status);
   EXPECT_TRUE(statuses.count("not_covered") || statuses.count("gyro_gap")) << *statuses.begin();
   // A wrong configuration key names the key and the file.
   std::ofstream(d / "bad.yaml") << "windows:\n  evnts: 3\n";
@@ -212,7 +212,7 @@ TEST(Pipeline, BatchWritesPaperTables) {
   EXPECT_NE(tex.find("\\textbf{"), std::string::npos);
   EXPECT_NE(readAll(d / "out" / "table.md").find("| roomB | phi [rad] |"), std::string::npos);
   // roomB ran only two methods.
-  for (const auto& row : eval::readWindowsCsv((d / "out" / "roomB" / "windows.csv").string()))
+  for (const auto& row : readWindowsCsv((d / "out" / "roomB" / "windows.csv").string()))
     EXPECT_TRUE(row.method == "celc" || row.method == "ce3lc") << row.method;
   std::ofstream(d / "bad.yaml") << "sequences:\n  - {label: x, pth: y}\n";
   const auto bad = test::runCelc("batch '" + (d / "bad.yaml").string() + "' -o '" + (d / "o2").string() + "'", d);

@@ -22,7 +22,7 @@
 #include "celc/sim/scene_trajectory.hpp"
 
 using namespace celc;
-using namespace celc::sim;
+using namespace celc;
 namespace fs = std::filesystem;
 
 namespace {

@@ -50,7 +50,7 @@ void runBatch(const BatchArgs& a) {
     job.title = "celc batch: " + e.label;
     jobs.push_back(job);
   }
-  std::vector<eval::SequenceSummary> table;
+  std::vector<SequenceSummary> table;
   for (size_t i = 0; i < jobs.size(); ++i) {
     spdlog::info("batch {}/{}: {} ({})", i + 1, jobs.size(), entries[i].label, jobs[i].inputs.events);
     Progress progress("batch " + entries[i].label, o.quiet);
@@ -62,11 +62,11 @@ void runBatch(const BatchArgs& a) {
     table.push_back({entries[i].label, outcome.summaries});
   }
   const fs::path out(a.outdir);
-  writeFileAtomically((out / "table.md").string(), eval::tableMarkdown(table));
-  writeFileAtomically((out / "table.tex").string(), eval::tableLatex(table));
-  writeFileAtomically((out / "table.csv").string(), eval::tableCsv(table));
+  writeFileAtomically((out / "table.md").string(), tableMarkdown(table));
+  writeFileAtomically((out / "table.tex").string(), tableLatex(table));
+  writeFileAtomically((out / "table.csv").string(), tableCsv(table));
   std::cout << "\nTable (mean over windows with ground truth; " << (out / "table.{md,tex,csv}").string()
-            << ")\n\n" << eval::tableMarkdown(table) << std::flush;
+            << ")\n\n" << tableMarkdown(table) << std::flush;
 }
 
 }  // namespace

@@ -64,16 +64,16 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   if (const std::string err = opt.validate(); !err.empty())
     throw std::runtime_error("invalid clustering options: " + err);
   // Any format the io module reads (text, AEDAT 2.0 / 3.1 / 4.0), window by window.
-  io::ReaderOptions ro;
+  ReaderOptions ro;
   ro.width = a.width;
   ro.height = a.height;
-  const auto reader = io::openEventSource(a.events, ro);
-  io::WindowOptions wo;
+  const auto reader = openEventSource(a.events, ro);
+  WindowOptions wo;
   wo.events_per_window = a.window_events;
-  io::WindowSource source(*reader, wo);
+  WindowSource source(*reader, wo);
   if (!a.dump.empty()) std::filesystem::create_directories(a.dump);
   std::cout << "window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms\n";
-  io::EventWindow win;
+  EventWindow win;
   for (size_t window = 0; source.next(win); ++window) {
     if (a.max_windows > 0 && window >= a.max_windows) break;
     const std::vector<Event>& ev = win.events;

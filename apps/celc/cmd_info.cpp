@@ -19,15 +19,15 @@ struct InfoArgs {
 };
 
 int runInfo(const InfoArgs& a) {
-  io::ReaderOptions o;
+  ReaderOptions o;
   o.width = a.width;
   o.height = a.height;
-  o.imu_columns = io::parseImuColumns(a.imu_columns);
+  o.imu_columns = parseImuColumns(a.imu_columns);
   o.text_time_scale = a.time_scale;
   o.strict = a.strict;
-  const io::FileInfo info = io::scanFile(a.path, o);
+  const FileInfo info = scanFile(a.path, o);
   std::printf("file:          %s\n", info.path.c_str());
-  std::printf("format:        %s\n", io::toString(info.format).c_str());
+  std::printf("format:        %s\n", toString(info.format).c_str());
   if (info.width > 0)
     std::printf("sensor:        %d x %d px\n", info.width, info.height);
   else

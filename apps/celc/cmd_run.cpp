@@ -48,13 +48,13 @@ void registerRun(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "run",
       "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (" +
-          io::sequenceLayoutSummary() +
+          sequenceLayoutSummary() +
           ") or an events/aedat file with --calib "
           "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
           "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");
-  cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/calibration.md) or ") + io::sequence_file::kCalibText)
+  cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/calibration.md) or ") + sequence_file::kCalibText)
       ->check(CLI::ExistingFile);
   cmd->add_option("--groundtruth", a->groundtruth, "poses `t px py pz qx qy qz qw` [s, m]")
       ->check(CLI::ExistingFile);

@@ -73,7 +73,7 @@ void runSolve(const SolveArgs& a) {
   if (a.calib.empty() && !a.normalized)
     throw std::runtime_error("solve: pixel events need --calib FILE (or pass --normalized)");
   CameraModel cam;
-  if (!a.calib.empty()) cam = io::loadCalibration(a.calib).camera;
+  if (!a.calib.empty()) cam = loadCalibration(a.calib).camera;
   else cam.fx = cam.fy = a.focal;
 
   // Group by cluster (id >= 0), sorted by time.

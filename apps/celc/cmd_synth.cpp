@@ -27,7 +27,7 @@ struct SynthArgs {
 void runSynth(const SynthArgs& a) {
   configureLogging(a.quiet, a.verbose);
   namespace fs = std::filesystem;
-  sim::SynthConfig cfg = sim::loadSynthConfig(a.scene);
+  SynthConfig cfg = loadSynthConfig(a.scene);
   if (a.seed >= 0) cfg.seed = static_cast<uint64_t>(a.seed);
   if (a.duration > 0.0) cfg.duration = a.duration;
   if (a.threads > 0) cfg.events.threads = a.threads;
@@ -48,7 +48,7 @@ void runSynth(const SynthArgs& a) {
   auto last = std::chrono::steady_clock::now();
   const double duration = cfg.duration;
   const bool show = !a.quiet;
-  const auto summary = sim::writeSequence(cfg, a.out, [&](double t, int64_t n) {
+  const auto summary = writeSequence(cfg, a.out, [&](double t, int64_t n) {
     const auto now = std::chrono::steady_clock::now();
     if (show && (now - last > std::chrono::seconds(2) || t >= duration)) {
       spdlog::info("synth: {:.3f} / {:.3f} s simulated, {} events", t, duration, n);
@@ -70,7 +70,7 @@ void runSynth(const SynthArgs& a) {
 // "events.txt, labels.txt, ...": the files `celc synth` writes.
 std::string synthFileList() {
   std::string list;
-  for (const char* name : io::simulatedSequenceFiles()) list += (list.empty() ? "" : ", ") + std::string(name);
+  for (const char* name : simulatedSequenceFiles()) list += (list.empty() ? "" : ", ") + std::string(name);
   return list;
 }
 }  // namespace

@@ -48,13 +48,13 @@ void runTable(const TableArgs& a) {
   // Rows per sequence label (the folder holding windows.csv); shards of one
   // sequence merge, a (window, method) seen twice is counted once.
   std::vector<std::string> order;
-  std::map<std::string, std::vector<eval::WindowsCsvRow>> rows;
+  std::map<std::string, std::vector<WindowsCsvRow>> rows;
   std::map<std::string, std::set<std::pair<std::int64_t, std::string>>> seen;
   for (const auto& csv : findCsvs(a.results)) {
     const std::string label = fs::absolute(csv).parent_path().filename().string();
     if (!rows.count(label)) order.push_back(label);
     int dup = 0;
-    for (auto& r : eval::readWindowsCsv(csv.string())) {
+    for (auto& r : readWindowsCsv(csv.string())) {
       if (!seen[label].insert({r.window, r.method}).second) {
         ++dup;
         continue;
@@ -63,15 +63,15 @@ void runTable(const TableArgs& a) {
     }
     if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", csv.string(), dup, label);
   }
-  std::vector<eval::SequenceSummary> table;
-  for (const auto& label : order) table.push_back({label, eval::summarize(rows[label])});
+  std::vector<SequenceSummary> table;
+  for (const auto& label : order) table.push_back({label, summarize(rows[label])});
   if (!a.output.empty()) {
-    writeFileAtomically(a.output + ".md", eval::tableMarkdown(table));
-    writeFileAtomically(a.output + ".tex", eval::tableLatex(table));
-    writeFileAtomically(a.output + ".csv", eval::tableCsv(table));
+    writeFileAtomically(a.output + ".md", tableMarkdown(table));
+    writeFileAtomically(a.output + ".tex", tableLatex(table));
+    writeFileAtomically(a.output + ".csv", tableCsv(table));
     spdlog::info("wrote {}.md, {}.tex, {}.csv", a.output, a.output, a.output);
   }
-  std::cout << eval::tableMarkdown(table) << std::flush;
+  std::cout << tableMarkdown(table) << std::flush;
 }
 
 }  // namespace

@@ -50,11 +50,11 @@ struct Inputs {
     a31 = (dir / "e.aedat31").string();
     a4lz4 = (dir / "lz4.aedat4").string();
     a4zstd = (dir / "zstd.aedat4").string();
-    io::writeEventsText(txt, ev);
-    io::writeAedat2(a2, ev, {});
-    io::writeAedat31(a31, ev, {}, "DAVIS240C", 4096);
-    io::writeAedat4(a4lz4, ev, {}, 240, 180, io::Aedat4Compression::Lz4, 4096, true);
-    io::writeAedat4(a4zstd, ev, {}, 240, 180, io::Aedat4Compression::Zstd, 4096, true);
+    writeEventsText(txt, ev);
+    writeAedat2(a2, ev, {});
+    writeAedat31(a31, ev, {}, "DAVIS240C", 4096);
+    writeAedat4(a4lz4, ev, {}, 240, 180, Aedat4Compression::Lz4, 4096, true);
+    writeAedat4(a4zstd, ev, {}, 240, 180, Aedat4Compression::Zstd, 4096, true);
   }
   ~Inputs() { std::filesystem::remove_all(dir); }
 };
@@ -68,7 +68,7 @@ void readAll(benchmark::State& state, const std::string& path) {
   std::vector<Event> batch;
   std::size_t total = 0;
   for (auto _ : state) {
-    auto r = io::openEventSource(path);
+    auto r = openEventSource(path);
     std::size_t n = 0;
     while (r->next(batch, 1 << 16)) n += batch.size();
     benchmark::DoNotOptimize(n);
@@ -127,11 +127,11 @@ void BM_WindowedTextPeakMemory(benchmark::State& state) {
   for (auto _ : state) {
     { std::ofstream c("/proc/self/clear_refs"); c << "5"; }  // reset VmHWM to the current RSS
     base_mb = double(statusKb("VmRSS:")) / 1024.0;
-    auto r = io::openEventSource(path);
-    io::WindowOptions o;
+    auto r = openEventSource(path);
+    WindowOptions o;
     o.events_per_window = 30000;
-    io::WindowSource ws(*r, o);
-    io::EventWindow w;
+    WindowSource ws(*r, o);
+    EventWindow w;
     windows = 0;
     while (ws.next(w)) ++windows;
     peak_buffered = ws.peakBuffered();

@@ -8,7 +8,7 @@
 #include "celc/sim/render_sequence.hpp"
 
 using namespace celc;
-using namespace celc::sim;
+using namespace celc;
 
 namespace {
 

@@ -13,8 +13,8 @@
 
 namespace celc {
 
-using cluster_detail::Group;
-using cluster_detail::Regions;
+using detail::Group;
+using detail::Regions;
 
 ClusterMethod parseClusterMethod(const std::string& name) {
   if (name == "grid") return ClusterMethod::Grid;
@@ -196,15 +196,15 @@ struct GroupOutput {
 };
 
 GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
-                         const cluster_detail::GridIndex* index, double c,
+                         const detail::GridIndex* index, double c,
                          const ClusterOptions& opt, int threads,
-                         cluster_detail::GridNormals* normals = nullptr) {
+                         detail::GridNormals* normals = nullptr) {
   GroupOutput out;
   if (static_cast<int>(g.size()) < opt.min_cluster_size) return out;
   auto t_start = Clock::now();
   const Regions regions = opt.method == ClusterMethod::Pcl || index == nullptr
-                              ? cluster_detail::growPcl(g, c, opt, threads)
-                              : cluster_detail::growGrid(*index, c, opt, threads, normals);
+                              ? detail::growPcl(g, c, opt, threads)
+                              : detail::growGrid(*index, c, opt, threads, normals);
   out.ms_normals = regions.ms_normals;
   out.ms_grow = msSince(t_start) - regions.ms_normals;
   t_start = Clock::now();
@@ -310,12 +310,12 @@ double estimateTimeScale(const std::vector<Event>& events, const ClusterOptions&
     if (validEvent(e)) t0 = std::min(t0, e.t), ++n_valid;
   if (n_valid < 50) return 0.0;
   const std::vector<Group> groups = makeGroups(events, t0, opt.separate_polarity);
-  std::vector<cluster_detail::GridIndex> indexes;
-  std::vector<const cluster_detail::GridIndex*> ptrs;
+  std::vector<detail::GridIndex> indexes;
+  std::vector<const detail::GridIndex*> ptrs;
   indexes.reserve(groups.size());
   for (const Group& g : groups) indexes.emplace_back(g);
   for (const auto& ix : indexes) ptrs.push_back(&ix);
-  return cluster_detail::estimateTimeScaleOnIndex(ptrs, initialTimeScale(events, opt), opt);
+  return detail::estimateTimeScaleOnIndex(ptrs, initialTimeScale(events, opt), opt);
 }
 
 ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptions& opt) {
@@ -347,15 +347,15 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   const std::vector<Group> groups = makeGroups(events, t0, opt.separate_polarity);
   auto t_c = Clock::now();
   // Grid indexes: used by the grid grower and by the automatic time scale.
-  std::vector<cluster_detail::GridIndex> indexes;
-  std::vector<const cluster_detail::GridIndex*> ptrs;
+  std::vector<detail::GridIndex> indexes;
+  std::vector<const detail::GridIndex*> ptrs;
   const bool need_index = opt.method == ClusterMethod::Grid || opt.c_px_per_s <= 0.0;
   if (need_index) {
     indexes.reserve(groups.size());
     if (groups.size() == 2 && opt.threads >= 2) {  // the two polarities' indexes side by side
       indexes.emplace_back(Group{});
       indexes.emplace_back(Group{});
-      parallelFor(2, 2, [&](std::size_t k) { indexes[k] = cluster_detail::GridIndex(groups[k]); });
+      parallelFor(2, 2, [&](std::size_t k) { indexes[k] = detail::GridIndex(groups[k]); });
     } else {
       for (const Group& g : groups) indexes.emplace_back(g);
     }
@@ -364,7 +364,7 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   double c = opt.c_px_per_s;
   if (c <= 0.0) {
     const double c0 = initialTimeScale(events, opt);
-    c = cluster_detail::estimateTimeScaleOnIndex(ptrs, c0, opt);
+    c = detail::estimateTimeScaleOnIndex(ptrs, c0, opt);
     if (c <= 0.0) c = c0;
   }
   res.c_px_per_s = c;
@@ -378,12 +378,12 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
     const int per = std::max(1, opt.threads / 2);
     // Grid: normals (the largest part) group after group with all threads, split
     // by event count; then growing and checks of the two groups in parallel.
-    std::vector<cluster_detail::GridNormals> normals(2);
+    std::vector<detail::GridNormals> normals(2);
     double ms_normals = 0.0;
     if (opt.method == ClusterMethod::Grid) {
       for (size_t k = 0; k < 2; ++k) {
         if (static_cast<int>(groups[k].size()) < opt.min_cluster_size) continue;
-        normals[k] = cluster_detail::computeGridNormals(indexes[k], c, opt, opt.threads);
+        normals[k] = detail::computeGridNormals(indexes[k], c, opt, opt.threads);
         ms_normals += normals[k].ms;
       }
     }

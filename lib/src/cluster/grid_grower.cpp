@@ -12,7 +12,7 @@
 
 #include "cluster/internal.hpp"
 
-namespace celc::cluster_detail {
+namespace celc::detail {
 
 GridIndex::GridIndex(const Group& g) {
   const size_t n = g.size();
@@ -302,4 +302,4 @@ double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, do
   return c;
 }
 
-}  // namespace celc::cluster_detail
+}  // namespace celc::detail

@@ -7,7 +7,7 @@
 
 #include "celc/cluster/cluster.hpp"
 
-namespace celc::cluster_detail {
+namespace celc::detail {
 
 /// The events of one group (one polarity, or all events).
 struct Group {
@@ -140,4 +140,4 @@ Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads
 double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, double c0,
                                 const ClusterOptions& opt);
 
-}  // namespace celc::cluster_detail
+}  // namespace celc::detail

@@ -11,7 +11,7 @@
 
 #include "cluster/internal.hpp"
 
-namespace celc::cluster_detail {
+namespace celc::detail {
 
 Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads) {
   Regions out;
@@ -63,4 +63,4 @@ Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads
   return out;
 }
 
-}  // namespace celc::cluster_detail
+}  // namespace celc::detail

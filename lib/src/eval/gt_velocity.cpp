@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace celc::eval {
+namespace celc {
 
 std::string GtVelocityOptions::validate() const {
   if (!(half_width > 0.0) || !std::isfinite(half_width)) return "half_width must be > 0 [s]";
@@ -105,4 +105,4 @@ GtVelocity GtVelocityEstimator::window(double t0, double t1) const {
   return r;
 }
 
-}  // namespace celc::eval
+}  // namespace celc

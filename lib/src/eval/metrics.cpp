@@ -5,7 +5,7 @@
 
 #include "celc/solver/solver.hpp"
 
-namespace celc::eval {
+namespace celc {
 
 double directionDistance(const Vec3& truth, const Vec3& estimate) { return (truth - estimate).norm(); }
 
@@ -22,4 +22,4 @@ DirectionErrors directionErrors(const Vec3& truth, const Vec3& estimate) {
   return e;
 }
 
-}  // namespace celc::eval
+}  // namespace celc

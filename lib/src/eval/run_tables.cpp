@@ -12,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace celc::eval {
+namespace celc {
 
 std::string windowsCsvHeader() {
   return "window,t_start,t_end,n_events,n_clusters,method,status,vx,vy,vz,gt_vx,gt_vy,gt_vz,eps,phi,runtime_ms";
@@ -263,4 +263,4 @@ std::string tableCsv(const std::vector<SequenceSummary>& seqs) {
   return o.str();
 }
 
-}  // namespace celc::eval
+}  // namespace celc

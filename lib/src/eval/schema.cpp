@@ -1,7 +1,7 @@
 // The schema of the evaluation options (core/fields.hpp).
 #include "celc/eval/gt_velocity.hpp"
 
-namespace celc::eval {
+namespace celc {
 
 void describe(FieldVisitor& v, GtVelocityOptions& o) {
   v.field({"half_width", "s", "local polynomial fit of the poses over +-half_width"}, o.half_width);
@@ -10,4 +10,4 @@ void describe(FieldVisitor& v, GtVelocityOptions& o) {
   v.field({"samples", "", "evaluation times per window"}, o.samples);
 }
 
-}  // namespace celc::eval
+}  // namespace celc

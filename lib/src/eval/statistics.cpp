@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace celc::eval {
+namespace celc {
 
 double median(std::vector<double> x) {
   if (x.empty()) return NAN;
@@ -29,4 +29,4 @@ double sampleStd(const std::vector<double>& x) {
   return std::sqrt(ss / static_cast<double>(x.size() - 1));
 }
 
-}  // namespace celc::eval
+}  // namespace celc

@@ -12,7 +12,7 @@
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 namespace {
 
 struct Aedat2Header {
@@ -302,4 +302,4 @@ std::unique_ptr<EventReader> openAedat2(const std::string& path, const ReaderOpt
   return std::make_unique<Aedat2Reader>(path, o);
 }
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

@@ -16,7 +16,7 @@
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 namespace {
 
 class Aedat31Reader final : public EventReader {
@@ -205,4 +205,4 @@ std::unique_ptr<EventReader> openAedat31(const std::string& path, const ReaderOp
   return std::make_unique<Aedat31Reader>(path, o);
 }
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

@@ -21,7 +21,7 @@
 #include "io/binary_file.hpp"
 #include "io/flatbuf.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 namespace {
 
 struct StreamInfo {
@@ -403,4 +403,4 @@ std::unique_ptr<EventReader> openAedat4(const std::string& path, const ReaderOpt
   return std::make_unique<Aedat4Reader>(path, o);
 }
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

@@ -5,8 +5,8 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 std::unique_ptr<EventReader> openAedat2(const std::string& path, const ReaderOptions& o);
 std::unique_ptr<EventReader> openAedat31(const std::string& path, const ReaderOptions& o);
 std::unique_ptr<EventReader> openAedat4(const std::string& path, const ReaderOptions& o);
-}  // namespace celc::io::detail
+}  // namespace celc::detail

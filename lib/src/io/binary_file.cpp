@@ -4,7 +4,7 @@
 #include <cerrno>
 #include <sys/stat.h>
 
-namespace celc::io::detail {
+namespace celc::detail {
 
 BinFile::BinFile(const std::string& path) : path_(path) {
   f_ = std::fopen(path.c_str(), "rb");
@@ -71,4 +71,4 @@ bool sensorSizeFromChip(const std::string& name, int& width, int& height) {
   return false;
 }
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

@@ -9,7 +9,7 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 
 class BinFile {
  public:
@@ -53,4 +53,4 @@ bool sensorSizeFromChip(const std::string& name, int& width, int& height);
 constexpr double kGravity = 9.80665;  ///< [m/s^2 per g]
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

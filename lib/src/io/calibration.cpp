@@ -8,7 +8,7 @@
 #include "celc/core/yaml.hpp"
 #include "io/text_parse.hpp"
 
-namespace celc::io {
+namespace celc {
 namespace {
 
 bool isRotation(const Mat3& R) {
@@ -107,4 +107,4 @@ Calibration loadCalibration(const std::string& path, int width, int height) {
   return loadCalibTxt(path, width, height);
 }
 
-}  // namespace celc::io
+}  // namespace celc

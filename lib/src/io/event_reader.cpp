@@ -12,7 +12,7 @@
 #include "celc/io/text_io.hpp"
 #include "io/aedat_readers.hpp"
 
-namespace celc::io {
+namespace celc {
 
 static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE float sizes expected");
 
@@ -153,4 +153,4 @@ FileInfo scanFile(const std::string& path, const ReaderOptions& options) {
   return info;
 }
 
-}  // namespace celc::io
+}  // namespace celc

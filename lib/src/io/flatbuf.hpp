@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace celc::io::detail {
+namespace celc::detail {
 
 struct FbError : std::runtime_error {
   FbError(std::size_t at, const std::string& what) : std::runtime_error(what), offset(at) {}
@@ -117,4 +117,4 @@ class FbBuf {
   std::size_t n_;
 };
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

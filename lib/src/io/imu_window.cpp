@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace celc::io {
+namespace celc {
 
 std::string toString(GyroStatus status) {
   switch (status) {
@@ -87,4 +87,4 @@ GyroWindow GyroTrack::window(double t0, double t1) const {
   return g;
 }
 
-}  // namespace celc::io
+}  // namespace celc

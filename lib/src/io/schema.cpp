@@ -3,7 +3,7 @@
 #include "celc/io/imu_window.hpp"
 #include "celc/io/window_source.hpp"
 
-namespace celc::io {
+namespace celc {
 
 void describe(FieldVisitor& v, ReaderOptions& o) {
   v.field({"width", "px", "sensor width when the file does not say (0 = unknown)"}, o.width);
@@ -31,4 +31,4 @@ void describe(FieldVisitor& v, GyroWindowOptions& o) {
   v.field({"gyro_max_gap", "s", "largest gap between gyro samples inside a window"}, o.max_gap);
 }
 
-}  // namespace celc::io
+}  // namespace celc

@@ -5,7 +5,7 @@
 
 namespace fs = std::filesystem;
 
-namespace celc::io {
+namespace celc {
 
 namespace {
 bool isRegularFile(const std::string& path) {
@@ -52,4 +52,4 @@ std::string sequenceLayoutSummary() {
   return std::string(kEvents) + ", " + kImu + ", " + kGroundTruth + ", " + kCalibYaml + "|" + kCalibText;
 }
 
-}  // namespace celc::io
+}  // namespace celc

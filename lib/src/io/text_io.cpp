@@ -6,7 +6,7 @@
 
 #include "io/text_parse.hpp"
 
-namespace celc::io {
+namespace celc {
 namespace {
 
 using detail::LineReader;
@@ -280,4 +280,4 @@ std::vector<PoseSample> readPosesText(const std::string& path, const ReaderOptio
   return out;
 }
 
-}  // namespace celc::io
+}  // namespace celc

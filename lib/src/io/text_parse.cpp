@@ -4,7 +4,7 @@
 #include <cerrno>
 #include <cstring>
 
-namespace celc::io::detail {
+namespace celc::detail {
 
 LineReader::LineReader(const std::string& path, std::size_t buffer_bytes) : path_(path) {
   file_ = std::fopen(path.c_str(), "rb");
@@ -89,4 +89,4 @@ bool looksLikeHeader(std::string_view line) {
   return !parseDouble(f[0], v) && std::isalpha(static_cast<unsigned char>(f[0][0]));
 }
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

@@ -11,7 +11,7 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io::detail {
+namespace celc::detail {
 
 /// Reads a file in large blocks and hands out lines (without "\n" / "\r\n").
 /// A missing final newline is fine. Lines longer than the buffer are an error.
@@ -84,4 +84,4 @@ std::vector<std::string> headerNames(std::string_view line);
 /// True when the first field does not parse as a number (a header line without '#').
 bool looksLikeHeader(std::string_view line);
 
-}  // namespace celc::io::detail
+}  // namespace celc::detail

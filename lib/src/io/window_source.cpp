@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace celc::io {
+namespace celc {
 
 std::string WindowOptions::validate() const {
   if ((events_per_window > 0) == (seconds_per_window > 0.0))
@@ -97,4 +97,4 @@ bool WindowSource::next(EventWindow& w) {
   return true;
 }
 
-}  // namespace celc::io
+}  // namespace celc

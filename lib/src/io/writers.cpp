@@ -13,7 +13,7 @@
 
 #include "io/binary_file.hpp"
 
-namespace celc::io {
+namespace celc {
 namespace {
 
 class Out {
@@ -451,4 +451,4 @@ void writeAedat4(const std::string& path, const std::vector<Event>& events, cons
   out.close();
 }
 
-}  // namespace celc::io
+}  // namespace celc

@@ -85,8 +85,6 @@ std::string PeerStudyConfig::validate() const {
 
 namespace {
 
-using eval::mean;
-using eval::median;
 
 
 

@@ -22,16 +22,16 @@ void describeClustering(FieldVisitor& v, ClusterOptions& cluster, LineFitOptions
 }
 
 void describe(FieldVisitor& v, RunConfig& c) {
-  v.section({"input", "", "reading the recording"}, [&](FieldVisitor& s) { io::describe(s, c.reader); });
+  v.section({"input", "", "reading the recording"}, [&](FieldVisitor& s) { describe(s, c.reader); });
   v.section({"windows", "", "cutting the stream into windows (events or seconds, not both)"},
-            [&](FieldVisitor& s) { io::describe(s, c.windows); });
+            [&](FieldVisitor& s) { describe(s, c.windows); });
   v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) {
     s.enumeration({"model", "", "constant_twist (paper) or gyro_integrated"}, c.motion,
                   {MotionModelKind::ConstantTwist, MotionModelKind::GyroIntegrated});
     s.enumeration({"omega_source", "", "gyro: the recording's IMU; fixed: fixed_omega"}, c.omega_source,
                   {OmegaSource::Gyro, OmegaSource::Fixed});
     s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed"}, c.fixed_omega);
-    io::describe(s, c.gyro);
+    describe(s, c.gyro);
   });
   describeClustering(v, c.cluster, c.observations.lines);
   v.section({"observations", "", "clusters turned into the solvers' observations"},
@@ -39,7 +39,7 @@ void describe(FieldVisitor& v, RunConfig& c) {
   v.section({"solver", "", "the solvers"}, [&](FieldVisitor& s) { describe(s, c.solver); });
   v.enumerations({"methods", "", "methods run on every window"}, c.methods, allMethods());
   v.section({"groundtruth", "", "camera-frame velocity from the pose file"},
-            [&](FieldVisitor& s) { eval::describe(s, c.groundtruth); });
+            [&](FieldVisitor& s) { describe(s, c.groundtruth); });
   v.field({"seed", "", "seeds the solvers' row subsets (per window: seed + index)"}, c.seed);
 }
 

@@ -45,7 +45,7 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, std::size_t method
   fs::create_directories(dir);
   if (mode == OutputMode::Resume && has_run) {
     // Keep the complete windows only (all methods' rows present).
-    const auto rows = eval::readWindowsCsv(csv_path_, true);
+    const auto rows = readWindowsCsv(csv_path_, true);
     std::map<std::int64_t, std::size_t> count;
     for (const auto& r : rows) count[r.window]++;
     for (const auto& [w, n] : count) {
@@ -53,7 +53,7 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, std::size_t method
       resume_after_ = w;
     }
     std::ifstream in(csv_path_);
-    std::string content = eval::windowsCsvHeader() + "\n", line;
+    std::string content = windowsCsvHeader() + "\n", line;
     std::getline(in, line);  // header
     std::int64_t kept = 0;
     while (std::getline(in, line)) {
@@ -74,7 +74,7 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, std::size_t method
     csv_.open(csv_path_, std::ios::app);
   } else {
     csv_.open(csv_path_, std::ios::trunc);
-    csv_ << eval::windowsCsvHeader() << "\n";
+    csv_ << windowsCsvHeader() << "\n";
     csv_.flush();
   }
   if (!csv_) throw std::runtime_error(csv_path_ + ": cannot write");
@@ -92,11 +92,11 @@ void RunOutput::writeConfig(const std::string& yaml) const {
   writeFileAtomically((fs::path(dir_) / "config.yaml").string(), yaml);
 }
 
-std::vector<eval::MethodSummary> RunOutput::writeSummary(const std::string& title,
+std::vector<MethodSummary> RunOutput::writeSummary(const std::string& title,
                                                          const std::vector<std::string>& notes) const {
-  const auto summaries = eval::summarize(eval::readWindowsCsv(csv_path_, true));
+  const auto summaries = summarize(readWindowsCsv(csv_path_, true));
   writeFileAtomically((fs::path(dir_) / "summary.md").string(),
-                      eval::summaryMarkdown(title, summaries, notes));
+                      summaryMarkdown(title, summaries, notes));
   return summaries;
 }
 

@@ -25,11 +25,11 @@ double secondsSince(Clock::time_point t) {
 struct SequenceRunner::Impl {
   RunConfig config;
   RunInputs inputs;
-  io::Calibration calib;
-  std::unique_ptr<io::EventReader> reader;
+  Calibration calib;
+  std::unique_ptr<EventReader> reader;
   std::unique_ptr<UndistortLut> lut;
-  io::GyroTrack gyro;
-  std::unique_ptr<eval::GtVelocityEstimator> gt;
+  GyroTrack gyro;
+  std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
 };
 
@@ -42,32 +42,32 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     throw std::runtime_error("configuration: " + err);
   if (!fs::exists(in.events)) throw std::runtime_error(in.events + ": no such file or directory");
   if (fs::is_directory(in.events)) {  // a sequence directory: what the inputs do not name
-    const io::SequenceLayout layout = io::resolveSequenceLayout(in.events);
+    const SequenceLayout layout = resolveSequenceLayout(in.events);
     if (m.inputs.calib.empty()) m.inputs.calib = layout.calib;
     if (m.inputs.groundtruth.empty()) m.inputs.groundtruth = layout.groundtruth;
   }
   if (m.inputs.calib.empty())
     throw std::runtime_error(in.events + ": no calibration (give --calib, or put " +
-                             io::sequence_file::kCalibYaml + " / " + io::sequence_file::kCalibText +
+                             sequence_file::kCalibYaml + " / " + sequence_file::kCalibText +
                              " in the sequence directory)");
 
-  m.reader = io::openEventSource(in.events, m.config.reader);
+  m.reader = openEventSource(in.events, m.config.reader);
   const int w = m.reader->width() > 0 ? m.reader->width() : 240;
   const int h = m.reader->height() > 0 ? m.reader->height() : 180;
-  m.calib = io::loadCalibration(m.inputs.calib, w, h);
+  m.calib = loadCalibration(m.inputs.calib, w, h);
   m.lut = std::make_unique<UndistortLut>(m.calib.camera);
 
   if (m.config.omega_source == OmegaSource::Gyro) {
     std::vector<ImuSample> imu = m.inputs.imu.empty() ? m.reader->readImu()
-                                                      : io::readImuText(m.inputs.imu, m.config.reader);
+                                                      : readImuText(m.inputs.imu, m.config.reader);
     m.n_imu = imu.size();
-    if (!imu.empty()) m.gyro = io::GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
+    if (!imu.empty()) m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
   }
   if (!m.inputs.groundtruth.empty()) {
-    auto poses = io::readPosesText(m.inputs.groundtruth, m.config.reader);
+    auto poses = readPosesText(m.inputs.groundtruth, m.config.reader);
     m.n_poses = poses.size();
     if (!poses.empty())
-      m.gt = std::make_unique<eval::GtVelocityEstimator>(std::move(poses), m.calib.T_body_cam,
+      m.gt = std::make_unique<GtVelocityEstimator>(std::move(poses), m.calib.T_body_cam,
                                                          m.config.groundtruth);
   }
 }
@@ -80,7 +80,7 @@ bool SequenceRunner::hasImu() const { return !impl_->gyro.empty(); }
 std::vector<std::string> SequenceRunner::describe() const {
   const Impl& m = *impl_;
   std::vector<std::string> d;
-  d.push_back("events: " + m.reader->path() + " (" + io::toString(m.reader->format()) + ")");
+  d.push_back("events: " + m.reader->path() + " (" + toString(m.reader->format()) + ")");
   d.push_back("calibration: " + m.inputs.calib + " (" + std::to_string(m.calib.camera.width) + "x" +
               std::to_string(m.calib.camera.height) + ", " + toString(m.calib.camera.distortion) + ")");
   if (m.config.omega_source == OmegaSource::Fixed)
@@ -111,7 +111,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // Ground truth first: it does not depend on the estimate.
   auto start = Clock::now();
   if (m.gt) {
-    const eval::GtVelocity g = m.gt->window(t0, t1);
+    const GtVelocity g = m.gt->window(t0, t1);
     if (g.ok() && g.v_cam.norm() > 1e-9) {
       rec.has_gt = true;
       rec.gt_speed = g.v_cam.norm();
@@ -127,9 +127,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
       rec.window_status = "no_gyro";
       return rec;
     }
-    const io::GyroWindow gw = m.gyro.window(t0, t1);
+    const GyroWindow gw = m.gyro.window(t0, t1);
     if (!gw.ok()) {
-      rec.window_status = io::toString(gw.status);
+      rec.window_status = toString(gw.status);
       return rec;
     }
     motion = cfg.motion == MotionModelKind::GyroIntegrated ? gw.motionModel(t0)
@@ -172,8 +172,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     row.result = results[i];
     if (row.result.ok() && rec.has_gt) {
       row.has_metrics = true;
-      row.eps = eval::directionDistance(rec.gt, row.result.v);
-      row.phi = eval::directionAngle(rec.gt, row.result.v);
+      row.eps = directionDistance(rec.gt, row.result.v);
+      row.phi = directionAngle(rec.gt, row.result.v);
     }
   }
   return rec;
@@ -190,8 +190,8 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
     double t0 = 0.0, t1 = 0.0;
     std::vector<Event> events;
   };
-  io::WindowSource source(*m.reader, m.config.windows);
-  io::EventWindow window;
+  WindowSource source(*m.reader, m.config.windows);
+  EventWindow window;
   // Windows read and not yet written: a bound on the memory held.
   const std::size_t max_in_flight = static_cast<std::size_t>(resolveThreadCount(threads)) + 2;
   orderedParallelMap<Job, WindowRecord>(

@@ -20,8 +20,8 @@ std::vector<double> range(double from, double to, double step) {
 
 
 void meanStd(const std::vector<double>& x, double& m, double& stdev) {
-  m = eval::mean(x);
-  stdev = eval::sampleStd(x);
+  m = mean(x);
+  stdev = sampleStd(x);
 }
 
 }  // namespace
@@ -104,9 +104,9 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
       c.n_ok = static_cast<int>(phi.size());
       meanStd(eps, c.eps_mean, c.eps_std);
       meanStd(phi, c.phi_mean, c.phi_std);
-      c.phi_median = eval::median(phi);
-      c.phi_median_sign_agnostic = eval::median(agn);
-      c.time_median_us = eval::median(time);
+      c.phi_median = median(phi);
+      c.phi_median_sign_agnostic = median(agn);
+      c.time_median_us = median(time);
       cells.push_back(c);
     }
   }

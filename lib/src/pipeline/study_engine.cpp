@@ -23,7 +23,7 @@ std::vector<MethodOutcome> scoreResults(const std::vector<SolverResult>& results
     MethodOutcome& o = out[m];
     o.ok = r.ok();
     if (!o.ok) continue;
-    const eval::DirectionErrors e = eval::directionErrors(truth, r.v);
+    const DirectionErrors e = directionErrors(truth, r.v);
     o.eps = e.eps;
     o.phi = e.phi;
     o.phi_sign_agnostic = e.phi_sign_agnostic;

@@ -9,7 +9,7 @@
 
 #include "celc/core/parallel.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 namespace {
 constexpr int64_t kNever = std::numeric_limits<int64_t>::min();
@@ -420,4 +420,4 @@ const std::vector<float>& RenderEventSimulator::thresholdOn() const { return imp
 const std::vector<float>& RenderEventSimulator::thresholdOff() const { return impl_->cm; }
 double RenderEventSimulator::imageSpeed(double t) const { return impl_->speed(t); }
 
-}  // namespace celc::sim
+}  // namespace celc

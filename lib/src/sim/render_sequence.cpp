@@ -14,10 +14,10 @@
 #include "celc/io/sequence_layout.hpp"
 #include "celc/io/writers.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 namespace fs = std::filesystem;
-namespace file = io::sequence_file;
+namespace file = sequence_file;
 
 std::string ImuOptions::validate() const {
   std::ostringstream e;
@@ -268,7 +268,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   if (ec) throw std::runtime_error(dir.string() + ": cannot create directory: " + ec.message());
   // Remove a previous run's files first (events.txt first), so that an
   // interrupted run never leaves old and new files that look like one sequence.
-  for (const char* name : io::simulatedSequenceFiles()) {
+  for (const char* name : simulatedSequenceFiles()) {
     fs::remove(dir / name, ec);
     if (ec) throw std::runtime_error((dir / name).string() + ": cannot remove: " + ec.message());
   }
@@ -290,12 +290,12 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
     const double t_next = std::min(config.duration, static_cast<double>(k) * slice);
     buf.clear();
     sim.advanceTo(t_next, buf);
-    ebuf.resize(buf.size() * (io::kEventLineMicrosMaxChars + 1));
+    ebuf.resize(buf.size() * (kEventLineMicrosMaxChars + 1));
     lbuf.resize(buf.size() * 12);  // int32 and a line end
     char* pe = ebuf.data();
     char* pl = lbuf.data();
     for (const SimEvent& e : buf) {
-      pe = io::putEventLineMicros(pe, e.t_us, e.x, e.y, e.on);
+      pe = putEventLineMicros(pe, e.t_us, e.x, e.y, e.on);
       *pe++ = '\n';
       pl = std::to_chars(pl, pl + 11, e.label).ptr;
       *pl++ = '\n';
@@ -383,4 +383,4 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   return summary;
 }
 
-}  // namespace celc::sim
+}  // namespace celc

@@ -8,7 +8,7 @@
 
 #include "celc/geometry/so3.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 namespace {
 constexpr int kMaxPlanes = 16;
@@ -501,4 +501,4 @@ int frontHit(const Scene& scene, const std::vector<CameraPlane>& cam_planes, dou
   return best;
 }
 
-}  // namespace celc::sim
+}  // namespace celc

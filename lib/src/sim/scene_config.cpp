@@ -8,7 +8,7 @@
 #include "celc/geometry/so3.hpp"
 #include "celc/sim/render_sequence.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 namespace {
 
@@ -177,4 +177,4 @@ SynthConfig loadSynthConfig(const std::string& path) {
   return c;
 }
 
-}  // namespace celc::sim
+}  // namespace celc

@@ -8,7 +8,7 @@
 
 #include "celc/geometry/so3.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 TrajectoryKind parseTrajectoryKind(const std::string& name) {
   if (name == "constant_twist") return TrajectoryKind::ConstantTwist;
@@ -146,4 +146,4 @@ Vec3 Trajectory::linearVelocityRate(double t) const {
   return spec_.amplitude_v * om * std::cos(om * t);
 }
 
-}  // namespace celc::sim
+}  // namespace celc

@@ -6,7 +6,7 @@
 
 #include "celc/geometry/motion_model.hpp"
 #include "celc/solver/celc_residual.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc::detail {
 

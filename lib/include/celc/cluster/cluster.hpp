@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "celc/core/fields.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

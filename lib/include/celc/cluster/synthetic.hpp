@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "celc/geometry/camera.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

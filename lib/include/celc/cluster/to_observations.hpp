@@ -9,7 +9,7 @@
 #include "celc/core/fields.hpp"
 #include "celc/cluster/cluster.hpp"
 #include "celc/lines/line_fit.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

@@ -22,7 +22,7 @@
 #include <string>
 
 #include "celc/geometry/motion_model.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

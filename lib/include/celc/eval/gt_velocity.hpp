@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "celc/core/fields.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::eval {
+namespace celc {
 
 struct GtVelocityOptions {
   double half_width = 0.05;  ///< [s] fit neighbourhood on each side
@@ -53,4 +53,4 @@ class GtVelocityEstimator {
   GtVelocityOptions o_;
 };
 
-}  // namespace celc::eval
+}  // namespace celc

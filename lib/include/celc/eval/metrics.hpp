@@ -7,9 +7,9 @@
 ///         computed in a form accurate for small and large angles alike),
 ///   sign-agnostic phi = min(phi, pi - phi), for methods that do not resolve
 ///         the sign of v.
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::eval {
+namespace celc {
 
 /// eps = |truth - estimate|.
 double directionDistance(const Vec3& truth, const Vec3& estimate);
@@ -26,4 +26,4 @@ struct DirectionErrors {
 };
 DirectionErrors directionErrors(const Vec3& truth, const Vec3& estimate);
 
-}  // namespace celc::eval
+}  // namespace celc

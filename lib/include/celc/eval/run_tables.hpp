@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::eval {
+namespace celc {
 
 /// The header of windows.csv.
 std::string windowsCsvHeader();
@@ -67,4 +67,4 @@ std::string tableMarkdown(const std::vector<SequenceSummary>& sequences);
 std::string tableLatex(const std::vector<SequenceSummary>& sequences);
 std::string tableCsv(const std::vector<SequenceSummary>& sequences);
 
-}  // namespace celc::eval
+}  // namespace celc

@@ -3,7 +3,7 @@
 /// Sample statistics used by the studies and the tables (NaN for no data).
 #include <vector>
 
-namespace celc::eval {
+namespace celc {
 
 /// Median (mean of the two middle values for an even count).
 double median(std::vector<double> x);
@@ -12,4 +12,4 @@ double mean(const std::vector<double>& x);
 /// Sample standard deviation (n - 1), 0 for one value.
 double sampleStd(const std::vector<double>& x);
 
-}  // namespace celc::eval
+}  // namespace celc

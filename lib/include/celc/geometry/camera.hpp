@@ -10,7 +10,7 @@
 #include <string>
 
 #include "celc/core/fields.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

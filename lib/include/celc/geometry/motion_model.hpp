@@ -16,7 +16,7 @@
 /// Both keep every CELC constraint linear in v.
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

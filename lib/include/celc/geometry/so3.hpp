@@ -7,7 +7,7 @@
 /// J_l maps a constant body twist to the translation of the SE(3) exponential:
 /// exp([v; w] tau) has translation J_l(w tau) v tau.
 /// Near th = 0 the coefficients switch to their Taylor series (error < 1e-16).
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc::so3 {
 

@@ -12,7 +12,7 @@
 #include "celc/geometry/camera.hpp"
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io {
+namespace celc {
 
 struct Calibration {
   CameraModel camera;
@@ -36,4 +36,4 @@ Calibration loadCalibTxt(const std::string& path, int width = 240, int height = 
 /// By extension: .yaml / .yml -> YAML, otherwise calib.txt.
 Calibration loadCalibration(const std::string& path, int width = 240, int height = 180);
 
-}  // namespace celc::io
+}  // namespace celc

@@ -25,9 +25,9 @@
 #include <vector>
 
 #include "celc/core/fields.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::io {
+namespace celc {
 
 /// Thrown at the I/O boundary; what() is one line: "FILE: line N: ..." or "FILE: byte N: ...".
 class IoError : public std::runtime_error {
@@ -148,4 +148,4 @@ FileInfo scanFile(const std::string& path, const ReaderOptions& options = {});
 /// Reads all events of a source (convenience for small files and tests).
 std::vector<Event> readAllEvents(EventReader& reader);
 
-}  // namespace celc::io
+}  // namespace celc

@@ -12,9 +12,9 @@
 
 #include "celc/geometry/motion_model.hpp"
 #include "celc/core/fields.hpp"
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::io {
+namespace celc {
 
 enum class GyroStatus { Ok, NoSamples, NotCovered, Gap, InvalidWindow };
 std::string toString(GyroStatus status);  ///< "ok", "no_gyro", "not_covered", "gyro_gap", "invalid_window"
@@ -61,4 +61,4 @@ class GyroTrack {
   GyroWindowOptions options_;
 };
 
-}  // namespace celc::io
+}  // namespace celc

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace celc::io {
+namespace celc {
 
 /// File names inside a sequence directory.
 namespace sequence_file {
@@ -53,4 +53,4 @@ const std::vector<const char*>& simulatedSequenceFiles();
 /// "events.txt, imu.txt, groundtruth.txt, calib.yaml|calib.txt": the layout in help texts.
 std::string sequenceLayoutSummary();
 
-}  // namespace celc::io
+}  // namespace celc

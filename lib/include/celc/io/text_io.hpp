@@ -16,7 +16,7 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io {
+namespace celc {
 
 /// Streaming reader of an events text file; `imu_path` (may be empty) is read by readImu().
 std::unique_ptr<EventReader> openTextEvents(const std::string& events_path,
@@ -30,4 +30,4 @@ std::vector<ImuSample> readImuText(const std::string& path, const ReaderOptions&
 /// a zero quaternion is an error). Throws IoError (file and line).
 std::vector<PoseSample> readPosesText(const std::string& path, const ReaderOptions& options = {});
 
-}  // namespace celc::io
+}  // namespace celc

@@ -19,7 +19,7 @@
 #include "celc/core/fields.hpp"
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io {
+namespace celc {
 
 struct WindowOptions {
   std::size_t events_per_window = 0;  ///< N > 0: windows by event count
@@ -65,4 +65,4 @@ class WindowSource {
   std::size_t peak_ = 0;
 };
 
-}  // namespace celc::io
+}  // namespace celc

@@ -10,7 +10,7 @@
 
 #include "celc/io/event_reader.hpp"
 
-namespace celc::io {
+namespace celc {
 
 struct TextWriteOptions {
   bool crlf = false;            ///< "\r\n" line endings
@@ -54,4 +54,4 @@ void writeAedat4(const std::string& path, const std::vector<Event>& events, cons
                  int width, int height, Aedat4Compression compression, int per_packet = 4096,
                  bool data_table = true);
 
-}  // namespace celc::io
+}  // namespace celc

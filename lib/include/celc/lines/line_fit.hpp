@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "celc/core/fields.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

@@ -25,16 +25,16 @@ enum class OmegaSource {
 std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
 struct RunConfig {
-  io::ReaderOptions reader;
-  io::WindowOptions windows = [] {
-    io::WindowOptions w;
+  ReaderOptions reader;
+  WindowOptions windows = [] {
+    WindowOptions w;
     w.events_per_window = 30000;
     return w;
   }();
   MotionModelKind motion = MotionModelKind::ConstantTwist;
   OmegaSource omega_source = OmegaSource::Gyro;
   Vec3 fixed_omega = Vec3::Zero();  ///< [rad/s], camera frame, with OmegaSource::Fixed
-  io::GyroWindowOptions gyro;
+  GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;
   /// The solvers' defaults, except the global starts: on clustered real or
@@ -48,7 +48,7 @@ struct RunConfig {
     return s;
   }();
   std::vector<Method> methods = allMethods();
-  eval::GtVelocityOptions groundtruth;
+  GtVelocityOptions groundtruth;
   std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)
   std::string validate() const;
 };

@@ -35,7 +35,7 @@ class RunOutput {
   /// Writes config.yaml (atomically).
   void writeConfig(const std::string& yaml) const;
   /// Rewrites summary.md from windows.csv (atomically); returns the summaries.
-  std::vector<eval::MethodSummary> writeSummary(const std::string& title,
+  std::vector<MethodSummary> writeSummary(const std::string& title,
                                                 const std::vector<std::string>& notes) const;
 
  private:
@@ -58,7 +58,7 @@ struct SequenceJob {
 
 struct SequenceOutcome {
   RunStats stats;
-  std::vector<eval::MethodSummary> summaries;
+  std::vector<MethodSummary> summaries;
   std::vector<std::string> notes;  ///< what was opened, throughput, stage shares
 };
 

@@ -71,7 +71,7 @@ struct RunStats {
 class SequenceRunner {
  public:
   /// Opens the inputs and loads calibration, IMU and poses. Throws
-  /// io::IoError / ConfigError / std::runtime_error naming the file.
+  /// IoError / ConfigError / std::runtime_error naming the file.
   SequenceRunner(const RunInputs& inputs, const RunConfig& config);
   ~SequenceRunner();
 

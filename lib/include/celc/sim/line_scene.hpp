@@ -16,7 +16,7 @@
 #include "celc/core/fields.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/geometry/motion_model.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

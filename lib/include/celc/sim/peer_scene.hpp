@@ -32,7 +32,7 @@
 #include "celc/geometry/camera.hpp"
 #include "celc/geometry/motion_model.hpp"
 #include "celc/lines/line_fit.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

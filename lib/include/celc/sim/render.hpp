@@ -34,7 +34,7 @@
 #include "celc/sim/scene.hpp"
 #include "celc/sim/scene_trajectory.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 struct RenderOptions {
   double contrast_on = 0.25;     ///< C+ [log intensity]
@@ -125,4 +125,4 @@ std::vector<float> renderLogImage(const Scene& scene, const CameraModel& camera,
 /// (two numbers per pixel).
 std::vector<double> pixelBearings(const CameraModel& camera);
 
-}  // namespace celc::sim
+}  // namespace celc

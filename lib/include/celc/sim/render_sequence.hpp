@@ -32,7 +32,7 @@
 #include "celc/sim/scene.hpp"
 #include "celc/sim/scene_trajectory.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 struct ImuOptions {
   double rate = 1000.0;            ///< [Hz]
@@ -104,4 +104,4 @@ void describe(FieldVisitor& v, SynthConfig& config);
 /// throw ConfigError with "FILE:LINE: key 'a.b': ..." messages.
 SynthConfig loadSynthConfig(const std::string& path);
 
-}  // namespace celc::sim
+}  // namespace celc

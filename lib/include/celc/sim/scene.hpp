@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 /// A rigid pose T_a_b: x_a = R x_b + p.
 struct RigidPose {
@@ -139,4 +139,4 @@ PixelSample shadePixel(const Scene& scene, const std::vector<CameraPlane>& cam_p
 int frontHit(const Scene& scene, const std::vector<CameraPlane>& cam_planes, double x, double y,
              const RigidPose& T_world_cam, Vec3& X_world);
 
-}  // namespace celc::sim
+}  // namespace celc

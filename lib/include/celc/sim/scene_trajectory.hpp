@@ -18,7 +18,7 @@
 
 #include "celc/sim/scene.hpp"
 
-namespace celc::sim {
+namespace celc {
 
 enum class TrajectoryKind { ConstantTwist, Piecewise, Sinusoid };
 /// "constant_twist" | "piecewise" | "sinusoid"; throws std::invalid_argument otherwise.
@@ -70,4 +70,4 @@ class Trajectory {
 /// Pose after moving with constant twist (v, w) for tau seconds from identity.
 RigidPose twistExp(const Vec3& v, const Vec3& w, double tau);
 
-}  // namespace celc::sim
+}  // namespace celc

@@ -18,7 +18,7 @@
 #include <cmath>
 
 #include "celc/geometry/motion_model.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

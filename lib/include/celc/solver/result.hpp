@@ -4,7 +4,7 @@
 /// data), the direction and what the solve saw.
 #include <string>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 

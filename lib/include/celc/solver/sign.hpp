@@ -3,7 +3,7 @@
 /// The cheirality sign test: v and -v satisfy every linear constraint alike;
 /// only one puts the clusters' 3D lines in front of the camera.
 #include "celc/geometry/motion_model.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 
 namespace celc {
 

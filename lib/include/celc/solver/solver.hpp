@@ -19,7 +19,7 @@
 #include "celc/geometry/motion_model.hpp"
 #include "celc/solver/celc_residual.hpp"
 #include "celc/solver/methods.hpp"
-#include "celc/solver/observations.hpp"
+#include "celc/core/observations.hpp"
 #include "celc/solver/options.hpp"
 #include "celc/solver/result.hpp"
 #include "celc/solver/sign.hpp"

@@ -8,7 +8,7 @@
 /// camera frame at the line's own time.
 #include <vector>
 
-#include "celc/types.hpp"
+#include "celc/core/types.hpp"
 
 namespace celc {
 
