@@ -126,9 +126,8 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
         const CrlbResult b = velocityDirectionCrlb(tr.truth, tr.true_motion, tr.true_direction,
                                                    scene.event_noise_px);
         if (b.ok) out.reference = b.rms_rad;
-        SolverOptions so = config.solver;
-        so.linear.seed = rng();
-        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, so);
+        const SampleSeeds seeds{rng(), config.solver.refine.seed};
+        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, config.solver, seeds);
         out.methods = scoreResults(res, tr.true_direction);
         return out;
       },

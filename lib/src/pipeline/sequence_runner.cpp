@@ -162,10 +162,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   rec.times.lines = secondsSince(start);
 
   start = Clock::now();
-  SolverOptions so = cfg.solver;
-  so.linear.seed = cfg.seed + index;
-  so.refine.seed = cfg.seed + index;
-  const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, so);
+  const SampleSeeds seeds{cfg.seed + index, cfg.seed + index};  // windows draw different subsets
+  const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds);
   rec.times.solve = secondsSince(start);
   for (size_t i = 0; i < cfg.methods.size(); ++i) {
     MethodRow& row = rec.rows[i];

@@ -75,9 +75,8 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
         LineSceneOptions scene = config.scene;
         sweep.apply(scene, sweep.levels[level]);
         const LineSceneTrial tr = generateLineScene(scene, rng);
-        SolverOptions so = config.solver;
-        so.linear.seed = rng();
-        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, so);
+        const SampleSeeds seeds{rng(), config.solver.refine.seed};
+        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, config.solver, seeds);
         TrialOutcome out;
         if (tr.true_direction.norm() > 0.5) out.methods = scoreResults(res, tr.true_direction);
         return out;

@@ -2,8 +2,9 @@
 #include "celc/solver/methods.hpp"
 
 #include <algorithm>
-#include <sstream>
 #include <stdexcept>
+
+#include "celc/core/text.hpp"
 
 namespace celc {
 
@@ -33,11 +34,8 @@ Method parseMethod(const std::string& name) {
 
 std::vector<Method> parseMethodList(const std::string& list) {
   std::vector<Method> out;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
+  for (std::string item : splitList(list, ',')) {
+    item = trimBlanks(item);
     if (item.empty()) continue;
     if (item == "all") return allMethods();
     const Method m = parseMethod(item);
