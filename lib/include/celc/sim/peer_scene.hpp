@@ -22,7 +22,7 @@
 ///  - the solvers get the angular velocity with an error of fixed magnitude
 ///    omega_error about a random axis.
 /// CELC's l1 / l3 and CE3LC's l2 are fitted from each cluster's own events
-/// (lines::attachFittedLines, by default over the first / last 10% of the
+/// (attachFittedLines, by default over the first / last 10% of the
 /// cluster's duration), never taken from the ground truth.
 #include <array>
 #include <random>
