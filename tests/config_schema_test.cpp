@@ -281,7 +281,7 @@ TEST(ConfigSchema, BatchFile) {
   write("sequences:\n  - {path: a}\n  - {path: b, config: {windows: {evnts: 5}}}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: events, seconds, overlap, "
-            "t_start, t_end, read_batch, keep_partial)");
+            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second)");
   write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: key 'sequences[1].label': duplicate label 'x'");

@@ -117,18 +117,23 @@ void runTable(const TableArgs& a) {
     }
     g->sources.push_back(s);
   }
-  // Labels shared by different runs: named by the parent folder, else the path.
-  for (auto& g : groups) {
-    const auto clash = [&](const std::string& label) {
-      return std::count_if(groups.begin(), groups.end(), [&](const Group& x) { return x.label == label; }) > 1;
-    };
-    if (!clash(g.label)) continue;
-    const fs::path folder = fs::absolute(g.sources.front().csv).parent_path();
-    const std::string old = g.label;
-    g.label = folder.parent_path().filename().string() + "/" + folder.filename().string();
-    if (clash(g.label)) g.label = folder.string();
-    spdlog::warn("results named '{}' from different runs: this one is the row '{}' (name rows with --label NAME=PATH)",
-                 old, g.label);
+  // Labels shared by different runs: each named by its parent folder, else its path.
+  const auto count = [&](const std::string& label) {
+    return std::count_if(groups.begin(), groups.end(), [&](const Group& x) { return x.label == label; });
+  };
+  for (int pass = 0; pass < 2; ++pass) {  // parent/name first, the full path where that clashes too
+    std::vector<bool> clashes;
+    for (const auto& g : groups) clashes.push_back(count(g.label) > 1);
+    for (std::size_t i = 0; i < groups.size(); ++i) {
+      if (!clashes[i]) continue;
+      Group& g = groups[i];
+      const fs::path folder = fs::absolute(g.sources.front().csv).parent_path();
+      const std::string old = g.label;
+      g.label = pass == 0 ? folder.parent_path().filename().string() + "/" + folder.filename().string()
+                          : folder.string();
+      spdlog::warn("results named '{}' from different runs: this one is the row '{}' (name rows with --label NAME=PATH)",
+                   old, g.label);
+    }
   }
 
   std::vector<SequenceSummary> table;
