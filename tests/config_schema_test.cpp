@@ -242,7 +242,8 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, screen_events)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
-  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }).substr(0, 30), "--set windows.overlap=2: overl");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
+            "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");
   EXPECT_EQ(c.windows.overlap, 0.0);
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
