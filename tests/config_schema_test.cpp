@@ -242,7 +242,8 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, screen_events)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
-  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }).substr(0, 30), "--set windows.overlap=2: overl");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
+            "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");
   EXPECT_EQ(c.windows.overlap, 0.0);
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
@@ -281,7 +282,7 @@ TEST(ConfigSchema, BatchFile) {
   write("sequences:\n  - {path: a}\n  - {path: b, config: {windows: {evnts: 5}}}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: events, seconds, overlap, "
-            "t_start, t_end, read_batch, keep_partial)");
+            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second)");
   write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: key 'sequences[1].label': duplicate label 'x'");

@@ -4,10 +4,13 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "celc/eval/run_tables.hpp"
 #include "celc/io/labelled_events.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/pipeline/run_output.hpp"
 #include "commands.hpp"
 
 namespace fs = std::filesystem;
@@ -17,54 +20,140 @@ namespace {
 
 struct TableArgs {
   std::vector<std::string> results;
+  std::vector<std::string> labels;  ///< NAME=PATH
   std::string output;
-  bool quiet = false;
+  bool quiet = false, allow_incomplete = false;
 };
 
-// windows.csv files named directly, or found in the given folders (one level
-// of sub-folders too, as `celc batch` writes them).
-std::vector<fs::path> findCsvs(const std::vector<std::string>& inputs) {
-  std::vector<fs::path> out;
-  for (const auto& in : inputs) {
-    const fs::path p(in);
-    if (!fs::exists(p)) throw std::runtime_error(in + ": no such file or directory");
-    if (fs::is_regular_file(p)) {
-      out.push_back(p);
-      continue;
-    }
-    if (fs::exists(p / "windows.csv")) out.push_back(p / "windows.csv");
-    std::vector<fs::path> sub;
-    for (const auto& e : fs::directory_iterator(p))
-      if (e.is_directory() && fs::exists(e.path() / "windows.csv")) sub.push_back(e.path() / "windows.csv");
-    std::sort(sub.begin(), sub.end());
-    out.insert(out.end(), sub.begin(), sub.end());
-  }
-  if (out.empty()) throw std::runtime_error("table: no windows.csv found in the given paths");
+// One windows.csv and the row label it belongs to.
+struct Source {
+  fs::path csv;
+  std::string label;   ///< the given NAME, or the folder's name
+  bool named = false;  ///< from --label
+};
+
+// windows.csv files named directly, or found in the given folder (one level
+// of sub-folders too, as `celc batch` writes them, each labelled by its
+// folder's name; with a NAME, "NAME/<folder>").
+std::vector<Source> findCsvs(const std::string& in, const std::string& name) {
+  const fs::path p(in);
+  if (!fs::exists(p)) throw std::runtime_error(in + ": no such file or directory");
+  auto folderName = [](const fs::path& csv) { return fs::absolute(csv).parent_path().filename().string(); };
+  if (fs::is_regular_file(p)) return {{p, name.empty() ? folderName(p) : name, !name.empty()}};
+  std::vector<Source> out;
+  if (fs::exists(p / "windows.csv")) out.push_back({p / "windows.csv", name.empty() ? folderName(p / "windows.csv") : name, !name.empty()});
+  std::vector<fs::path> sub;
+  for (const auto& e : fs::directory_iterator(p))
+    if (e.is_directory() && fs::exists(e.path() / "windows.csv")) sub.push_back(e.path() / "windows.csv");
+  std::sort(sub.begin(), sub.end());
+  for (const auto& csv : sub)
+    out.push_back({csv, name.empty() ? folderName(csv) : name + "/" + folderName(csv), !name.empty()});
+  if (out.empty()) throw std::runtime_error(in + ": no windows.csv in it or in its sub-folders");
   return out;
+}
+
+// The run's configuration (config.yaml beside windows.csv), when readable.
+std::optional<RunConfig> configOf(const fs::path& csv) {
+  const fs::path cfg = csv.parent_path() / "config.yaml";
+  if (!fs::exists(cfg)) return std::nullopt;
+  try {
+    return loadRunConfig(cfg.string());
+  } catch (const std::exception& e) {
+    spdlog::warn("{}: not compared with other runs ({})", cfg.string(), e.what());
+    return std::nullopt;
+  }
+}
+
+// Rows are grouped by label; without --label, results of the same name merge
+// only when they are shards of one run (the same configuration), else each
+// keeps its own row, named by its parent folder (or its path).
+struct Group {
+  std::string label;
+  std::optional<RunConfig> config;
+  std::vector<Source> sources;
+};
+
+bool sameRun(const Group& g, const Source& s, const std::optional<RunConfig>& config) {
+  if (g.label != s.label) return false;
+  if (s.named) return true;  // the user named them alike: one row
+  return g.config && config && firstConfigDifference(*g.config, *config).empty();
 }
 
 void runTable(const TableArgs& a) {
   configureLogging(a.quiet, false);
-  // Rows per sequence label (the folder holding windows.csv); shards of one
-  // sequence merge, a (window, method) seen twice is counted once.
-  std::vector<std::string> order;
-  std::map<std::string, std::vector<WindowsCsvRow>> rows;
-  std::map<std::string, std::set<std::pair<std::int64_t, std::string>>> seen;
-  for (const auto& csv : findCsvs(a.results)) {
-    const std::string label = fs::absolute(csv).parent_path().filename().string();
-    if (!rows.count(label)) order.push_back(label);
-    int dup = 0;
-    for (auto& r : readWindowsCsv(csv.string())) {
-      if (!seen[label].insert({r.window, r.method}).second) {
-        ++dup;
-        continue;
-      }
-      rows[label].push_back(r);
-    }
-    if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", csv.string(), dup, label);
+  std::vector<Source> sources;
+  for (const auto& r : a.results) {
+    const auto found = findCsvs(r, "");
+    sources.insert(sources.end(), found.begin(), found.end());
   }
+  for (const auto& l : a.labels) {
+    const auto eq = l.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == l.size())
+      throw std::runtime_error("--label '" + l + "': expected NAME=PATH");
+    const auto found = findCsvs(l.substr(eq + 1), l.substr(0, eq));
+    sources.insert(sources.end(), found.begin(), found.end());
+  }
+  if (sources.empty()) throw std::runtime_error("table: give result folders, windows.csv files or --label NAME=PATH");
+
+  // A run that has not completed is not a result.
+  for (auto& s : sources) {
+    std::string reason;
+    if (!isIncompleteRun(s.csv.parent_path().string(), &reason)) continue;
+    const std::string where = (s.csv.parent_path() / kIncompleteMarker).string();
+    if (!a.allow_incomplete)
+      throw std::runtime_error(where + ": incomplete run (" + reason +
+                               "); finish it with `celc run --resume`, or pass --allow-incomplete");
+    spdlog::warn("{}: incomplete run, shown as '{} (incomplete)'", where, s.label);
+    s.label += " (incomplete)";
+  }
+
+  std::vector<Group> groups;
+  for (const auto& s : sources) {
+    const auto config = configOf(s.csv);
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const Group& x) { return sameRun(x, s, config); });
+    if (g == groups.end()) {
+      groups.push_back({s.label, config, {}});
+      g = groups.end() - 1;
+    }
+    g->sources.push_back(s);
+  }
+  // Labels shared by different runs: each named by its parent folder, else its path.
+  const auto count = [&](const std::string& label) {
+    return std::count_if(groups.begin(), groups.end(), [&](const Group& x) { return x.label == label; });
+  };
+  for (int pass = 0; pass < 2; ++pass) {  // parent/name first, the full path where that clashes too
+    std::vector<bool> clashes;
+    for (const auto& g : groups) clashes.push_back(count(g.label) > 1);
+    for (std::size_t i = 0; i < groups.size(); ++i) {
+      if (!clashes[i]) continue;
+      Group& g = groups[i];
+      const fs::path folder = fs::absolute(g.sources.front().csv).parent_path();
+      const std::string old = g.label;
+      g.label = pass == 0 ? folder.parent_path().filename().string() + "/" + folder.filename().string()
+                          : folder.string();
+      spdlog::warn("results named '{}' from different runs: this one is the row '{}' (name rows with --label NAME=PATH)",
+                   old, g.label);
+    }
+  }
+
   std::vector<SequenceSummary> table;
-  for (const auto& label : order) table.push_back({label, summarize(rows[label])});
+  for (const auto& g : groups) {
+    // Shards of one run merge; a (window, method) seen twice is counted once.
+    std::vector<WindowsCsvRow> rows;
+    std::set<std::pair<std::int64_t, std::string>> seen;
+    for (const auto& s : g.sources) {
+      int dup = 0;
+      for (auto& r : readWindowsCsv(s.csv.string())) {
+        if (!seen.insert({r.window, r.method}).second) {
+          ++dup;
+          continue;
+        }
+        rows.push_back(r);
+      }
+      if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", s.csv.string(), dup, g.label);
+    }
+    table.push_back({g.label, summarize(rows)});
+  }
   if (!a.output.empty()) {
     writeFileAtomically(a.output + ".md", tableMarkdown(table));
     writeFileAtomically(a.output + ".tex", tableLatex(table));
@@ -80,12 +169,19 @@ void registerTable(CLI::App& app) {
   auto a = std::make_shared<TableArgs>();
   auto* cmd = app.add_subcommand(
       "table",
-      "Error tables in the paper's layout (rows eps [m/s] and phi [rad] per sequence, columns the "
-      "methods, best in bold) from windows.csv files or folders holding them; shards of one "
-      "sequence (same folder name) are merged. Markdown on stdout; -o PREFIX also writes "
-      "PREFIX.md, PREFIX.tex (booktabs) and PREFIX.csv.");
-  cmd->add_option("results", a->results, "windows.csv files or result folders")->required();
+      "Error tables in the paper's layout (rows eps, the distance between the unit estimate and "
+      "the unit ground truth, and phi [rad] per sequence; columns the methods, best in bold) from "
+      "windows.csv files or folders holding them. A row per run, named by its folder or by "
+      "--label; shards of one run (same name, same config.yaml) merge; incomplete runs (an "
+      "INCOMPLETE marker) are refused. Markdown on stdout; -o PREFIX also writes PREFIX.md, "
+      "PREFIX.tex (booktabs) and PREFIX.csv.");
+  cmd->add_option("results", a->results, "windows.csv files or result folders");
+  cmd->add_option("--label", a->labels,
+                  "NAME=PATH: the results in PATH as the row NAME (repeatable; the same NAME twice "
+                  "merges, e.g. shards)");
   cmd->add_option("-o,--output", a->output, "write PREFIX.md, PREFIX.tex, PREFIX.csv");
+  cmd->add_flag("--allow-incomplete", a->allow_incomplete,
+                "include runs that have not completed, their rows marked '(incomplete)'");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");
   cmd->callback([a]() { runTable(*a); });
 }

@@ -28,13 +28,17 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
                   "assume this constant angular velocity wx,wy,wz [rad/s, camera frame] instead of "
                   "the gyroscope (recordings without IMU)");
   cmd->add_option("--motion-model", o.motion_model, fieldHelp(schema, "motion.model"));
-  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores, at most 1024)")->capture_default_str();
   cmd->add_option("--set", o.sets,
                   "override any configuration key, e.g. --set cluster.smoothness_deg=15 "
                   "(repeatable; YAML values; `celc config --keys` lists every key)");
   cmd->add_option("--shard", o.shard, "K/N: process only windows with index % N == K-1");
-  cmd->add_flag("--force", o.force, "replace results already in the output folder");
-  cmd->add_flag("--resume", o.resume, "continue a run after its last finished window");
+  cmd->add_flag("--force", o.force,
+                "replace results already in the output folder (with --resume: replace them only when "
+                "the stored configuration differs)");
+  cmd->add_flag("--resume", o.resume,
+                "continue a run after its last finished window; refused when OUTDIR/config.yaml differs "
+                "from this configuration");
   cmd->add_flag("-q,--quiet", o.quiet, "only warnings and errors on stderr");
   cmd->add_flag("-v,--verbose", o.verbose, "debug logging");
 }
@@ -43,14 +47,61 @@ void applySets(const std::vector<std::string>& sets, RunConfig& c) {
   for (const std::string& s : sets) applyRunSetting(s, c);
 }
 
+namespace {
+
+// A whole number of events > 0, or an error naming the option.
+std::size_t parseWindowEvents(const std::string& text) {
+  std::size_t used = 0;
+  long long n = 0;
+  try {
+    n = std::stoll(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || n <= 0)
+    throw std::runtime_error("--window-events '" + text + "': expected a positive whole number of events");
+  return static_cast<std::size_t>(n);
+}
+
+// A finite duration > 0 [s], or an error naming the option.
+double parseWindowSeconds(const std::string& text) {
+  std::size_t used = 0;
+  double s = 0.0;
+  try {
+    s = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(s) || !(s > 0.0))
+    throw std::runtime_error("--window-seconds '" + text + "': expected a positive, finite duration [s]");
+  return s;
+}
+
+}  // namespace
+
+void checkThreads(int threads) {
+  if (threads < 0 || threads > kMaxThreads)
+    throw std::runtime_error("--threads " + std::to_string(threads) + ": expected 0 (all cores) to " +
+                             std::to_string(kMaxThreads));
+}
+
 RunConfig buildRunConfig(const RunOverrides& o) {
+  checkThreads(o.threads);
+  if (!o.window_events.empty() && !o.window_seconds.empty())
+    throw std::runtime_error("--window-events, --window-seconds: give one of them, not both");
   RunConfig c = o.config.empty() ? RunConfig{} : loadRunConfig(o.config);
-  if (o.window_events > 0) {
-    c.windows.events_per_window = o.window_events;
+  if (!o.window_events.empty()) {
+    c.windows.events_per_window = parseWindowEvents(o.window_events);
     c.windows.seconds_per_window = 0.0;
   }
-  if (o.window_seconds > 0) {
-    c.windows.seconds_per_window = o.window_seconds;
+  if (!o.window_seconds.empty()) {
+    const double s = parseWindowSeconds(o.window_seconds);
+    const double per_second = 1.0 / ((1.0 - c.windows.overlap) * s);
+    if (!(per_second <= c.windows.max_windows_per_second))
+      throw std::runtime_error(fmt::format(
+          "--window-seconds {}: {:.3g} windows per second of data, more than windows.max_windows_per_second = {:g}",
+          o.window_seconds, per_second, c.windows.max_windows_per_second));
+    c.windows.seconds_per_window = s;
     c.windows.events_per_window = 0;
   }
   if (!o.methods.empty()) c.methods = parseMethodList(o.methods);
@@ -76,7 +127,7 @@ RunConfig buildRunConfig(const RunOverrides& o) {
 }
 
 OutputMode outputMode(const RunOverrides& o) {
-  if (o.force && o.resume) throw std::runtime_error("--force and --resume exclude each other");
+  if (o.force && o.resume) return OutputMode::ResumeOrReplace;
   return o.resume ? OutputMode::Resume : (o.force ? OutputMode::Force : OutputMode::Create);
 }
 

@@ -13,10 +13,11 @@ namespace celc::app {
 struct RunOverrides {
   std::string config;              ///< -c YAML
   std::vector<std::string> sets;   ///< --set key.path=value
-  std::size_t window_events = 0;
-  double window_seconds = 0.0;
+  /// --window-events / --window-seconds as typed (empty: not given), parsed
+  /// by buildRunConfig so that 0, negative and non-finite values are errors.
+  std::string window_events, window_seconds;
   std::string methods, omega, motion_model;
-  int threads = 0;
+  int threads = 0;  ///< 0 = all cores; checked by checkThreads
   bool force = false, resume = false, quiet = false, verbose = false;
   std::string shard;
 };
@@ -27,7 +28,13 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o);
 RunConfig buildRunConfig(const RunOverrides& o);
 /// Applies `--set a.b=value` style overrides (YAML values) onto a config.
 void applySets(const std::vector<std::string>& sets, RunConfig& config);
+/// --force and --resume: Create, Force, Resume, or (both) Resume that may
+/// replace a run whose stored configuration differs.
 OutputMode outputMode(const RunOverrides& o);
+/// The largest --threads accepted.
+constexpr int kMaxThreads = 1024;
+/// --threads outside [0, kMaxThreads] is an error naming the option.
+void checkThreads(int threads);
 /// Prints the per-method summary table to stdout.
 void printSummary(const std::string& title, const SequenceOutcome& outcome);
 

@@ -215,13 +215,15 @@ std::string tableMarkdown(const std::vector<SequenceSummary>& seqs) {
   for (const auto& s : seqs)
     for (bool eps : {true, false}) {
       const int b = best(s, cols, eps);
-      o << "| " << s.label << " | " << (eps ? "eps [m/s]" : "phi [rad]") << " |";
+      o << "| " << s.label << " | " << (eps ? "eps (unit-vector distance)" : "phi [rad]") << " |";
       for (size_t i = 0; i < cols.size(); ++i) {
         const std::string v = fmt(valueOf(s, cols[i], eps));
         o << " " << (static_cast<int>(i) == b ? "**" + v + "**" : v) << " |";
       }
       o << "\n";
     }
+  o << "\neps = |v_gt - v|: the distance between the unit ground-truth and unit estimated directions "
+       "(0 to 2, no unit); phi = acos(v_gt . v) [rad]; means over the windows with status ok and ground truth.\n";
   return o.str();
 }
 
@@ -229,6 +231,7 @@ std::string tableLatex(const std::vector<SequenceSummary>& seqs) {
   const auto cols = columns(seqs);
   std::ostringstream o;
   o << "% celc table: mean errors over the windows with ground truth; best per row in bold\n"
+    << "% epsilon = |v_gt - v| between unit vectors (0 to 2, no unit), phi = acos(v_gt . v) [rad]\n"
     << "\\begin{tabular}{ll" << std::string(cols.size(), 'c') << "}\n\\toprule\nSequence & Error";
   for (const auto& c : cols) o << " & " << latexEscape(methodDisplayName(c));
   o << " \\\\\n\\midrule\n";
@@ -237,7 +240,7 @@ std::string tableLatex(const std::vector<SequenceSummary>& seqs) {
     for (bool eps : {true, false}) {
       const int b = best(s, cols, eps);
       o << (eps ? "\\multirow{2}{*}{" + latexEscape(s.label) + "}" : std::string()) << " & "
-        << (eps ? "$\\epsilon$ [m/s]" : "$\\phi$ [rad]");
+        << (eps ? "$\\epsilon$ (unit-vector dist.)" : "$\\phi$ [rad]");
       for (size_t i = 0; i < cols.size(); ++i) {
         const std::string v = fmt(valueOf(s, cols[i], eps));
         o << " & " << (static_cast<int>(i) == b ? "\\textbf{" + v + "}" : v);

@@ -24,7 +24,12 @@ void describe(FieldVisitor& v, WindowOptions& o) {
   v.field({"t_start", "s", "first time used"}, o.t_start);
   v.field({"t_end", "s", "end of the time used (exclusive)"}, o.t_end);
   v.field({"read_batch", "events", "events pulled from the reader at a time"}, o.read_batch);
-  v.field({"keep_partial", "", "also emit the last, incomplete window"}, o.keep_partial);
+  v.field({"keep_partial", "", "also emit the last, incomplete window, whatever it holds"}, o.keep_partial);
+  v.field({"partial_min_share", "-",
+           "otherwise the last, incomplete window is processed when it holds this share of a window, in [0, 1]"},
+          o.partial_min_share);
+  v.field({"max_windows_per_second", "1/s", "a window policy making more windows per second of data is an error"},
+          o.max_windows_per_second);
 }
 
 void describe(FieldVisitor& v, GyroWindowOptions& o) {

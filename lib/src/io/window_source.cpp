@@ -2,20 +2,38 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace celc {
 
 std::string WindowOptions::validate() const {
-  if ((events_per_window > 0) == (seconds_per_window > 0.0))
-    return "give exactly one of events_per_window (> 0) and seconds_per_window (> 0)";
-  if (!std::isfinite(seconds_per_window) || seconds_per_window < 0.0) return "seconds_per_window must be finite, >= 0";
-  if (!(overlap >= 0.0 && overlap < 1.0)) return "overlap must be in [0, 1)";
-  if (events_per_window > 0 && std::size_t(std::floor((1.0 - overlap) * double(events_per_window))) < 1)
-    return "overlap leaves a step of 0 events";
-  if (std::isnan(t_start) || std::isnan(t_end) || !(t_end > t_start)) return "need t_start < t_end";
-  if (read_batch < 1) return "read_batch must be >= 1";
-  return {};
+  std::ostringstream e;
+  e.precision(6);
+  const bool seconds_ok = std::isfinite(seconds_per_window) && seconds_per_window >= 0.0;
+  if (!seconds_ok)
+    e << "seconds: must be finite and > 0 (0 = windows by events), got " << seconds_per_window << "; ";
+  else if ((events_per_window > 0) == (seconds_per_window > 0.0))
+    e << "events, seconds: give exactly one of events (> 0) and seconds (> 0); ";
+  const bool overlap_ok = overlap >= 0.0 && overlap < 1.0;
+  if (!overlap_ok)
+    e << "overlap: must be in [0, 1), got " << overlap << "; ";
+  else if (events_per_window > 0 && std::size_t(std::floor((1.0 - overlap) * double(events_per_window))) < 1)
+    e << "overlap: leaves a step of 0 events; ";
+  if (!(partial_min_share >= 0.0 && partial_min_share <= 1.0))
+    e << "partial_min_share: must be in [0, 1], got " << partial_min_share << "; ";
+  if (!(max_windows_per_second > 0.0) || !std::isfinite(max_windows_per_second))
+    e << "max_windows_per_second: must be finite and > 0, got " << max_windows_per_second << "; ";
+  else if (seconds_ok && overlap_ok && seconds_per_window > 0.0) {
+    // By duration the rate is known before reading: one window per step.
+    const double per_second = 1.0 / ((1.0 - overlap) * seconds_per_window);
+    if (!(per_second <= max_windows_per_second))
+      e << "seconds: windows of " << seconds_per_window << " s (overlap " << overlap << ") make " << per_second
+        << " windows per second of data, more than max_windows_per_second = " << max_windows_per_second << "; ";
+  }
+  if (std::isnan(t_start) || std::isnan(t_end) || !(t_end > t_start)) e << "t_start, t_end: need t_start < t_end; ";
+  if (read_batch < 1) e << "read_batch: must be >= 1; ";
+  return e.str();
 }
 
 WindowSource::WindowSource(EventReader& reader, const WindowOptions& options) : reader_(reader), o_(options) {
@@ -58,13 +76,21 @@ bool WindowSource::next(EventWindow& w) {
     const std::size_t n = o_.events_per_window;
     while (buf_.size() < n && pull()) {
     }
-    if (buf_.empty() || (buf_.size() < n && !o_.keep_partial)) return false;
+    if (buf_.size() < n) {  // the end: a partial window, or nothing new
+      const std::size_t fresh = buf_.size() - std::min(covered_front_, buf_.size());
+      if (fresh == 0) return false;  // tail_ keeps what became of the last partial window
+      tail_ = {fresh, double(buf_.size()) / double(n), false};
+      if (!(o_.keep_partial || tail_.share >= o_.partial_min_share)) return false;
+      tail_.emitted = true;
+    }
     const std::size_t take = std::min(n, buf_.size());
     w.events.assign(buf_.begin(), buf_.begin() + std::ptrdiff_t(take));
     w.t0 = w.events.front().t;
     w.t1 = w.events.back().t;
     const std::size_t step = std::max<std::size_t>(1, std::size_t(std::floor((1.0 - o_.overlap) * double(n))));
-    buf_.erase(buf_.begin(), buf_.begin() + std::ptrdiff_t(std::min(step, buf_.size())));
+    const std::size_t erased = std::min(step, buf_.size());
+    buf_.erase(buf_.begin(), buf_.begin() + std::ptrdiff_t(erased));
+    covered_front_ = take - erased;
     ++index_;
     return true;
   }
@@ -81,9 +107,14 @@ bool WindowSource::next(EventWindow& w) {
   }
   // complete when events reach t1, or the stream passed t_end and t1 <= t_end
   const bool complete = (!buf_.empty() && buf_.back().t >= t1) || (past_end_ && t1 <= o_.t_end);
-  if (!complete) {
-    if (!o_.keep_partial) return false;
-    if (std::none_of(buf_.begin(), buf_.end(), [&](const Event& e) { return e.t >= t0; })) return false;
+  if (!complete) {  // the end: a partial window, or nothing new
+    const auto fresh = std::count_if(buf_.begin(), buf_.end(),
+                                     [&](const Event& e) { return e.t >= t0 && e.t >= covered_until_; });
+    const double span = buf_.empty() ? 0.0 : std::max(0.0, buf_.back().t - t0);
+    if (fresh == 0) return false;  // tail_ keeps what became of the last partial window
+    tail_ = {std::size_t(fresh), std::min(1.0, span / S), false};
+    if (!(o_.keep_partial || tail_.share >= o_.partial_min_share)) return false;
+    tail_.emitted = true;
   }
   for (const Event& e : buf_) {
     if (e.t >= t1) break;
@@ -91,6 +122,7 @@ bool WindowSource::next(EventWindow& w) {
   }
   w.t0 = t0;
   w.t1 = t1;
+  covered_until_ = t1;
   const double following = next_t0_ + double(index_ + 1) * (1.0 - o_.overlap) * S;
   while (!buf_.empty() && buf_.front().t < following) buf_.pop_front();
   ++index_;

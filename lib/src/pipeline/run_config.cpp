@@ -1,16 +1,35 @@
 #include "celc/pipeline/run_config.hpp"
 
+#include <algorithm>
+
 #include "celc/core/yaml.hpp"
 
 namespace celc {
 
 std::string toString(OmegaSource source) { return source == OmegaSource::Gyro ? "gyro" : "fixed"; }
 
+namespace {
+// "key: what; key: what; " of one section -> "section.key: what; ..."
+std::string inSection(const std::string& section, const std::string& problems) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < problems.size()) {
+    std::size_t end = problems.find("; ", at);
+    if (end == std::string::npos) end = problems.size();
+    out += section + "." + problems.substr(at, end - at) + "; ";
+    at = end + 2;
+  }
+  return out;
+}
+}  // namespace
+
 std::string RunConfig::validate() const {
-  std::string e = reader.validate() + windows.validate() + gyro.validate() + cluster.validate() +
-                  observations.validate() + solver.validate() + groundtruth.validate();
+  std::string e = reader.validate() + inSection("windows", windows.validate()) + gyro.validate() +
+                  cluster.validate() + observations.validate() + solver.validate() + groundtruth.validate();
   if (methods.empty()) e += "methods: at least one; ";
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
+  // One line: the problems joined by "; ", without the last separator.
+  while (!e.empty() && (e.back() == ' ' || e.back() == ';')) e.pop_back();
   return e;
 }
 
@@ -75,6 +94,25 @@ std::string toYaml(const RunConfig& c) {
   return writeYaml([&](FieldVisitor& v) { describe(v, copy); },
                    {true, std::string("celc ") + CELC_VERSION +
                               " configuration of `celc run` / `celc batch` (units in brackets)"});
+}
+
+const std::vector<std::string>& resultNeutralKeys() {
+  static const std::vector<std::string> keys = {"cluster.threads", "windows.read_batch"};
+  return keys;
+}
+
+std::string firstConfigDifference(const RunConfig& a, const RunConfig& b) {
+  RunConfig ca = a, cb = b;
+  const auto fa = listFields([&](FieldVisitor& v) { describe(v, ca); });
+  const auto fb = listFields([&](FieldVisitor& v) { describe(v, cb); });
+  const auto& neutral = resultNeutralKeys();
+  for (std::size_t i = 0; i < std::max(fa.size(), fb.size()); ++i) {
+    if (i >= fa.size() || i >= fb.size() || fa[i].key != fb[i].key)  // list lengths differ
+      return (i < fa.size() ? fa[i].key : fb[i].key) + ": present in one configuration only";
+    if (std::find(neutral.begin(), neutral.end(), fa[i].key) != neutral.end()) continue;
+    if (fa[i].value != fb[i].value) return fa[i].key + ": " + fa[i].value + " vs " + fb[i].value;
+  }
+  return {};
 }
 
 }  // namespace celc

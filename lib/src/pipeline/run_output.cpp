@@ -1,7 +1,9 @@
 #include "celc/pipeline/run_output.hpp"
 
 #include <cmath>
+#include <ctime>
 #include <iomanip>
+#include <set>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -37,25 +39,89 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
   return lines;
 }
 
-RunOutput::RunOutput(const std::string& dir, OutputMode mode, std::size_t methods_per_window)
+bool isIncompleteRun(const std::string& dir, std::string* reason) {
+  const fs::path marker = fs::path(dir) / kIncompleteMarker;
+  if (!fs::exists(marker)) return false;
+  if (reason) {
+    std::ifstream in(marker);
+    std::getline(in, *reason);
+  }
+  return true;
+}
+
+namespace {
+
+// windows.csv holds at least one row after its header (a header-only file,
+// from a run that stopped before its first window, is not a run).
+bool holdsRows(const std::string& csv_path) {
+  std::ifstream in(csv_path);
+  if (!in) return false;
+  std::string line;
+  if (!std::getline(in, line)) return false;
+  while (std::getline(in, line))
+    if (!line.empty() && line != "\r") return true;
+  return false;
+}
+
+std::string nowText() {
+  const std::time_t t = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", std::localtime(&t));
+  return buf;
+}
+
+}  // namespace
+
+RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config)
     : dir_(dir), csv_path_((fs::path(dir) / "windows.csv").string()) {
-  const bool has_run = fs::exists(csv_path_);
+  const fs::path config_path = fs::path(dir) / "config.yaml";
+  const bool has_run = holdsRows(csv_path_);
   if (has_run && mode == OutputMode::Create)
     throw std::runtime_error(dir + ": holds an earlier run (windows.csv); use --force to replace it or --resume to continue it");
+  bool resume = has_run && (mode == OutputMode::Resume || mode == OutputMode::ResumeOrReplace);
+  if (resume) {
+    // Continue only what the stored configuration describes.
+    std::string difference;
+    if (!fs::exists(config_path)) {
+      difference = "missing, so the configuration of the rows is unknown";
+    } else {
+      try {
+        difference = firstConfigDifference(loadRunConfig(config_path.string()), config);
+        if (!difference.empty()) difference = "differs from this run's configuration at " + difference + " (stored vs now)";
+      } catch (const std::exception& e) {
+        difference = std::string("unreadable (") + e.what() + ")";
+      }
+    }
+    if (!difference.empty()) {
+      if (mode == OutputMode::Resume)
+        throw std::runtime_error(config_path.string() + ": " + difference +
+                                 "; --resume continues the same configuration only (--resume --force replaces the run)");
+      notes_.push_back("replaced the earlier run: its config.yaml " + difference);
+      resume = false;
+    }
+  }
+  created_dir_ = !fs::exists(dir);
   fs::create_directories(dir);
-  if (mode == OutputMode::Resume && has_run) {
-    // Keep the complete windows only (all methods' rows present).
+  if (resume) {
+    // Keep the complete windows only (all methods' rows present); rows beyond
+    // the last complete window may only be the torn last window.
     const auto rows = readWindowsCsv(csv_path_, true);
-    std::map<std::int64_t, std::size_t> count;
-    for (const auto& r : rows) count[r.window]++;
-    for (const auto& [w, n] : count) {
-      if (n != methods_per_window) break;
-      resume_after_ = w;
+    std::map<std::int64_t, std::set<std::string>> methods_of;
+    for (const auto& r : rows) methods_of[r.window].insert(r.method);
+    std::set<std::string> wanted;
+    for (Method m : config.methods) wanted.insert(toString(m));
+    std::int64_t incomplete = -1;
+    for (const auto& [w, names] : methods_of) {
+      if (incomplete >= 0)
+        throw std::runtime_error(csv_path_ + ": window " + std::to_string(incomplete) +
+                                 " lacks rows of some methods but later windows follow; not resumable "
+                                 "(--force replaces the run)");
+      if (names == wanted) resume_after_ = w;
+      else incomplete = w;
     }
     std::ifstream in(csv_path_);
     std::string content = windowsCsvHeader() + "\n", line;
     std::getline(in, line);  // header
-    std::int64_t kept = 0;
     while (std::getline(in, line)) {
       const auto comma = line.find(',');
       if (comma == std::string::npos) break;
@@ -67,17 +133,28 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, std::size_t method
       }
       if (w > resume_after_) break;
       content += line + "\n";
-      ++kept;
     }
-    (void)kept;
+    in.close();
+    writeMarker("celc run resumed " + nowText() + "; not complete (interrupted, or stopped on an error)");
+    fs::remove(fs::path(dir) / "summary.md");
     writeFileAtomically(csv_path_, content);
     csv_.open(csv_path_, std::ios::app);
   } else {
+    // The old summary goes first: it never stands beside new rows.
+    fs::remove(fs::path(dir) / "summary.md");
+    writeMarker("celc run started " + nowText() + "; not complete (interrupted, or stopped on an error)");
     csv_.open(csv_path_, std::ios::trunc);
     csv_ << windowsCsvHeader() << "\n";
     csv_.flush();
   }
   if (!csv_) throw std::runtime_error(csv_path_ + ": cannot write");
+  writeFileAtomically(config_path.string(), toYaml(config));
+}
+
+void RunOutput::writeMarker(const std::string& text) const {
+  writeFileAtomically((fs::path(dir_) / kIncompleteMarker).string(),
+                      text + "\n\nThis folder is not a complete result: `celc table` refuses it. "
+                             "Continue the run with `celc run ... --resume`, or replace it with --force.\n");
 }
 
 void RunOutput::append(const WindowRecord& record) {
@@ -86,10 +163,7 @@ void RunOutput::append(const WindowRecord& record) {
   csv_ << block;
   csv_.flush();  // a finished window survives an interruption
   if (!csv_) throw std::runtime_error(csv_path_ + ": write failed");
-}
-
-void RunOutput::writeConfig(const std::string& yaml) const {
-  writeFileAtomically((fs::path(dir_) / "config.yaml").string(), yaml);
+  ++appended_;
 }
 
 std::vector<MethodSummary> RunOutput::writeSummary(const std::string& title,
@@ -98,6 +172,31 @@ std::vector<MethodSummary> RunOutput::writeSummary(const std::string& title,
   writeFileAtomically((fs::path(dir_) / "summary.md").string(),
                       summaryMarkdown(title, summaries, notes));
   return summaries;
+}
+
+void RunOutput::complete() {
+  csv_.close();
+  fs::remove(fs::path(dir_) / kIncompleteMarker);
+}
+
+void RunOutput::abandon(const std::string& error) {
+  csv_.close();
+  std::error_code ec;
+  if (appended_ == 0 && resume_after_ < 0) {
+    // Nothing of a result: remove what this run created.
+    for (const char* f : {"windows.csv", "config.yaml", "summary.md", kIncompleteMarker})
+      fs::remove(fs::path(dir_) / f, ec);
+    if (created_dir_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
+    return;
+  }
+  std::string line = error;
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  try {
+    writeMarker("celc run stopped on an error " + nowText() + ": " + line);
+  } catch (const std::exception&) {
+    // the marker of the start stays
+  }
 }
 
 std::pair<int, int> parseShard(const std::string& text) {
@@ -117,12 +216,29 @@ std::pair<int, int> parseShard(const std::string& text) {
   return {k - 1, n};
 }
 
+namespace {
+void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
+             const std::function<void(std::uint64_t, std::uint64_t)>& progress, SequenceOutcome& out);
+}  // namespace
+
 SequenceOutcome runSequence(const SequenceJob& job,
                             const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   SequenceOutcome out;
-  SequenceRunner runner(job.inputs, job.config);
-  RunOutput output(job.outdir, job.mode, job.config.methods.size());
-  output.writeConfig(toYaml(job.config));
+  SequenceRunner runner(job.inputs, job.config);  // opens the inputs: nothing written yet
+  RunOutput output(job.outdir, job.mode, job.config);
+  try {
+    runInto(runner, output, job, progress, out);
+  } catch (const std::exception& e) {
+    output.abandon(e.what());
+    throw;
+  }
+  output.complete();
+  return out;
+}
+
+namespace {
+void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
+             const std::function<void(std::uint64_t, std::uint64_t)>& progress, SequenceOutcome& out) {
   WindowFilter filter;
   filter.after = output.resumeAfter();
   filter.shard_index = job.shard_index;
@@ -130,6 +246,7 @@ SequenceOutcome runSequence(const SequenceJob& job,
   out.stats = runner.run(job.threads, filter, [&](const WindowRecord& r) { output.append(r); }, progress);
 
   out.notes = runner.describe();
+  out.notes.insert(out.notes.end(), output.notes().begin(), output.notes().end());
   if (job.shard_count > 1)
     out.notes.push_back("shard " + std::to_string(job.shard_index + 1) + "/" + std::to_string(job.shard_count));
   if (filter.after >= 0) out.notes.push_back("resumed after window " + std::to_string(filter.after));
@@ -153,8 +270,17 @@ SequenceOutcome runSequence(const SequenceJob& job,
   }
   if (s.reader_warnings > 0)
     out.notes.push_back(std::to_string(s.reader_warnings) + " reader warnings (see celc info)");
+  const WindowTail& tail = s.tail;
+  if (tail.events > 0) {
+    std::ostringstream n;
+    n.precision(3);
+    n << "last, partial window: " << tail.events << " events, " << 100 * tail.share << "% of a window, "
+      << (tail.emitted ? "processed" : "not processed") << " (windows.partial_min_share = "
+      << job.config.windows.partial_min_share << (job.config.windows.keep_partial ? ", keep_partial" : "") << ")";
+    out.notes.push_back(n.str());
+  }
   out.summaries = output.writeSummary(job.title, out.notes);
-  return out;
 }
+}  // namespace
 
 }  // namespace celc

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "celc/core/parallel.hpp"
 #include "celc/eval/metrics.hpp"
@@ -55,13 +56,24 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
   const int w = m.reader->width() > 0 ? m.reader->width() : 240;
   const int h = m.reader->height() > 0 ? m.reader->height() : 180;
   m.calib = loadCalibration(m.inputs.calib, w, h);
+  // A calibration of another sensor maps every pixel to a wrong bearing.
+  if (m.reader->width() > 0 && m.reader->height() > 0 &&
+      (m.calib.camera.width != m.reader->width() || m.calib.camera.height != m.reader->height()))
+    throw std::runtime_error(m.inputs.calib + ": calibration of a " + std::to_string(m.calib.camera.width) + "x" +
+                             std::to_string(m.calib.camera.height) + " image, but " + in.events + " is from a " +
+                             std::to_string(m.reader->width()) + "x" + std::to_string(m.reader->height()) +
+                             " sensor");
   m.lut = std::make_unique<UndistortLut>(m.calib.camera);
 
   if (m.config.omega_source == OmegaSource::Gyro) {
     std::vector<ImuSample> imu = m.inputs.imu.empty() ? m.reader->readImu()
                                                       : readImuText(m.inputs.imu, m.config.reader);
     m.n_imu = imu.size();
-    if (!imu.empty()) m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
+    if (imu.empty())
+      throw std::runtime_error((m.inputs.imu.empty() ? in.events : m.inputs.imu) +
+                               ": no IMU samples; give --imu FILE, or --omega wx,wy,wz [rad/s] "
+                               "(motion.omega_source: fixed) for a recording without IMU");
+    m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
   }
   if (!m.inputs.groundtruth.empty()) {
     auto poses = readPosesText(m.inputs.groundtruth, m.config.reader);
@@ -190,6 +202,29 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   };
   WindowSource source(*m.reader, m.config.windows);
   EventWindow window;
+  // By count the number of windows per second of data depends on the event
+  // rate: checked as windows arrive (by duration WindowOptions::validate did).
+  double first_t0 = 0.0;
+  auto checkWindowRate = [&](std::uint64_t n_windows, const EventWindow& w) {
+    const WindowOptions& wo = m.config.windows;
+    if (wo.events_per_window == 0) return;
+    if (n_windows == 1) first_t0 = w.t0;
+    const double span = w.t1 - first_t0;
+    // The first window alone: a step of `step` events lasts about
+    // span * step / n s; later: the windows so far over the data so far.
+    const double n = static_cast<double>(wo.events_per_window);
+    const double step = std::max(1.0, std::floor((1.0 - wo.overlap) * n));
+    const double per_second = n_windows == 1 ? n / (step * span) : (n_windows - 1.0) / span;
+    if (!(per_second <= wo.max_windows_per_second)) {
+      std::ostringstream e;
+      e.precision(3);
+      e << "windows.events = " << wo.events_per_window << ": " << per_second
+        << " windows per second of data (at " << n_windows << (n_windows == 1 ? " window" : " windows")
+        << "), more than windows.max_windows_per_second = " << wo.max_windows_per_second
+        << "; use longer windows or raise the bound";
+      throw std::runtime_error(e.str());
+    }
+  };
   // Windows read and not yet written: a bound on the memory held.
   const std::size_t max_in_flight = static_cast<std::size_t>(resolveThreadCount(threads)) + 2;
   orderedParallelMap<Job, WindowRecord>(
@@ -202,6 +237,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
           if (!more) return false;
           stats.windows_read++;
           stats.events_read += window.events.size();
+          checkWindowRate(stats.windows_read, window);
           const auto idx = static_cast<std::int64_t>(window.index);
           const bool wanted = idx > filter.after && filter.shard_count > 0 &&
                               idx % filter.shard_count == filter.shard_index;
@@ -226,6 +262,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         if (progress) progress(stats.windows_processed, stats.events_processed);
       });
   stats.reader_warnings = m.reader->warnings().total();
+  stats.tail = source.tail();
   stats.seconds_total = secondsSince(start);
   return stats;
 }

@@ -61,7 +61,8 @@ struct SequenceSummary {
 /// Display name of a method in the tables (celc -> CELC, celc_opt -> CELC+opt, ...).
 std::string methodDisplayName(const std::string& method);
 
-/// The paper's layout: rows "label eps [m/s]" and "label phi [rad]", columns
+/// The paper's layout: rows "label eps (unit-vector distance)" (|v_gt - v| on
+/// unit vectors, no unit) and "label phi [rad]", columns
 /// the methods (means over the windows with metrics), best per row in bold.
 std::string tableMarkdown(const std::vector<SequenceSummary>& sequences);
 std::string tableLatex(const std::vector<SequenceSummary>& sequences);

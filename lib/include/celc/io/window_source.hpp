@@ -28,13 +28,33 @@ struct WindowOptions {
   double t_start = -std::numeric_limits<double>::infinity();  ///< [s]
   double t_end = std::numeric_limits<double>::infinity();     ///< [s], exclusive
   std::size_t read_batch = 65536;     ///< events pulled from the reader at a time
-  /// Emit the last, incomplete window (fewer than N events / cut by the file's end).
+  /// Emit the last, incomplete window (fewer than N events / cut by the file's
+  /// end) whatever it holds (the same as partial_min_share = 0).
   bool keep_partial = false;
+  /// Otherwise the last, incomplete window is emitted when it holds at least
+  /// this share of a window: of N events (by count) or of S seconds, from t0
+  /// to its last event (by duration). In [0, 1]; 1 emits complete windows only.
+  /// Either way it must hold events that no earlier window held.
+  double partial_min_share = 1.0;
+  /// Upper bound on the windows per second of data [1/s]: a window policy
+  /// that would exceed it is an error, not a run of millions of windows.
+  /// By duration it is checked here (1 / step); by count, where it depends on
+  /// the event rate, by the caller as windows arrive.
+  double max_windows_per_second = 10000.0;
+  /// Why the options are unusable ("" = valid): "key: what; " per problem,
+  /// keys as in the `windows:` section.
   std::string validate() const;
 };
 /// The schema of the `windows:` section (core/fields.hpp).
 void describe(FieldVisitor& v, WindowOptions& options);
 
+
+/// What became of the events after the last emitted window (see WindowSource::tail()).
+struct WindowTail {
+  std::size_t events = 0;  ///< events in no emitted window (0: the windows covered the data)
+  double share = 0.0;      ///< the partial window's share of a full window (events or seconds)
+  bool emitted = false;    ///< the partial window was emitted (events then counts what it held)
+};
 
 struct EventWindow {
   std::uint64_t index = 0;
@@ -46,10 +66,13 @@ class WindowSource {
  public:
   /// Throws std::invalid_argument when the options are invalid. The reader must outlive the source.
   WindowSource(EventReader& reader, const WindowOptions& options);
-  /// Next window; false when no (complete, unless keep_partial) window remains.
+  /// Next window; false when no window remains (complete, or partial with
+  /// enough events: keep_partial, partial_min_share).
   bool next(EventWindow& window);
   /// Largest number of events held at once so far (the memory bound).
   std::size_t peakBuffered() const { return peak_; }
+  /// After next() returned false: the last, partial window, emitted or not.
+  const WindowTail& tail() const { return tail_; }
 
  private:
   bool pull();  ///< appends one batch within the time range; false at the end
@@ -63,6 +86,9 @@ class WindowSource {
   double next_t0_ = 0.0;
   std::uint64_t index_ = 0;
   std::size_t peak_ = 0;
+  std::size_t covered_front_ = 0;  ///< by count: events at the buffer's front already in a window
+  double covered_until_ = -std::numeric_limits<double>::infinity();  ///< by duration: end of the last window [s]
+  WindowTail tail_;
 };
 
 }  // namespace celc

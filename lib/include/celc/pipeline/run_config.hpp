@@ -26,9 +26,13 @@ std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
 struct RunConfig {
   ReaderOptions reader;
+  /// 30,000 events per window (the paper's choice); the last, partial window
+  /// is processed when it holds at least half a window (else the summary says
+  /// how many events it held).
   WindowOptions windows = [] {
     WindowOptions w;
     w.events_per_window = 30000;
+    w.partial_min_share = 0.5;
     return w;
   }();
   MotionModelKind motion = MotionModelKind::ConstantTwist;
@@ -70,5 +74,15 @@ RunConfig loadRunConfig(const std::string& path);
 void applyRunSetting(const std::string& assignment, RunConfig& config);
 /// The effective configuration as YAML (every key, with its unit and doc).
 std::string toYaml(const RunConfig& config);
+
+/// Keys that do not change a run's rows, left out of configuration
+/// comparisons (resume, table grouping): `cluster.threads` (the clustering of
+/// one window gives the same clusters on any number of threads; `--threads`
+/// sets it) and `windows.read_batch` (how many events are read at a time).
+const std::vector<std::string>& resultNeutralKeys();
+
+/// The first field (in schema order, result-neutral keys left out) whose
+/// value differs, as "key: A vs B" with the YAML values; "" when none does.
+std::string firstConfigDifference(const RunConfig& a, const RunConfig& b);
 
 }  // namespace celc

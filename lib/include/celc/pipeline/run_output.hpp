@@ -3,6 +3,12 @@
 /// The output folder of a run: windows.csv (rows appended and flushed per
 /// window, so an interrupted run keeps every finished window), summary.md and
 /// config.yaml (written to a temporary name and renamed), and resuming.
+///
+/// A folder is a result only when it is complete: from the start of a run to
+/// its end the folder holds the marker file INCOMPLETE (what stopped the run,
+/// when it stopped on an error), which `celc table` refuses. A run that fails
+/// before its first window removes what it created; a folder whose windows.csv
+/// holds no rows is not a run (a new run needs no --force).
 #include <cstdint>
 #include <fstream>
 #include <string>
@@ -16,32 +22,55 @@ namespace celc {
 /// The windows.csv rows of one window (one per method).
 std::vector<std::string> windowsCsvLines(const WindowRecord& record);
 
-enum class OutputMode { Create, Force, Resume };
+/// The marker of a run that has not completed (in the output folder).
+inline constexpr const char* kIncompleteMarker = "INCOMPLETE";
+
+/// True when `dir` holds the INCOMPLETE marker; `reason` gets its first line.
+bool isIncompleteRun(const std::string& dir, std::string* reason = nullptr);
+
+enum class OutputMode {
+  Create,          ///< the folder must not hold a run
+  Force,           ///< an existing run is replaced (its summary removed first)
+  Resume,          ///< continue a run of the same configuration (refused otherwise)
+  ResumeOrReplace  ///< --resume --force: continue it, or replace it when the configuration differs
+};
 
 class RunOutput {
  public:
   /// Create: the folder must not hold a run (error naming it otherwise).
-  /// Force: an existing run is replaced. Resume: the existing windows.csv is
-  /// kept up to its last complete window (a torn last window is dropped) and
-  /// resumeAfter() says where to continue.
-  RunOutput(const std::string& dir, OutputMode mode, std::size_t methods_per_window);
+  /// Force: an existing run is replaced. Resume: OUTDIR/config.yaml must hold
+  /// the same configuration (result-neutral keys aside; the error names the
+  /// first differing key); the existing windows.csv is kept up to its last
+  /// complete window (only a torn last window is dropped) and resumeAfter()
+  /// says where to continue. Writes config.yaml and the INCOMPLETE marker.
+  RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config);
 
   /// Index of the last complete window already in windows.csv (-1: none).
   std::int64_t resumeAfter() const { return resume_after_; }
   const std::string& dir() const { return dir_; }
+  /// Notes for the summary (a replaced run, ...).
+  const std::vector<std::string>& notes() const { return notes_; }
 
   /// Appends one window's rows and flushes them to the file.
   void append(const WindowRecord& record);
-  /// Writes config.yaml (atomically).
-  void writeConfig(const std::string& yaml) const;
   /// Rewrites summary.md from windows.csv (atomically); returns the summaries.
   std::vector<MethodSummary> writeSummary(const std::string& title,
                                                 const std::vector<std::string>& notes) const;
+  /// The run completed: removes the INCOMPLETE marker.
+  void complete();
+  /// The run stopped on `error`: before its first window (and with no rows
+  /// kept from a resumed run) the files this run created are removed, else
+  /// the marker records the error.
+  void abandon(const std::string& error);
 
  private:
+  void writeMarker(const std::string& text) const;
   std::string dir_, csv_path_;
   std::ofstream csv_;
   std::int64_t resume_after_ = -1;
+  bool created_dir_ = false;
+  std::size_t appended_ = 0;  ///< windows appended by this run
+  std::vector<std::string> notes_;
 };
 
 /// One sequence run into an output folder (what `celc run` and each entry of

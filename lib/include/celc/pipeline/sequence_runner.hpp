@@ -66,12 +66,16 @@ struct RunStats {
   double seconds_total = 0.0, seconds_reading = 0.0;
   StageTimes stage_seconds;  ///< summed over windows
   std::uint64_t reader_warnings = 0;
+  WindowTail tail;           ///< the last, partial window: processed or not, and its events
 };
 
 class SequenceRunner {
  public:
   /// Opens the inputs and loads calibration, IMU and poses. Throws
-  /// IoError / ConfigError / std::runtime_error naming the file.
+  /// IoError / ConfigError / std::runtime_error naming the file, also when
+  /// the calibration's image size differs from the recording's sensor size
+  /// (where the recording states one) and when the angular velocity comes
+  /// from the gyroscope but the recording has no IMU samples.
   SequenceRunner(const RunInputs& inputs, const RunConfig& config);
   ~SequenceRunner();
 
@@ -81,7 +85,9 @@ class SequenceRunner {
   std::vector<std::string> describe() const;
 
   /// Processes the windows; sink(record) is called on the calling thread in
-  /// window order. progress(windows_done, events_done) likewise.
+  /// window order. progress(windows_done, events_done) likewise. Throws
+  /// (naming windows.max_windows_per_second) when windows by event count come
+  /// faster than that bound per second of data.
   RunStats run(int threads, const WindowFilter& filter,
                const std::function<void(const WindowRecord&)>& sink,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
