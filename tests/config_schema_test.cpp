@@ -219,6 +219,9 @@ TEST(ConfigSchema, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(apply("cluster:\n  seed: 1\n  seed: 2\n"), "b.yaml:3: key 'cluster.seed': given twice (first at line 2)");
   EXPECT_EQ(apply("? [camera]\n: 1\n"), "b.yaml:1: keys must be names, got a list");
   EXPECT_NE(apply("cluster: [1, 2\n").find("b.yaml:"), std::string::npos);
+  // Raw bytes of a hostile file never reach the message.
+  EXPECT_EQ(apply("a: \"\\\xA4\"\n"), "b.yaml:1: YAML syntax: unknown escape character: <0xA4>");
+  EXPECT_EQ(apply("cluster:\n  conf\xB5: 1\n").rfind("b.yaml:2: unknown key 'cluster.conf<0xB5>' (allowed", 0), 0u);
   EXPECT_NE(apply("cluster:\n  smoothness_deg: 200\n").find("smoothness_deg must be"), std::string::npos);
   EXPECT_NE(apply("lines:\n  min_events: 1\n").find("min_events"), std::string::npos);
   // A failed apply leaves the configuration as it was.

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -15,13 +16,30 @@
 namespace celc {
 
 namespace {
+/// One printable line: bytes outside printable ASCII (control bytes, line
+/// breaks, invalid or non-ASCII UTF-8 from a hostile file) as <0xNN>.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "<0x%02X>", c);
+      out += buf;
+    }
+  }
+  return out;
+}
+
 std::string placeText(const std::string& origin, int line, const std::string& key,
                       const std::string& what) {
   std::string s = origin;
   if (line > 0) s += ":" + std::to_string(line);
   s += ": ";
-  if (!key.empty()) s += "key '" + key + "': ";
-  return s + what;
+  if (!key.empty()) s += "key '" + printable(key) + "': ";
+  return s + printable(what);
 }
 }  // namespace
 
@@ -31,7 +49,7 @@ ConfigError::ConfigError(std::string origin_, int line_, std::string key_, const
       line(line_),
       key(std::move(key_)) {}
 
-ConfigError::ConfigError(const std::string& message) : std::runtime_error(message) {}
+ConfigError::ConfigError(const std::string& message) : std::runtime_error(printable(message)) {}
 
 void FieldVisitor::fail(const char* key, const std::string& what) {
   throw ConfigError("", 0, key, what);
@@ -290,7 +308,7 @@ class Reader final : public FieldVisitor {
       if (visited_.count(k)) continue;
       std::vector<std::string> allowed(order_.begin(), order_.end());
       throw ConfigError(origin_, lineOf(kv.first), "",
-                        "unknown key '" + join(path_, k) + "'" +
+                        "unknown key '" + printable(join(path_, k)) + "'" +
                             (allowed.empty() ? std::string() : " (allowed here: " + listOf(allowed) + ")"));
     }
   }
