@@ -3,6 +3,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace celc {
 
@@ -43,6 +44,10 @@ std::vector<Vec2> undistortPixelsCv(const CameraModel& camera, const std::vector
 UndistortLut::UndistortLut(const CameraModel& camera) {
   const std::string err = camera.validate();
   if (!err.empty()) throw std::invalid_argument("undistortion table: " + err);
+  if (camera.width > kMaxSensorSide || camera.height > kMaxSensorSide)
+    throw std::invalid_argument("undistortion table: sensor " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + " exceeds " + std::to_string(kMaxSensorSide) + "x" +
+                                std::to_string(kMaxSensorSide));
   w_ = camera.width;
   h_ = camera.height;
   std::vector<Vec2> px;

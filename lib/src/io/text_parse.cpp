@@ -17,7 +17,7 @@ LineReader::~LineReader() {
 }
 
 void LineReader::fail(const std::string& what) const {
-  throw IoError(path_ + ": line " + std::to_string(line_no_) + ": " + what);
+  throw IoError(path_ + ": line " + std::to_string(line_no_) + ": " + printable(what, 400));
 }
 
 bool LineReader::refill() {
