@@ -404,3 +404,18 @@ TEST(IoRobustness, DuplicatedSectionsInCalibrationSceneAndBatchNameBothLines) {
   EXPECT_NE(m.find("b.yaml:4"), std::string::npos) << m;
   EXPECT_NE(m.find("given twice (first at line 3)"), std::string::npos) << m;
 }
+
+// ---- found by fuzz_calibration: a YAML syntax error quoting a raw byte ------------
+
+TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
+  TempDir d;
+  writeBytes(d.file("c.yaml"), std::string("camera: \"\\\xcd\xdf\"\n"));  // an unknown escape: a byte >= 0x80
+  try {
+    (void)loadCalibration(d.file("c.yaml"));
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    expectPrintable(m);
+    EXPECT_NE(m.find("c.yaml:1"), std::string::npos) << m;
+  }
+}

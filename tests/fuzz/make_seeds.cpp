@@ -98,7 +98,8 @@ int main(int argc, char** argv) {
        std::string(1, '\1') +
            "sequences:\n  - label: a\n    path: ../data/sample_seq\n    config:\n      windows:\n        events: 30000\n"
            "  - label: b\n    path: ../data/sample_seq\n");
-  SynthConfig scene;
+  // the scene defaults have no planes: start from a shipped scene, written back by the schema
+  SynthConfig scene = loadSynthConfig(std::string(CELC_SOURCE_DIR) + "/config/scenes/davis240_rectangles.yaml");
   text(out / "config_yaml/seed_scene",
        std::string(1, '\2') + writeYaml([&](FieldVisitor& v) { describe(v, scene); }));
 

@@ -154,7 +154,9 @@ class Aedat2Reader final : public EventReader {
     std::snprintf(scale, sizeof(scale), "IMU scale %g LSB/(deg/s), %g LSB/g", h_.gyro_lsb_per_dps,
                   h_.accel_lsb_per_g);
     notes_.push_back(scale);
-    buf_.resize(std::size_t(8) << 20);
+    // 8 MB blocks, or the data of a smaller file (rounded up to whole records)
+    const std::uint64_t data = f_.size() - h_.data_start;
+    buf_.resize(std::size_t(std::min<std::uint64_t>(std::uint64_t(8) << 20, std::max<std::uint64_t>((data + 7) / 8 * 8, 4096))));
   }
   Format format() const override { return Format::Aedat2; }
 

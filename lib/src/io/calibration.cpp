@@ -72,7 +72,15 @@ void describeCalibration(FieldVisitor& v, Calibration& c) {
 Calibration loadCalibrationYaml(const std::string& path) {
   Calibration c;
   c.camera.distortion = DistortionModel::None;
-  readYamlFile(path, [&](FieldVisitor& v) { describeCalibration(v, c); });
+  try {
+    readYamlFile(path, [&](FieldVisitor& v) { describeCalibration(v, c); });
+  } catch (const ConfigError& e) {
+    // yaml-cpp's syntax messages quote the offending byte raw: one printable line
+    const std::string m = e.what();
+    const std::string clean = detail::printable(m, 600);
+    if (clean == m) throw;
+    throw ConfigError(clean);
+  }
   return c;
 }
 
