@@ -204,8 +204,15 @@ TEST(IoAedatBad, Aedat2TruncatedRecordAndHeader) {
   writeAedat2(d.file("a.aedat"), f.ev, {});
   std::string b = celc::test::readBytes(d.file("a.aedat"));
   celc::test::writeBytes(d.file("t.aedat"), b.substr(0, b.size() - 3));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat")), "t.aedat: byte " + std::to_string(b.size() - 8),
-                  "truncated event record");
+  {  // the complete records are read, the partial one is a warning naming where the file ends
+    auto r = openEventSource(d.file("t.aedat"));
+    EXPECT_EQ(readAllEvents(*r).size(), 999u);
+    EXPECT_EQ(r->warnings().truncated, 1u);
+  }
+  ReaderOptions strict;
+  strict.strict = true;
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat"), strict), "t.aedat: byte " + std::to_string(b.size() - 8),
+                  "truncated event record", "file ends at byte " + std::to_string(b.size() - 3));
   // header cut inside the preferences block
   const std::size_t prefs = b.find("#End of Preferences");
   celc::test::writeBytes(d.file("h.aedat"), b.substr(0, prefs));
@@ -251,23 +258,31 @@ TEST(IoAedatBad, Aedat31HostileAndTruncatedPackets) {
   writeAedat31(d.file("a.aedat31"), f.ev, {}, "DAVIS240C", 500);
   const std::string b = celc::test::readBytes(d.file("a.aedat31"));
   const std::size_t data = b.find("#!END-HEADER\r\n") + 14;
-  // truncated inside the second packet
+  // truncated inside the second packet: the first is read, a warning (an error with strict)
+  ReaderOptions strict;
+  strict.strict = true;
   celc::test::writeBytes(d.file("t.aedat31"), b.substr(0, b.size() - 100));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat31")),
+  {
+    auto r = openEventSource(d.file("t.aedat31"));
+    EXPECT_EQ(readAllEvents(*r).size(), 500u);
+    EXPECT_EQ(r->warnings().truncated, 1u);
+  }
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat31"), strict),
                   "byte " + std::to_string(data + 28 + 500 * 8), "beyond the end of the file");
-  // hostile capacity: 2^31-1 events of 8 bytes
+  // hostile capacity: 2^31-1 events of 8 bytes (never allocated: beyond the file)
   std::string h = b;
   const std::int32_t huge = 0x7FFFFFFF;
   std::memcpy(&h[data + 16], &huge, 4);
   celc::test::writeBytes(d.file("h.aedat31"), h);
-  EXPECT_IO_ERROR(celc::test::drain(d.file("h.aedat31")), "byte " + std::to_string(data), "beyond the end of the file");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("h.aedat31"), strict), "byte " + std::to_string(data),
+                  "beyond the end of the file");
   // capacity == number == large, but beyond the file
   std::string h2 = b;
   const std::int32_t big = 100000000;
   std::memcpy(&h2[data + 16], &big, 4);
   std::memcpy(&h2[data + 20], &big, 4);
   celc::test::writeBytes(d.file("h2.aedat31"), h2);
-  EXPECT_IO_ERROR(celc::test::drain(d.file("h2.aedat31")), "byte " + std::to_string(data), "beyond the end");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("h2.aedat31"), strict), "byte " + std::to_string(data), "beyond the end");
   // wrong event size for polarity
   std::string s = b;
   const std::int32_t nine = 9;
@@ -301,14 +316,20 @@ TEST(IoAedatBad, Aedat4HostileSizesCorruptFramesAndBombs) {
   std::memcpy(&h[14], &huge, 4);
   celc::test::writeBytes(d.file("h.aedat4"), h);
   EXPECT_IO_ERROR(openEventSource(d.file("h.aedat4")), "byte 14", "IOHeader size");
-  // hostile packet size
+  // hostile packet size: beyond the file, so read as a cut (never allocated); an error with strict
+  ReaderOptions strict;
+  strict.strict = true;
   std::string p = b;
   std::memcpy(&p[first + 4], &huge, 4);
   celc::test::writeBytes(d.file("p.aedat4"), p);
-  EXPECT_IO_ERROR(celc::test::drain(d.file("p.aedat4")), "byte " + std::to_string(first), "packet size");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("p.aedat4"), strict), "byte " + std::to_string(first), "packet of");
+  const std::int32_t negative = -5;
+  std::memcpy(&p[first + 4], &negative, 4);
+  celc::test::writeBytes(d.file("n.aedat4"), p);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("n.aedat4")), "byte " + std::to_string(first), "packet size -5");
   // truncated file
   celc::test::writeBytes(d.file("t.aedat4"), b.substr(0, b.size() - 50));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat4")), "truncated");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("t.aedat4"), strict), "truncated");
   // corrupt LZ4 frame (garbage in the first packet's payload)
   std::string c = b;
   for (std::size_t i = first + 8 + 10; i < first + 8 + 60; ++i) c[i] = char(0xA5);

@@ -49,8 +49,12 @@ TEST(IoCli, InfoBadFileIsOneLineErrorNonZeroExit) {
   EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("e.txt"), out), 0);
   EXPECT_NE(out.find("e.txt: line 2: non-numeric x"), std::string::npos) << out;
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
-  celc::test::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1 1 2 1\n");
+  celc::test::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1995 1 2 1\n");  // within input.backwards_tolerance
   ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("w.txt"), out), 0) << out;
   EXPECT_NE(out.find("timestamps backwards 1"), std::string::npos) << out;
   EXPECT_NE(run(std::string(CELC_BINARY) + " info --strict " + d.file("w.txt"), out), 0);
+  celc::test::writeBytes(d.file("b.txt"), "0.2 1 2 1\n0.1 1 2 1\n");  // beyond it: an error naming the line
+  EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("b.txt"), out), 0);
+  EXPECT_NE(out.find("b.txt: line 2: timestamp"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
 }

@@ -2,7 +2,9 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace celc {
 
@@ -43,17 +45,28 @@ std::vector<Vec2> undistortPixelsCv(const CameraModel& camera, const std::vector
 UndistortLut::UndistortLut(const CameraModel& camera) {
   const std::string err = camera.validate();
   if (!err.empty()) throw std::invalid_argument("undistortion table: " + err);
+  if (camera.width > kMaxSensorSide || camera.height > kMaxSensorSide)
+    throw std::invalid_argument("undistortion table: sensor " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + " exceeds " + std::to_string(kMaxSensorSide) + "x" +
+                                std::to_string(kMaxSensorSide));
   w_ = camera.width;
   h_ = camera.height;
+  // Row blocks: the peak memory is the table plus one block, not three copies
+  // of the table (each pixel is undistorted independently: same values).
+  xy_.resize(2 * std::size_t(w_) * std::size_t(h_));
+  constexpr int kRowsPerBlock = 64;
   std::vector<Vec2> px;
-  px.reserve(std::size_t(w_) * std::size_t(h_));
-  for (int y = 0; y < h_; ++y)
-    for (int x = 0; x < w_; ++x) px.emplace_back(double(x), double(y));
-  const auto un = undistortPixelsCv(camera, px);
-  xy_.resize(2 * un.size());
-  for (std::size_t i = 0; i < un.size(); ++i) {
-    xy_[2 * i] = un[i].x();
-    xy_[2 * i + 1] = un[i].y();
+  for (int y0 = 0; y0 < h_; y0 += kRowsPerBlock) {
+    const int y1 = std::min(h_, y0 + kRowsPerBlock);
+    px.clear();
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w_; ++x) px.emplace_back(double(x), double(y));
+    const auto un = undistortPixelsCv(camera, px);
+    const std::size_t base = 2 * std::size_t(y0) * std::size_t(w_);
+    for (std::size_t i = 0; i < un.size(); ++i) {
+      xy_[base + 2 * i] = un[i].x();
+      xy_[base + 2 * i + 1] = un[i].y();
+    }
   }
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
@@ -52,7 +53,7 @@ Aedat2Header readHeader(BinFile& f, const ReaderOptions& o) {
   Aedat2Header h;
   std::string line;
   if (!f.readLine(line, 1024) || trimEol(line) != "#!AER-DAT2.0")
-    f.fail(0, "bad magic line: expected '#!AER-DAT2.0', found '" + trimEol(line).substr(0, 40) + "'");
+    f.fail(0, "bad magic line: expected '#!AER-DAT2.0', found '" + printable(trimEol(line), 40) + "'");
   h.lines = 1;
   bool prefs_open = false;
   const std::uint64_t max_header = std::uint64_t(64) << 20;
@@ -141,18 +142,21 @@ class Aedat2Reader final : public EventReader {
     std::string chip_upper;
     for (char c : h_.chip) chip_upper.push_back(char(std::toupper(static_cast<unsigned char>(c))));
     if (chip_upper.find("DVS128") != std::string::npos)
-      f_.fail(0, "chip '" + h_.chip + "' uses the DVS128 address layout, which is not supported (DAVIS only)");
+      f_.fail(0, "chip '" + printable(h_.chip, 60) + "' uses the DVS128 address layout, which is not supported (DAVIS only)");
     if (height_ <= 0)
-      f_.fail(0, "sensor size unknown (chip '" + h_.chip +
+      f_.fail(0, "sensor size unknown (chip '" + printable(h_.chip, 60) +
                      "'): give the width and height (needed to flip y to a top-left origin)");
-    notes_.push_back("chip " + (h_.chip.empty() ? std::string("unknown") : h_.chip));
+    jump_us_ = std::int64_t(std::min(o.max_time_jump * 1e6, 2.0e9));
+    notes_.push_back("chip " + (h_.chip.empty() ? std::string("unknown") : printable(h_.chip, 60)));
     notes_.push_back("header " + std::to_string(h_.lines) + " lines, data at byte " +
                      std::to_string(h_.data_start));
     char scale[96];
     std::snprintf(scale, sizeof(scale), "IMU scale %g LSB/(deg/s), %g LSB/g", h_.gyro_lsb_per_dps,
                   h_.accel_lsb_per_g);
     notes_.push_back(scale);
-    buf_.resize(std::size_t(8) << 20);
+    // 8 MB blocks, or the data of a smaller file (rounded up to whole records)
+    const std::uint64_t data = f_.size() - h_.data_start;
+    buf_.resize(std::size_t(std::min<std::uint64_t>(std::uint64_t(8) << 20, std::max<std::uint64_t>((data + 7) / 8 * 8, 4096))));
   }
   Format format() const override { return Format::Aedat2; }
 
@@ -161,6 +165,7 @@ class Aedat2Reader final : public EventReader {
     if (max == 0) max = 1;
     batch.reserve(std::min<std::size_t>(max, std::size_t(1) << 20));
     decode(&batch, max, nullptr);
+    if (batch.size() < max) release(batch, max);
     return !batch.empty();
   }
 
@@ -195,10 +200,7 @@ class Aedat2Reader final : public EventReader {
           const std::uint32_t x = (a >> 12) & 0x3FFu;
           const std::uint32_t yr = (a >> 22) & 0x1FFu;
           if (x >= std::uint32_t(width_) || yr > h1) {
-            warn(&ReaderWarnings::outside_sensor,
-                 path_ + ": byte " + std::to_string(byteOf(p)) + ": pixel (" + std::to_string(x) +
-                     ", " + std::to_string(yr) + ") outside the " + std::to_string(width_) + "x" +
-                     std::to_string(height_) + " sensor");
+            outsideSensor(path_ + ": byte " + std::to_string(byteOf(p)), double(x), double(yr));
             continue;
           }
           Event e;
@@ -206,13 +208,7 @@ class Aedat2Reader final : public EventReader {
           e.x = float(x);
           e.y = float(h1 - yr);
           e.on = (a & 0x800u) != 0;
-          if (have_prev_ && t < prev_t_)
-            warn(&ReaderWarnings::backwards_time, path_ + ": byte " + std::to_string(byteOf(p)) +
-                                                      ": timestamp " + std::to_string(t) +
-                                                      " us before previous " + std::to_string(prev_t_));
-          prev_t_ = t;
-          have_prev_ = true;
-          events->push_back(e);
+          admit(*events, e, [&] { return path_ + ": byte " + std::to_string(byteOf(p)); });
           if (events->size() >= max) {
             pos_ += (i + 1) * 8;
             return;
@@ -250,14 +246,34 @@ class Aedat2Reader final : public EventReader {
   std::uint64_t byteOf(const unsigned char* p) const {
     return buf_start_ + std::uint64_t(p - buf_.data());
   }
+  /// 64-bit time of a raw 32-bit timestamp. A wrap-around is recognised only
+  /// when it is plausible: the timestamp continues, within max_time_jump, from
+  /// the last trusted time across 2^32 us. A raw value far from the trusted time
+  /// (one corrupt word such as 0xFFFFFFFF) is not unwrapped and does not move
+  /// the trusted time unless the next word confirms it (a gap); admit() then
+  /// reports it as an outlier or a gap.
   std::int64_t unwrap(std::uint32_t raw) {
-    if (have_raw_) {
-      const std::int64_t d = std::int64_t(raw) - std::int64_t(last_raw_);
-      if (d < -(std::int64_t(1) << 31)) wrap_ += std::int64_t(1) << 32;
+    const std::int64_t here = wrap_ + std::int64_t(raw);
+    if (!have_raw_) {
+      have_raw_ = true;
+      ref_ = here;
+      return here;
     }
-    last_raw_ = raw;
-    have_raw_ = true;
-    return wrap_ + std::int64_t(raw);
+    const std::int64_t wrapped = here + (std::int64_t(1) << 32);
+    if (std::llabs(here - ref_) <= jump_us_ || (have_cand_ && std::llabs(here - cand_) <= jump_us_)) {
+      ref_ = here;
+      have_cand_ = false;
+      return here;
+    }
+    if (std::llabs(wrapped - ref_) <= jump_us_ || (have_cand_ && std::llabs(wrapped - cand_) <= jump_us_)) {
+      wrap_ += std::int64_t(1) << 32;
+      ref_ = wrapped;
+      have_cand_ = false;
+      return wrapped;
+    }
+    cand_ = here;  // far from the trusted time: trusted only if the next word agrees
+    have_cand_ = true;
+    return here;
   }
   bool refill() {
     if (!started_) {
@@ -271,8 +287,12 @@ class Aedat2Reader final : public EventReader {
     pos_ = 0;
     if (got % 8 != 0) {
       if (f_.tell() < f_.size()) f_.fail(f_.tell(), "internal: unaligned read");
-      if (len_ == 0)
-        f_.fail(buf_start_, "truncated event record: " + std::to_string(got) + " trailing bytes (records are 8 bytes)");
+      if (len_ == 0) {  // only the partial record is left: the complete ones are read
+        warn(&ReaderWarnings::truncated,
+             path_ + ": byte " + std::to_string(buf_start_) + ": truncated event record: the file ends at byte " +
+                 std::to_string(f_.size()) + ", " + std::to_string(got) + " trailing bytes ignored (records are 8 bytes)");
+        return false;
+      }
       // leave the partial record for the next refill, which reports it
       f_.seek(buf_start_ + len_);
     }
@@ -286,10 +306,11 @@ class Aedat2Reader final : public EventReader {
   std::size_t pos_ = 0, len_ = 0;
   bool started_ = false;
   bool have_raw_ = false;
-  std::uint32_t last_raw_ = 0;
   std::int64_t wrap_ = 0;
-  bool have_prev_ = false;
-  std::int64_t prev_t_ = 0;
+  std::int64_t ref_ = 0;   ///< last trusted unwrapped time [us]
+  std::int64_t cand_ = 0;  ///< a time far from ref_, trusted when the next word agrees [us]
+  bool have_cand_ = false;
+  std::int64_t jump_us_ = 0;
   std::uint64_t special_ = 0, imu_broken_ = 0;
   int imu_next_ = 0;
   std::int64_t imu_t_ = 0;

@@ -30,7 +30,7 @@ class Aedat31Reader final : public EventReader {
       return s;
     };
     if (!f_.readLine(line, 1024) || trim(line) != "#!AER-DAT3.1")
-      f_.fail(0, "bad magic line: expected '#!AER-DAT3.1', found '" + trim(line).substr(0, 40) + "'");
+      f_.fail(0, "bad magic line: expected '#!AER-DAT3.1', found '" + printable(trim(line), 40) + "'");
     bool ended = false;
     while (f_.tell() < (std::uint64_t(16) << 20)) {
       std::uint64_t start = f_.tell();
@@ -47,7 +47,7 @@ class Aedat31Reader final : public EventReader {
         if (colon != std::string::npos) {
           std::string name = line.substr(colon + 1);
           while (!name.empty() && name.front() == ' ') name.erase(name.begin());
-          notes_.push_back("source" + line.substr(7, colon - 7) + ": " + name);
+          notes_.push_back(printable("source" + line.substr(7, colon - 7) + ": " + name, 120));
           int w, h;
           if (width_ == 0 && sensorSizeFromChip(name, w, h)) width_ = w, height_ = h;
         }
@@ -64,6 +64,7 @@ class Aedat31Reader final : public EventReader {
     batch.clear();
     if (max == 0) max = 1;
     decode(&batch, max, nullptr);
+    if (batch.size() < max) release(batch, max);
     return !batch.empty();
   }
 
@@ -92,23 +93,15 @@ class Aedat31Reader final : public EventReader {
           const std::uint32_t x = (d >> 17) & 0x7FFFu;
           const std::uint64_t byte = pkt_byte_ + cur_ * 8;
           if ((width_ > 0 && x >= std::uint32_t(width_)) || (height_ > 0 && y >= std::uint32_t(height_))) {
-            warn(&ReaderWarnings::outside_sensor, path_ + ": byte " + std::to_string(byte) + ": pixel (" +
-                                                      std::to_string(x) + ", " + std::to_string(y) +
-                                                      ") outside the sensor");
+            outsideSensor(path_ + ": byte " + std::to_string(byte), double(x), double(y));
             continue;
           }
-          if (have_prev_ && t < prev_t_)
-            warn(&ReaderWarnings::backwards_time, path_ + ": byte " + std::to_string(byte) +
-                                                      ": timestamp " + std::to_string(t) +
-                                                      " us before previous " + std::to_string(prev_t_));
-          prev_t_ = t;
-          have_prev_ = true;
           Event e;
           e.t = double(t) * 1e-6;
           e.x = float(x);
           e.y = float(y);
           e.on = (d & 2u) != 0;
-          events->push_back(e);
+          admit(*events, e, [&] { return path_ + ": byte " + std::to_string(byte); });
           if (events->size() >= max) {
             ++cur_;
             return;
@@ -127,6 +120,13 @@ class Aedat31Reader final : public EventReader {
     const std::uint64_t at = f_.tell();
     if (at == f_.size()) return false;
     unsigned char h[28];
+    if (f_.size() - at < 28) {
+      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) +
+                                           ": packet header cut by the end of the file at byte " +
+                                           std::to_string(f_.size()) + ": truncated, ignored");
+      f_.seek(f_.size());
+      return false;
+    }
     f_.readExact(h, 28, "packet header");
     const auto type = loadLE<std::int16_t>(h);
     const auto source = loadLE<std::int16_t>(h + 2);
@@ -135,13 +135,19 @@ class Aedat31Reader final : public EventReader {
     const auto overflow = loadLE<std::int32_t>(h + 12);
     const auto capacity = loadLE<std::int32_t>(h + 16);
     const auto number = loadLE<std::int32_t>(h + 20);
+    // 64-bit arithmetic: every field may hold INT32_MAX
     if (size <= 0 || capacity < 0 || number < 0 || number > capacity || overflow < 0 || tsoff < 0 ||
-        tsoff + 4 > size)
+        std::int64_t(tsoff) + 4 > std::int64_t(size))
       f_.fail(at, "invalid packet header (type " + std::to_string(type) + ", size " + std::to_string(size) +
                       ", capacity " + std::to_string(capacity) + ", number " + std::to_string(number) + ")");
     const std::uint64_t bytes = std::uint64_t(size) * std::uint64_t(capacity);
-    if (bytes > f_.size() - f_.tell())
-      f_.fail(at, "packet of " + std::to_string(bytes) + " bytes extends beyond the end of the file: truncated");
+    if (bytes > f_.size() - f_.tell()) {  // the last packet cut by the end of the file: the complete ones are read
+      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) + ": packet of " +
+                                           std::to_string(bytes) + " bytes extends beyond the end of the file at byte " +
+                                           std::to_string(f_.size()) + ": truncated, ignored");
+      f_.seek(f_.size());
+      return false;
+    }
     if (bytes > options_.max_packet_bytes)
       f_.fail(at, "packet of " + std::to_string(bytes) + " bytes exceeds the limit");
     const std::uint64_t payload = f_.tell();
@@ -195,8 +201,6 @@ class Aedat31Reader final : public EventReader {
   std::uint64_t pkt_byte_ = 0;
   std::int64_t overflow_ = 0;
   std::size_t cur_ = 0, count_ = 0;
-  bool have_prev_ = false;
-  std::int64_t prev_t_ = 0;
 };
 
 }  // namespace

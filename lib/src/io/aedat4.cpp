@@ -114,13 +114,25 @@ class Aedat4Reader final : public EventReader {
     }
     if (compression_ < 0 || compression_ > 4)
       f_.fail(hdr_at, "unknown compression " + std::to_string(compression_));
-    if (table_pos_ >= 0 && (std::uint64_t(table_pos_) < data_start_ || std::uint64_t(table_pos_) > f_.size()))
+    if (table_pos_ >= 0 && std::uint64_t(table_pos_) < data_start_)
       f_.fail(hdr_at, "data table position " + std::to_string(table_pos_) + " outside the file");
+    if (table_pos_ >= 0 && std::uint64_t(table_pos_) >= f_.size()) {
+      // the file was cut before its data table: read the packets that are there
+      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(hdr_at) + ": the data table at byte " +
+                                           std::to_string(table_pos_) + " is beyond the end of the file at byte " +
+                                           std::to_string(f_.size()) + ": truncated, read without the table");
+      table_pos_ = -1;
+    }
     streams_ = parseStreams(xml);
+    for (const auto& st : streams_)
+      if (st.width > kMaxReaderSensorSide || st.height > kMaxReaderSensorSide)
+        f_.fail(hdr_at, "stream " + std::to_string(st.id) + " declares a " + std::to_string(st.width) + "x" +
+                            std::to_string(st.height) + " sensor (at most " + std::to_string(kMaxReaderSensorSide) +
+                            "x" + std::to_string(kMaxReaderSensorSide) + ")");
     static const char* cnames[] = {"none", "LZ4", "LZ4 high", "Zstd", "Zstd high"};
     notes_.push_back(std::string("compression ") + cnames[compression_]);
     for (const auto& s : streams_) {
-      notes_.push_back("stream " + std::to_string(s.id) + " " + s.type +
+      notes_.push_back("stream " + std::to_string(s.id) + " " + printable(s.type, 16) +
                        (s.width ? " " + std::to_string(s.width) + "x" + std::to_string(s.height) : ""));
       if (s.type == "EVTS" && event_stream_ < 0) {
         event_stream_ = s.id;
@@ -143,6 +155,7 @@ class Aedat4Reader final : public EventReader {
       if (cur_ == count_ && !nextPacket(true, nullptr)) break;
       drain(batch, max);
     }
+    if (batch.size() < max) release(batch, max);
     return !batch.empty();
   }
 
@@ -173,6 +186,14 @@ class Aedat4Reader final : public EventReader {
   }
 
  private:
+  /// The file ends inside the packet at `at`: the complete packets before it are
+  /// read; a counted warning (an error with `strict`) names both bytes.
+  void truncatedAt(std::uint64_t at, const std::string& what) {
+    warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) + ": " + what +
+                                         " cut by the end of the file at byte " + std::to_string(f_.size()) +
+                                         ": truncated, ignored");
+    f_.seek(f_.size());
+  }
   std::uint64_t end_of_packets() const { return table_pos_ >= 0 ? std::uint64_t(table_pos_) : f_.size(); }
 
   void drain(std::vector<Event>& batch, std::size_t max) {
@@ -182,24 +203,19 @@ class Aedat4Reader final : public EventReader {
       const auto x = loadLE<std::int16_t>(p + 8);
       const auto y = loadLE<std::int16_t>(p + 10);
       const bool on = p[12] != 0;
+      auto where = [&] {
+        return path_ + ": byte " + std::to_string(pkt_byte_) + " (packet), event " + std::to_string(cur_);
+      };
       if (x < 0 || y < 0 || (width_ > 0 && x >= width_) || (height_ > 0 && y >= height_)) {
-        warn(&ReaderWarnings::outside_sensor,
-             path_ + ": packet at byte " + std::to_string(pkt_byte_) + ", event " + std::to_string(cur_) +
-                 ": pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the sensor");
+        outsideSensor(where(), double(x), double(y));
         continue;
       }
-      if (have_prev_ && t < prev_t_)
-        warn(&ReaderWarnings::backwards_time,
-             path_ + ": packet at byte " + std::to_string(pkt_byte_) + ", event " + std::to_string(cur_) +
-                 ": timestamp " + std::to_string(t) + " us before previous " + std::to_string(prev_t_));
-      prev_t_ = t;
-      have_prev_ = true;
       Event e;
       e.t = double(t) * 1e-6;
       e.x = float(x);
       e.y = float(y);
       e.on = on;
-      batch.push_back(e);
+      admit(batch, e, where);
     }
   }
 
@@ -283,12 +299,22 @@ class Aedat4Reader final : public EventReader {
       const std::uint64_t at = f_.tell();
       if (at >= end_of_packets()) return false;
       unsigned char h[8];
+      if (end_of_packets() - at < 8) {
+        truncatedAt(at, "packet header");
+        return false;
+      }
       f_.readExact(h, 8, "packet header");
       const auto stream = loadLE<std::int32_t>(h);
       const auto size = loadLE<std::int32_t>(h + 4);
-      if (size <= 0 || std::uint64_t(size) > end_of_packets() - f_.tell())
-        f_.fail(at, "packet size " + std::to_string(size) + " out of range (" +
-                        std::to_string(end_of_packets() - f_.tell()) + " bytes left): truncated or corrupt");
+      if (size <= 0)
+        f_.fail(at, "packet size " + std::to_string(size) + " out of range: corrupt");
+      if (std::uint64_t(size) > end_of_packets() - f_.tell()) {
+        if (table_pos_ >= 0)  // a packet overlapping the data table is corrupt, not cut
+          f_.fail(at, "packet size " + std::to_string(size) + " out of range (" +
+                          std::to_string(end_of_packets() - f_.tell()) + " bytes left before the data table): corrupt");
+        truncatedAt(at, "packet of " + std::to_string(size) + " bytes");
+        return false;
+      }
       if (std::size_t(size) > options_.max_packet_bytes)
         f_.fail(at, "packet size " + std::to_string(size) + " exceeds the limit");
       const bool is_events = stream == event_stream_ && want_events;
@@ -391,8 +417,6 @@ class Aedat4Reader final : public EventReader {
   const unsigned char* events_ = nullptr;
   std::size_t cur_ = 0, count_ = 0;
   std::uint64_t pkt_byte_ = 0;
-  bool have_prev_ = false;
-  std::int64_t prev_t_ = 0;
   bool table_loaded_ = false;
   std::vector<TableEntry> table_;
 };

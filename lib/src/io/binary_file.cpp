@@ -19,7 +19,7 @@ BinFile::~BinFile() {
 }
 
 void BinFile::fail(std::uint64_t byte, const std::string& what) const {
-  throw IoError(path_ + ": byte " + std::to_string(byte) + ": " + what);
+  throw IoError(path_ + ": byte " + std::to_string(byte) + ": " + printable(what, 400));
 }
 
 void BinFile::seek(std::uint64_t pos) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "celc/core/yaml.hpp"
+#include "celc/geometry/undistort.hpp"
 #include "io/text_parse.hpp"
 
 namespace celc {
@@ -29,6 +30,11 @@ void describeCalibration(FieldVisitor& v, Calibration& c) {
   v.section({"camera", "", "intrinsics"}, [&](FieldVisitor& s) {
     for (const char* k : {"width", "height", "fx", "fy", "cx", "cy"}) s.require(k);
     describe(s, c.camera);
+    // bounded before anything is sized from it (the undistortion table)
+    if (c.camera.width > kMaxSensorSide)
+      s.fail("width", "sensor width " + std::to_string(c.camera.width) + " exceeds " + std::to_string(kMaxSensorSide));
+    if (c.camera.height > kMaxSensorSide)
+      s.fail("height", "sensor height " + std::to_string(c.camera.height) + " exceeds " + std::to_string(kMaxSensorSide));
     const auto& k = c.camera.coeffs;
     if (c.camera.distortion == DistortionModel::None && (k[0] != 0 || k[1] != 0 || k[2] != 0 || k[3] != 0 || k[4] != 0))
       s.fail("distortion", "non-zero coefficients with distortion_model none");
@@ -66,9 +72,19 @@ void describeCalibration(FieldVisitor& v, Calibration& c) {
 Calibration loadCalibrationYaml(const std::string& path) {
   Calibration c;
   c.camera.distortion = DistortionModel::None;
-  readYamlFile(path, [&](FieldVisitor& v) { describeCalibration(v, c); });
+  try {
+    readYamlFile(path, [&](FieldVisitor& v) { describeCalibration(v, c); });
+  } catch (const ConfigError& e) {
+    // yaml-cpp's syntax messages quote the offending byte raw: one printable line
+    const std::string m = e.what();
+    const std::string clean = detail::printable(m, 600);
+    if (clean == m) throw;
+    throw ConfigError(clean);
+  }
   return c;
 }
+
+static_assert(kMaxReaderSensorSide == kMaxSensorSide, "the readers and the undistortion table share one bound");
 
 Calibration loadCalibTxt(const std::string& path, int width, int height) {
   detail::LineReader lr(path);

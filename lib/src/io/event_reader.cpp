@@ -36,6 +36,15 @@ std::string toString(ImuColumns columns) {
   return "auto";
 }
 
+std::string toString(BackwardsPolicy policy) {
+  switch (policy) {
+    case BackwardsPolicy::Error: return "error";
+    case BackwardsPolicy::Drop: return "drop";
+    case BackwardsPolicy::Sort: return "sort";
+  }
+  return "error";
+}
+
 ImuColumns parseImuColumns(const std::string& name) {
   if (name == "auto") return ImuColumns::Auto;
   if (name == "rpg" || name == "accel_first") return ImuColumns::RpgAccelFirst;
@@ -46,17 +55,183 @@ ImuColumns parseImuColumns(const std::string& name) {
 std::string ReaderOptions::validate() const {
   if (width < 0 || height < 0) return "width and height must be >= 0";
   if ((width == 0) != (height == 0)) return "give both width and height, or neither";
-  if (width > 65535 || height > 65535) return "width and height must be <= 65535";
+  if (width > kMaxReaderSensorSide || height > kMaxReaderSensorSide)
+    return "width and height must be <= " + std::to_string(kMaxReaderSensorSide);
   if (!(text_time_scale > 0.0) || !std::isfinite(text_time_scale)) return "text_time_scale must be > 0";
   if (max_packet_bytes < 1024) return "max_packet_bytes must be >= 1024";
   if (aedat_source < -1 || aedat_source > 32767) return "aedat_source must be -1 or a source id";
+  if (!(max_time_jump > 0.0) || !std::isfinite(max_time_jump)) return "max_time_jump must be > 0 and finite";
+  if (!(backwards_tolerance >= 0.0) || !std::isfinite(backwards_tolerance))
+    return "backwards_tolerance must be >= 0 and finite";
+  if (!(max_outside_share >= 0.0 && max_outside_share <= 1.0)) return "max_outside_share must be in [0, 1]";
   return {};
 }
 
+namespace detail {
+std::size_t firstNonTextByte(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto u = static_cast<unsigned char>(s[i]);
+    if (u < 0x80) {
+      if ((u < 0x20 && u != '\t' && u != '\n' && u != '\r' && u != '\f') || u == 0x7F) return i;
+      ++i;
+      continue;
+    }
+    // UTF-8 sequence: lead byte then 1..3 continuation bytes (a cut at the end is fine)
+    const std::size_t n = (u & 0xE0) == 0xC0 ? 1 : (u & 0xF0) == 0xE0 ? 2 : (u & 0xF8) == 0xF0 ? 3 : 0;
+    if (n == 0 || u == 0xC0 || u == 0xC1 || u > 0xF4) return i;
+    for (std::size_t k = 1; k <= n; ++k) {
+      if (i + k >= s.size()) return std::string::npos;
+      if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return i;
+    }
+    i += n + 1;
+  }
+  return std::string::npos;
+}
+
+std::string printable(const std::string& s, std::size_t max) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  std::size_t shown = 0;
+  for (const char ch : s) {
+    if (shown == max) {
+      out += "...";
+      break;
+    }
+    const auto u = static_cast<unsigned char>(ch);
+    if (u >= 0x20 && u < 0x7F) {
+      out.push_back(ch);
+    } else {
+      out += "\\x";
+      out.push_back(hex[u >> 4]);
+      out.push_back(hex[u & 15]);
+    }
+    ++shown;
+  }
+  return out;
+}
+}  // namespace detail
+
 void EventReader::warn(std::uint64_t ReaderWarnings::*counter, const std::string& message) {
-  if (options_.strict) throw IoError(message + " (strict mode)");
+  const std::string m = detail::printable(message, 400);
+  if (options_.strict) throw IoError(m + " (strict mode)");
   ++(warnings_.*counter);
-  if (warnings_.messages.size() < 20) warnings_.messages.push_back(message);
+  if (warnings_.messages.size() < 20) warnings_.messages.push_back(m);
+}
+
+void EventReader::outsideSensor(const std::string& where, double x, double y) {
+  char px[96];
+  std::snprintf(px, sizeof px, "pixel (%g, %g) outside the %dx%d sensor", x, y, width_, height_);
+  warn(&ReaderWarnings::outside_sensor, where + ": " + px);
+  const std::uint64_t n = warnings_.outside_sensor;
+  const std::uint64_t seen = admitted_ + n;
+  if (n >= 100 && double(n) > options_.max_outside_share * double(seen)) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg,
+                  ": %llu of %llu events so far have pixels outside the %dx%d sensor (more than "
+                  "input.max_outside_share = %g): wrong sensor size? (input.width / input.height)",
+                  static_cast<unsigned long long>(n), static_cast<unsigned long long>(seen), width_, height_,
+                  options_.max_outside_share);
+    throw IoError(where + msg);
+  }
+}
+
+void EventReader::accept(std::vector<Event>& out, const Event& e) {
+  prev_t_ = e.t;
+  have_prev_ = true;
+  if (options_.backwards != BackwardsPolicy::Sort) {
+    out.push_back(e);
+    return;
+  }
+  reorder_.push(e);
+  if (reorder_.size() > kSortBufferEvents) {
+    const Event first = reorder_.top();
+    reorder_.pop();
+    if (emitted_any_ && first.t < last_emitted_) {
+      warn(&ReaderWarnings::backwards_time,
+           path_ + ": an event at " + std::to_string(first.t) + " s arrived more than " +
+               std::to_string(kSortBufferEvents) + " events late for the sort buffer: dropped");
+      return;
+    }
+    emitted_any_ = true;
+    last_emitted_ = first.t;
+    out.push_back(first);
+  }
+}
+
+void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::string& where) {
+  char msg[320];
+  if (!have_prev_) {
+    accept(out, e);
+    return;
+  }
+  const double J = options_.max_time_jump;
+  if (holding_) {
+    holding_ = false;
+    if (std::abs(e.t - held_.t) <= J) {  // the next event confirms the jump: a gap in the recording
+      std::snprintf(msg, sizeof msg, ": timestamp %.6f s follows %.6f s: a gap of %.6g s (more than input.max_time_jump = %g s)",
+                    held_.t, prev_t_, held_.t - prev_t_, J);
+      warn(&ReaderWarnings::time_jumps, held_where_ + msg);
+      accept(out, held_);
+    } else {
+      std::snprintf(msg, sizeof msg,
+                    ": timestamp %.6g s jumps %.6g s ahead of the previous event and the next comes back: "
+                    "outlier dropped (input.max_time_jump = %g s)",
+                    held_.t, held_.t - prev_t_, J);
+      warn(&ReaderWarnings::time_jumps, held_where_ + msg);
+    }
+  }
+  const double d = e.t - prev_t_;
+  if (d > J) {  // hold it until the next event says whether it is an outlier or a gap
+    holding_ = true;
+    held_ = e;
+    held_where_ = where;
+    return;
+  }
+  if (d < 0.0) {
+    const bool beyond = -d > options_.backwards_tolerance;
+    if (!beyond || options_.backwards == BackwardsPolicy::Sort) {
+      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the previous event (%s)", e.t, -d,
+                    beyond ? "sorted" : "kept");
+      warn(&ReaderWarnings::backwards_time, where + msg);
+      if (beyond) {  // sort mode: keep the running maximum as the reference
+        const double keep = prev_t_;
+        accept(out, e);
+        prev_t_ = keep;
+        return;
+      }
+      accept(out, e);
+      return;
+    }
+    if (options_.backwards == BackwardsPolicy::Drop) {
+      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the previous event: dropped", e.t, -d);
+      warn(&ReaderWarnings::backwards_time, where + msg);
+      return;
+    }
+    std::snprintf(msg, sizeof msg,
+                  ": timestamp %.6f s is %.6g s before the previous event (more than input.backwards_tolerance = "
+                  "%g s): the events are not time-ordered (input.backwards: drop or sort)",
+                  e.t, -d, options_.backwards_tolerance);
+    throw IoError(where + msg);
+  }
+  accept(out, e);
+}
+
+void EventReader::release(std::vector<Event>& out, std::size_t max) {
+  if (holding_) {  // a jump at the very end: nothing confirms or refutes it; keep it, reported
+    holding_ = false;
+    char msg[200];
+    std::snprintf(msg, sizeof msg, ": the last event jumps %.6g s ahead (more than input.max_time_jump = %g s)",
+                  held_.t - prev_t_, options_.max_time_jump);
+    warn(&ReaderWarnings::time_jumps, held_where_ + msg);
+    accept(out, held_);
+  }
+  while (!reorder_.empty() && out.size() < max) {
+    out.push_back(reorder_.top());
+    emitted_any_ = true;
+    last_emitted_ = reorder_.top().t;
+    reorder_.pop();
+  }
 }
 
 namespace {
@@ -78,18 +253,26 @@ Format detectFormat(const std::string& path) {
   }
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw IoError(path + ": cannot open: " + std::strerror(errno));
-  char buf[16] = {0};
-  const std::size_t got = std::fread(buf, 1, sizeof(buf), f);
+  // The header decides: the AEDAT magic line, else the first 4 KB must look like
+  // text (no control bytes but tab / CR / LF / FF, valid UTF-8).
+  std::string head(4096, '\0');
+  head.resize(std::fread(&head[0], 1, head.size(), f));
   std::fclose(f);
-  const std::string head(buf, got);
   if (head.rfind("#!AER-DAT2.0", 0) == 0) return Format::Aedat2;
   if (head.rfind("#!AER-DAT3.1", 0) == 0) return Format::Aedat31;
   if (head.rfind("#!AER-DAT4.0", 0) == 0) return Format::Aedat4;
-  if (head.rfind("#!AER-DAT", 0) == 0)
-    throw IoError(path + ": byte 0: unsupported AEDAT version '" + head.substr(0, 12) + "'");
-  // a binary file that is not AEDAT: refuse instead of parsing garbage as text
-  for (std::size_t i = 0; i < got; ++i)
-    if (buf[i] == 0) throw IoError(path + ": byte " + std::to_string(i) + ": binary data without an AEDAT magic line");
+  if (head.rfind("#!AER-DAT", 0) == 0) {
+    const std::size_t eol = head.find_first_of("\r\n");
+    throw IoError(path + ": byte 0: unsupported AEDAT version '" +
+                  detail::printable(head.substr(0, std::min<std::size_t>(eol, 24)), 24) + "'");
+  }
+  const std::size_t bad = detail::firstNonTextByte(head);
+  if (bad != std::string::npos) {
+    char b[8];
+    std::snprintf(b, sizeof b, "0x%02X", unsigned(static_cast<unsigned char>(head[bad])));
+    throw IoError(path + ": byte " + std::to_string(bad) + ": binary data (byte " + b +
+                  ") without an AEDAT magic line: not an events text file");
+  }
   return Format::Text;
 }
 

@@ -15,6 +15,14 @@ void describe(FieldVisitor& v, ReaderOptions& o) {
   v.field({"strict", "", "every counted warning is an error"}, o.strict);
   v.field({"max_packet_bytes", "bytes", "largest AEDAT packet decoded"}, o.max_packet_bytes);
   v.field({"aedat_source", "", "AEDAT 3.1: only this source id (-1 = all)"}, o.aedat_source);
+  v.field({"max_time_jump", "s", "larger forward steps between events: one outlier dropped, or a gap (reported)"},
+          o.max_time_jump);
+  v.field({"backwards_tolerance", "s", "timestamp decreases up to this are counted and kept"},
+          o.backwards_tolerance);
+  v.enumeration({"backwards", "", "larger decreases: error, drop the event, or sort (bounded buffer)"},
+                o.backwards, {BackwardsPolicy::Error, BackwardsPolicy::Drop, BackwardsPolicy::Sort});
+  v.field({"max_outside_share", "-", "share of events outside the sensor that stops the reading"},
+          o.max_outside_share);
 }
 
 void describe(FieldVisitor& v, WindowOptions& o) {

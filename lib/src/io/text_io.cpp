@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "io/text_parse.hpp"
 
@@ -169,23 +170,16 @@ class TextEventReader final : public EventReader {
       e.x = float(xd);
       e.y = float(yd);
       e.on = pi == 1;
-      if (has_prev_ && t < prev_t_)
-        warn(&ReaderWarnings::backwards_time,
-             path_ + ": line " + std::to_string(lr_.lineNumber()) + ": timestamp " +
-                 std::to_string(t) + " before previous " + std::to_string(prev_t_));
-      prev_t_ = t;
-      has_prev_ = true;
+      if (options_.text_time_scale == 1.0 && scale_checked_ < kScaleProbe) checkTimeScale(t);
       // without a sensor size, 65536 bounds any sensor (and keeps integer conversions defined)
       const double wmax = width_ > 0 ? width_ : 65536.0, hmax = height_ > 0 ? height_ : 65536.0;
       if (!(xd >= 0 && yd >= 0 && xd < wmax && yd < hmax)) {
-        warn(&ReaderWarnings::outside_sensor,
-             path_ + ": line " + std::to_string(lr_.lineNumber()) + ": pixel (" +
-                 std::to_string(xd) + ", " + std::to_string(yd) + ") outside the " +
-                 std::to_string(width_) + "x" + std::to_string(height_) + " sensor");
+        outsideSensor(where(), xd, yd);
         continue;
       }
-      batch.push_back(e);
+      admit(batch, e, [this] { return where(); });
     }
+    if (batch.size() < max) release(batch, max);
     return !batch.empty();
   }
 
@@ -195,11 +189,31 @@ class TextEventReader final : public EventReader {
   }
 
  private:
+  static constexpr int kScaleProbe = 64;
+  std::string where() const { return path_ + ": line " + std::to_string(lr_.lineNumber()); }
+  /// Seconds are what the file should hold: the first kScaleProbe timestamps all
+  /// whole numbers at least 1 apart on average are microseconds (or
+  /// nanoseconds) read as seconds, an error that names input.time_scale.
+  void checkTimeScale(double t) {
+    if (scale_checked_ == 0) scale_first_ = t;
+    scale_integers_ = scale_integers_ && t == std::floor(t);
+    if (++scale_checked_ < kScaleProbe || !scale_integers_) return;
+    const double step = (t - scale_first_) / double(kScaleProbe - 1);
+    if (step >= 1.0) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "the first %d timestamps are whole numbers %.4g apart on average: microseconds or "
+                    "nanoseconds read as seconds? set input.time_scale (--time-scale 1e-6 for us, 1e-9 for ns)",
+                    kScaleProbe, step);
+      lr_.fail(msg);
+    }
+  }
   LineReader lr_;
   std::string imu_path_;
   Layout layout_;
-  double prev_t_ = 0.0;
-  bool has_prev_ = false;
+  int scale_checked_ = 0;
+  bool scale_integers_ = true;
+  double scale_first_ = 0.0;
 };
 
 }  // namespace

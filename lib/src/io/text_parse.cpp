@@ -3,12 +3,20 @@
 #include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <sys/stat.h>
+
+#include <algorithm>
 
 namespace celc::detail {
 
 LineReader::LineReader(const std::string& path, std::size_t buffer_bytes) : path_(path) {
   file_ = std::fopen(path.c_str(), "rb");
   if (!file_) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  // A small file needs no 4 MB block: size + 1 holds all of it (so the
+  // line-length limit is never reached earlier than with the full block).
+  struct stat st {};
+  if (::fstat(::fileno(file_), &st) == 0 && S_ISREG(st.st_mode))
+    buffer_bytes = std::min<std::size_t>(buffer_bytes, std::max<std::size_t>(std::size_t(st.st_size) + 1, 65536));
   buf_.resize(buffer_bytes);
 }
 
@@ -17,7 +25,7 @@ LineReader::~LineReader() {
 }
 
 void LineReader::fail(const std::string& what) const {
-  throw IoError(path_ + ": line " + std::to_string(line_no_) + ": " + what);
+  throw IoError(path_ + ": line " + std::to_string(line_no_) + ": " + printable(what, 400));
 }
 
 bool LineReader::refill() {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -69,6 +71,30 @@ bool WindowSource::pull() {
   }
 }
 
+void WindowSource::skipGap(double t_next, double S, double step) {
+  const double t0 = next_t0_ + double(step_index_) * step;
+  if (t_next < t0 + S) return;  // the next event is in this window: no gap
+  const double gap = t_next - t0;
+  const double empty = std::floor((t_next - t0 - S) / step) + 1.0;  // windows that end before t_next
+  if (empty <= double(kMaxEmptyWindows) && gap <= reader_.options().max_time_jump) return;
+  // a long gap (or an outlier the reader let through): jump to the window that
+  // holds t_next instead of producing every empty window in between
+  if (empty < 9.0e15 && double(step_index_) + empty < 9.0e15) {
+    step_index_ += std::uint64_t(empty);
+  } else {  // too many steps for exact arithmetic: restart the time grid at the event
+    next_t0_ = t_next;
+    step_index_ = 0;
+  }
+  ++gaps_;
+  skipped_ += empty < 1.8e19 ? std::uint64_t(empty) : std::numeric_limits<std::uint64_t>::max() / 2;
+  if (reports_.size() < 20) {
+    char msg[240];
+    std::snprintf(msg, sizeof msg, "%s: no events in [%.6f, %.6f) s: %.4g empty windows of %g s skipped",
+                  reader_.path().c_str(), t0, t_next, empty, S);
+    reports_.push_back(msg);
+  }
+}
+
 bool WindowSource::next(EventWindow& w) {
   w.events.clear();
   w.index = index_;
@@ -96,12 +122,18 @@ bool WindowSource::next(EventWindow& w) {
   }
   // by duration
   const double S = o_.seconds_per_window;
+  const double step = (1.0 - o_.overlap) * S;
   if (index_ == 0 && buf_.empty()) {
     if (!pull()) return false;
   }
   if (index_ == 0) next_t0_ = std::isfinite(o_.t_start) ? o_.t_start : buf_.front().t;
-  // t0 from the origin and the index (no accumulated rounding)
-  const double t0 = next_t0_ + double(index_) * (1.0 - o_.overlap) * S, t1 = t0 + S;
+  if (buf_.empty()) pull();
+  if (!buf_.empty()) skipGap(buf_.front().t, S, step);
+  // t0 from the origin and the step count (no accumulated rounding)
+  const double t0 = next_t0_ + double(step_index_) * step, t1 = t0 + S;
+  if (!(t1 > t0) || !(next_t0_ + double(step_index_ + 1) * step > t0))
+    throw IoError(reader_.path() + ": time " + std::to_string(t0) + " s is too large for windows of " +
+                  std::to_string(S) + " s (t0 + S == t0 in double precision)");
   // make sure the buffer reaches t1 (or the end)
   while ((buf_.empty() || buf_.back().t < t1) && pull()) {
   }
@@ -123,8 +155,9 @@ bool WindowSource::next(EventWindow& w) {
   w.t0 = t0;
   w.t1 = t1;
   covered_until_ = t1;
-  const double following = next_t0_ + double(index_ + 1) * (1.0 - o_.overlap) * S;
+  const double following = next_t0_ + double(step_index_ + 1) * step;
   while (!buf_.empty() && buf_.front().t < following) buf_.pop_front();
+  ++step_index_;
   ++index_;
   return true;
 }

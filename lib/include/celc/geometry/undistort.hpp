@@ -10,11 +10,16 @@
 
 namespace celc {
 
+/// Largest sensor side [px] the table is built for: 4096 x 4096 pixels take
+/// 256 MB of table, so larger sizes (from a hostile calibration or file
+/// header) are refused before anything is allocated.
+inline constexpr int kMaxSensorSide = 4096;
+
 class UndistortLut {
  public:
   UndistortLut() = default;
   /// Builds the table for every pixel of camera (width x height). Throws
-  /// std::invalid_argument when the camera is invalid.
+  /// std::invalid_argument when the camera is invalid or a side exceeds kMaxSensorSide.
   explicit UndistortLut(const CameraModel& camera);
   int width() const { return w_; }
   int height() const { return h_; }

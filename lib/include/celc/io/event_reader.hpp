@@ -14,12 +14,19 @@
 ///  - errors (an IoError naming the file and the line or byte offset): bad magic,
 ///    truncated binary records, sizes or offsets out of range, corrupt
 ///    compression or flatbuffers, non-numeric text fields, wrong column counts;
-///  - counted warnings: timestamps going backwards (event kept), pixels outside
-///    the sensor (event dropped), unknown AEDAT event types (skipped).
-///    With ReaderOptions::strict, a warning is an error too.
+///  - counted warnings: timestamps going backwards within a tolerance (event
+///    kept), single outlier timestamps (dropped) and gaps (kept), pixels outside
+///    the sensor (event dropped; an error past a share), unknown AEDAT event
+///    types (skipped), a truncated final packet or record (the complete ones
+///    are read). With ReaderOptions::strict, a warning is an error too.
+///  - time sanity (every format, the same rules; see EventReader::admit):
+///    decreases beyond ReaderOptions::backwards_tolerance are an error (or are
+///    dropped / sorted when asked), forward jumps beyond max_time_jump are an
+///    outlier when the next event comes back, a gap when it does not.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <queue>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -47,6 +54,22 @@ enum class ImuColumns {
 ImuColumns parseImuColumns(const std::string& name);  ///< "auto" | "rpg" | "gyro_first"
 std::string toString(ImuColumns columns);             ///< "auto" | "rpg" | "gyro_first"
 
+/// What a reader does with an event whose timestamp is more than
+/// ReaderOptions::backwards_tolerance before the previous event's.
+enum class BackwardsPolicy {
+  Error,  ///< stop with an error naming the line / byte (the default: the file is not time-ordered)
+  Drop,   ///< drop the event, counted as a warning
+  Sort,   ///< reorder through a buffer of kSortBufferEvents events, counted as a warning
+};
+std::string toString(BackwardsPolicy policy);  ///< "error" | "drop" | "sort"
+
+/// Largest sensor side [px] any reader accepts from a file or an option: the
+/// undistortion table holds one entry per pixel, so a hostile header must not
+/// size it (celc::kMaxSensorSide in geometry/undistort.hpp is the same bound).
+inline constexpr int kMaxReaderSensorSide = 4096;
+/// Events held by BackwardsPolicy::Sort (a bounded reorder buffer).
+inline constexpr std::size_t kSortBufferEvents = std::size_t(1) << 20;
+
 struct ReaderOptions {
   /// Sensor size [px] when the file does not say (text formats); 0 = unknown:
   /// no pixel-range check. A non-zero value overrides the size in the file.
@@ -58,9 +81,20 @@ struct ReaderOptions {
   /// Turn every counted warning into an error.
   bool strict = false;
   /// Upper bound of one decoded AEDAT packet [bytes]: a hostile size beyond it is an error.
-  std::size_t max_packet_bytes = std::size_t(256) << 20;
+  std::size_t max_packet_bytes = std::size_t(64) << 20;
   /// AEDAT 3.1: read only this source id (-1 = every source, merged in file order).
   int aedat_source = -1;
+  /// Largest plausible forward step between consecutive events [s]. One event
+  /// beyond it followed by one back near the previous time is an outlier
+  /// (dropped, counted); a jump the next event confirms is a gap (kept, counted).
+  double max_time_jump = 10.0;
+  /// Decreases of the timestamp up to this [s] are counted and the event kept;
+  /// larger ones follow `backwards`.
+  double backwards_tolerance = 1e-3;
+  BackwardsPolicy backwards = BackwardsPolicy::Error;
+  /// Share of events with a pixel outside the sensor beyond which reading stops
+  /// with an error (checked once 100 such events are seen): a wrong sensor size.
+  double max_outside_share = 0.05;
   /// Empty when valid, else what is wrong.
   std::string validate() const;
 };
@@ -73,8 +107,12 @@ struct ReaderWarnings {
   std::uint64_t backwards_time = 0;   ///< timestamp smaller than the previous event's (kept)
   std::uint64_t outside_sensor = 0;   ///< pixel outside [0,width)x[0,height) (dropped)
   std::uint64_t skipped_records = 0;  ///< unknown event types / special events skipped
+  std::uint64_t time_jumps = 0;       ///< outlier timestamps dropped and gaps beyond max_time_jump
+  std::uint64_t truncated = 0;        ///< a final packet / record cut by the end of the file
   std::vector<std::string> messages;  ///< up to 20 first messages
-  std::uint64_t total() const { return backwards_time + outside_sensor + skipped_records; }
+  std::uint64_t total() const {
+    return backwards_time + outside_sensor + skipped_records + time_jumps + truncated;
+  }
 };
 
 /// Pull reader: events in file order, IMU on request.
@@ -99,6 +137,8 @@ class EventReader {
   /// (some earlier events of the same packet may remain; callers filter).
   /// Returns false when the reader cannot seek (then nothing changes).
   virtual bool seekTime(double t_start) { (void)t_start; return false; }
+  /// The options the reader was opened with.
+  const ReaderOptions& options() const { return options_; }
   /// Warnings counted so far by next().
   const ReaderWarnings& warnings() const { return warnings_; }
   /// Human-readable notes about the source (chip name, compression, streams...).
@@ -106,13 +146,66 @@ class EventReader {
   void addNote(const std::string& note) { notes_.push_back(note); }
 
  protected:
+  /// Counts a warning and keeps its message (printable, one line); with
+  /// `strict` it is an IoError instead.
   void warn(std::uint64_t ReaderWarnings::*counter, const std::string& message);
+  /// An event whose pixel is outside the sensor: counted; an IoError once more
+  /// than max_outside_share of the events read are outside. `where` is
+  /// "FILE: line N" / "FILE: byte N".
+  void outsideSensor(const std::string& where, double x, double y);
+
+  /// Passes one decoded event through the time checks into `out` (every reader
+  /// calls it instead of push_back). `where()` gives "FILE: line N" or
+  /// "FILE: byte N" and is only called when something is reported. Events may
+  /// be held back (an outlier candidate, the sort buffer): release() them at
+  /// the end of the stream.
+  template <class Where>
+  void admit(std::vector<Event>& out, const Event& e, Where&& where) {
+    ++admitted_;
+    if (have_prev_ && !holding_ && reorder_.empty() && e.t >= prev_t_ &&
+        e.t - prev_t_ <= options_.max_time_jump) {
+      prev_t_ = e.t;
+      out.push_back(e);
+      return;
+    }
+    admitSlow(out, e, where());
+  }
+  /// At the end of the stream: moves held events into `out` (at most up to
+  /// `max` events in `out`). Readers call it when a batch comes out short.
+  void release(std::vector<Event>& out, std::size_t max);
+
   std::string path_;
   int width_ = 0, height_ = 0;
   ReaderOptions options_;
   ReaderWarnings warnings_;
   std::vector<std::string> notes_;
+
+ private:
+  struct Later {
+    bool operator()(const Event& a, const Event& b) const { return a.t > b.t; }
+  };
+  void admitSlow(std::vector<Event>& out, const Event& e, const std::string& where);
+  void accept(std::vector<Event>& out, const Event& e);
+  bool have_prev_ = false;
+  double prev_t_ = 0.0;        ///< time of the last event passed on (or pushed to the sort buffer)
+  bool holding_ = false;       ///< `held_` is an outlier candidate (a forward jump)
+  Event held_{};
+  std::string held_where_;
+  std::uint64_t admitted_ = 0;  ///< events offered to admit() (for the outside share)
+  std::priority_queue<Event, std::vector<Event>, Later> reorder_;
+  bool emitted_any_ = false;
+  double last_emitted_ = 0.0;  ///< sort mode: time of the last event released from the buffer
 };
+
+namespace detail {
+/// `s` as printable ASCII on one line, at most `max` characters of it: control
+/// bytes, bytes >= 0x7F (invalid UTF-8 included) become \xNN, a cut is marked
+/// "...". Every fragment of an input file echoed in a message goes through it.
+std::string printable(const std::string& s, std::size_t max = 80);
+/// Offset of the first byte that is not text (a control byte other than tab /
+/// CR / LF / FF, or invalid UTF-8), npos when none (a cut sequence at the end is text).
+std::size_t firstNonTextByte(const std::string& s);
+}  // namespace detail
 
 /// Detects the format (directory in RPG/UZH-FPV layout, `#!AER-DAT` magic,
 /// else a text events file) and opens a reader. Throws IoError.

@@ -9,6 +9,11 @@
 /// (step = (1 - overlap) * N events, or (1 - overlap) * S seconds).
 /// Time range: events outside [t_start, t_end) are skipped; readers that can
 /// seek (AEDAT 4.0 with a data table) jump to t_start.
+/// Gaps (by duration): empty windows are returned across a gap, unless the gap
+/// is longer than the reader's max_time_jump or spans more than
+/// kMaxEmptyWindows windows; then the source jumps to the window holding the
+/// next event (counted in gaps() / skippedWindows(), described in reports()),
+/// so one far timestamp never makes it produce windows without bound.
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -64,6 +69,8 @@ struct EventWindow {
 
 class WindowSource {
  public:
+  /// Most empty windows returned for one gap before the source skips it.
+  static constexpr std::uint64_t kMaxEmptyWindows = 1000;
   /// Throws std::invalid_argument when the options are invalid. The reader must outlive the source.
   WindowSource(EventReader& reader, const WindowOptions& options);
   /// Next window; false when no window remains (complete, or partial with
@@ -73,9 +80,16 @@ class WindowSource {
   std::size_t peakBuffered() const { return peak_; }
   /// After next() returned false: the last, partial window, emitted or not.
   const WindowTail& tail() const { return tail_; }
+  /// Gaps skipped so far, the empty windows they would have made, and up to 20
+  /// one-line descriptions ("FILE: no events in [a, b) s: N empty windows of S s skipped").
+  std::uint64_t gaps() const { return gaps_; }
+  std::uint64_t skippedWindows() const { return skipped_; }
+  const std::vector<std::string>& reports() const { return reports_; }
 
  private:
   bool pull();  ///< appends one batch within the time range; false at the end
+  /// By duration: moves the time grid past a long gap before the event at t_next.
+  void skipGap(double t_next, double S, double step);
   EventReader& reader_;
   WindowOptions o_;
   std::deque<Event> buf_;
@@ -84,11 +98,14 @@ class WindowSource {
   bool past_end_ = false;  ///< an event at or after t_end was seen
   bool started_ = false;
   double next_t0_ = 0.0;
-  std::uint64_t index_ = 0;
+  std::uint64_t index_ = 0;       ///< windows returned
+  std::uint64_t step_index_ = 0;  ///< by duration: steps from next_t0_ to the current window
   std::size_t peak_ = 0;
   std::size_t covered_front_ = 0;  ///< by count: events at the buffer's front already in a window
   double covered_until_ = -std::numeric_limits<double>::infinity();  ///< by duration: end of the last window [s]
   WindowTail tail_;
+  std::uint64_t gaps_ = 0, skipped_ = 0;
+  std::vector<std::string> reports_;
 };
 
 }  // namespace celc

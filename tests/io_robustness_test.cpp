@@ -1,0 +1,421 @@
+// Regression tests for the malformed inputs of issue 15 (and the reader checks
+// of issue 13): every reproducer is generated here, through the project's
+// writers and byte edits. docs/robustness.md lists them with the behaviour each
+// one checks.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <random>
+
+#include "celc/core/yaml.hpp"
+#include "celc/geometry/undistort.hpp"
+#include "celc/io/calibration.hpp"
+#include "celc/io/window_source.hpp"
+#include "celc/io/writers.hpp"
+#include "celc/pipeline/batch.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/sim/render_sequence.hpp"
+#include "io_test_util.hpp"
+
+using namespace celc;
+using celc::test::readBytes;
+using celc::test::TempDir;
+using celc::test::writeBytes;
+
+namespace {
+
+/// Printable ASCII on one line: what every message may contain.
+void expectPrintable(const std::string& m) {
+  for (char c : m) {
+    const auto u = static_cast<unsigned char>(c);
+    ASSERT_TRUE(u >= 0x20 && u < 0x7F) << "byte " << int(u) << " in message: " << m;
+  }
+}
+
+std::string ioError(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no IoError";
+  return {};
+}
+
+void putLE32(std::string& b, std::size_t at, std::int32_t v) { std::memcpy(&b[at], &v, 4); }
+void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
+  for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
+}
+
+ReaderOptions strictOptions() {
+  ReaderOptions o;
+  o.strict = true;
+  return o;
+}
+
+}  // namespace
+
+// ---- AEDAT 3.1: signed overflow in the packet header check ----------------------
+
+TEST(IoRobustness, Aedat31TimestampOffsetInt32MaxIsAnErrorNotOverflow) {
+  TempDir d;
+  writeAedat31(d.file("a.aedat31"), celc::test::randomEvents(50, 240, 180, 1), {}, "DAVIS240C", 50);
+  std::string b = readBytes(d.file("a.aedat31"));
+  const std::size_t data = b.find("#!END-HEADER\r\n") + 14;
+  putLE32(b, data + 8, 0x7FFFFFFF);  // eventTSOffset: tsoff + 4 overflowed int before
+  writeBytes(d.file("o.aedat31"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.aedat31")), "byte " + std::to_string(data), "invalid packet header");
+  // the largest overflow counter is representable: 2^31-1 << 31 fits in int64
+  b = readBytes(d.file("a.aedat31"));
+  putLE32(b, data + 12, 0x7FFFFFFF);
+  writeBytes(d.file("v.aedat31"), b);
+  auto r = openEventSource(d.file("v.aedat31"));
+  const auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 50u);
+  EXPECT_GT(ev.front().t, 4.6e12);
+}
+
+// ---- sizes from headers bounded before allocation -------------------------------
+
+TEST(IoRobustness, CalibrationYamlHugeSensorRefusedWithFileAndKey) {
+  TempDir d;
+  for (const char* size : {"65535", "4097"}) {
+    writeBytes(d.file("c.yaml"), std::string("camera:\n  width: ") + size + "\n  height: 180\n  fx: 200\n  fy: 200\n"
+                                 "  cx: 120\n  cy: 90\n");
+    try {
+      (void)loadCalibration(d.file("c.yaml"));
+      ADD_FAILURE() << "accepted width " << size;
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("c.yaml"), std::string::npos) << m;
+      EXPECT_NE(m.find("width"), std::string::npos) << m;
+      EXPECT_NE(m.find("4096"), std::string::npos) << m;
+    }
+  }
+}
+
+TEST(IoRobustness, Aedat4HeaderHugeSensorRefusedBeforeAnyTable) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(100, 240, 180, 2);
+  writeAedat4(d.file("a.aedat4"), ev, {}, 6000, 6000, Aedat4Compression::Lz4, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14", "6000x6000", "4096");
+  writeAedat4(d.file("b.aedat4"), ev, {}, 4096, 4096, Aedat4Compression::None, 50, true);
+  EXPECT_NO_THROW(celc::test::drain(d.file("b.aedat4")));
+}
+
+TEST(IoRobustness, UndistortTableRefusesHugeSensorsAndReaderOptionsAreBounded) {
+  CameraModel c;
+  c.width = 30000;
+  c.height = 30000;
+  c.fx = c.fy = 300;
+  c.cx = c.cy = 100;
+  try {
+    UndistortLut lut(c);
+    ADD_FAILURE() << "built a 30000x30000 table";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds 4096x4096"), std::string::npos) << e.what();
+  }
+  ReaderOptions o;
+  o.width = 5000;
+  o.height = 10;
+  EXPECT_NE(o.validate().find("4096"), std::string::npos);
+}
+
+// ---- AEDAT 2.0: one corrupt timestamp no longer shifts the rest ------------------
+
+TEST(IoRobustness, Aedat2OneTimestampAllOnesIsAnOutlierNotAWrap) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(2000, 240, 180, 3, 1.0);
+  writeAedat2(d.file("a.aedat"), ev, {});
+  std::string b = readBytes(d.file("a.aedat"));
+  const std::size_t data = b.size() - 8 * ev.size();
+  const std::size_t k = 1000;
+  putBE32(b, data + 8 * k + 4, 0xFFFFFFFFu);
+  writeBytes(d.file("o.aedat"), b);
+  auto r = openEventSource(d.file("o.aedat"));
+  const auto got = readAllEvents(*r);
+  ASSERT_EQ(got.size(), ev.size() - 1);  // the outlier dropped
+  EXPECT_NEAR(got.back().t, ev.back().t, 1e-9);  // nothing shifted by 2^32 us
+  EXPECT_EQ(r->warnings().time_jumps, 1u);
+  ASSERT_FALSE(r->warnings().messages.empty());
+  EXPECT_NE(r->warnings().messages[0].find("byte " + std::to_string(data + 8 * k)), std::string::npos)
+      << r->warnings().messages[0];
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.aedat"), strictOptions()), "byte " + std::to_string(data + 8 * k),
+                  "outlier");
+}
+
+// ---- endless windowing across an outlier ----------------------------------------
+
+TEST(IoRobustness, OutlierTimestampInTextDoesNotMakeEndlessWindows) {
+  TempDir d;
+  for (const char* outlier : {"10000000", "1e300"}) {
+    std::string text;
+    for (int i = 0; i < 2000; ++i) {
+      char line[64];
+      std::snprintf(line, sizeof line, "%.6f %d %d 1\n", 1.0 + i * 1e-3, i % 240, i % 180);
+      text += line;
+      if (i == 700) text += std::string(outlier) + " 5 5 1\n";
+    }
+    writeBytes(d.file("e.txt"), text);
+    auto r = openEventSource(d.file("e.txt"));
+    WindowOptions w;
+    w.seconds_per_window = 0.1;
+    WindowSource src(*r, w);
+    EventWindow win;
+    std::size_t n = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (src.next(win) && n < 1000) ++n;
+    EXPECT_LT(n, 25u) << outlier;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+    EXPECT_EQ(r->warnings().time_jumps, 1u) << outlier;
+    EXPECT_NE(r->warnings().messages.at(0).find("line 702"), std::string::npos) << r->warnings().messages.at(0);
+  }
+}
+
+TEST(IoRobustness, WindowSourceSkipsLongGapsAndRefusesUnrepresentableTimes) {
+  TempDir d;
+  // a real gap (two events confirm it): kept by the reader, skipped by the windows
+  writeBytes(d.file("g.txt"), "1.0 1 1 1\n1.05 1 1 1\n1.25 1 1 1\n5000.0 2 2 1\n5000.01 2 2 1\n5000.2 2 2 1\n");
+  auto r = openEventSource(d.file("g.txt"));
+  WindowOptions w;
+  w.seconds_per_window = 0.1;
+  WindowSource src(*r, w);
+  EventWindow win;
+  std::vector<EventWindow> got;
+  while (src.next(win) && got.size() < 100) got.push_back(win);
+  // 1.0-1.3 s: three windows, then the window holding 5000.0 (the grid's rounding
+  // near 5000 s may put it one window earlier) and the one holding 5000.01
+  ASSERT_GE(got.size(), 4u);
+  ASSERT_LE(got.size(), 5u);
+  EXPECT_EQ(got[1].events.size(), 0u);  // a gap of one window is returned empty, as before
+  EXPECT_EQ(got[2].events.size(), 1u);
+  EXPECT_GT(got[3].t0, 4999.8);
+  EXPECT_LE(got[3].t0, 5000.0);
+  EXPECT_GT(got.back().t1, 5000.01);
+  EXPECT_EQ(src.gaps(), 1u);
+  EXPECT_GT(src.skippedWindows(), 40000u);
+  ASSERT_EQ(src.reports().size(), 1u);
+  EXPECT_NE(src.reports()[0].find("g.txt: no events in"), std::string::npos) << src.reports()[0];
+  EXPECT_EQ(r->warnings().time_jumps, 1u);  // the reader reports the gap too
+  // a gap to 1e300: the window grid restarts there and t0 + S == t0 is an error, not a loop
+  writeBytes(d.file("h.txt"), "1.0 1 1 1\n1.2 1 1 1\n1e300 2 2 1\n1e300 2 2 1\n");
+  auto r2 = openEventSource(d.file("h.txt"));
+  WindowSource src2(*r2, w);
+  std::size_t n = 0;
+  EXPECT_IO_ERROR(
+      while (src2.next(win) && n < 100) ++n, "h.txt", "too large for windows");
+  EXPECT_LT(n, 100u);
+}
+
+// ---- messages never echo raw bytes ---------------------------------------------
+
+TEST(IoRobustness, MessagesArePrintableOneLine) {
+  TempDir d;
+  std::vector<std::string> messages;
+  // control bytes and an ANSI escape in a field
+  writeBytes(d.file("c.txt"), std::string("0.1\x01\x1b[31m 1 2 1\n"));
+  messages.push_back(ioError([&] { celc::test::drain(d.file("c.txt")); }));
+  // invalid UTF-8 in a header line (after a valid first block, so detection passes)
+  writeBytes(d.file("u.txt"), std::string("0.1 1 2 1\ntime col\xff\xfe row sign\n"));
+  messages.push_back(ioError([&] { celc::test::drain(d.file("u.txt")); }));
+  // a field with a carriage return inside the line
+  writeBytes(d.file("r.txt"), std::string("0.1 1 2 1\n0.2 1\r2 1 1\n"));
+  messages.push_back(ioError([&] { celc::test::drain(d.file("r.txt")); }));
+  // an AEDAT version "line" that spans two lines and holds control bytes
+  writeBytes(d.file("v.aedat"), std::string("#!AER-DAT9.9\rsecond line\n\x07\x1b[2J"));
+  messages.push_back(ioError([&] { openEventSource(d.file("v.aedat")); }));
+  // AEDAT 2.0 / 3.1 magic lines with junk
+  writeBytes(d.file("m2.aedat"), std::string("#!AER-DAT2.0\x1b[0m\xff\r\n"));
+  messages.push_back(ioError([&] { openEventSource(d.file("m2.aedat")); }));
+  writeBytes(d.file("m3.aedat"), std::string("#!AER-DAT3.1\x01\x02\xc3\x28\r\n"));
+  messages.push_back(ioError([&] { openEventSource(d.file("m3.aedat")); }));
+  // an AEDAT 2.0 chip name with control bytes: the note and the error are printable
+  writeBytes(d.file("chip.aedat"), std::string("#!AER-DAT2.0\r\n# AEChip: x.\x1b]0;DVS128\x07\r\n"));
+  messages.push_back(ioError([&] { openEventSource(d.file("chip.aedat")); }));
+  for (const auto& m : messages) {
+    SCOPED_TRACE(m);
+    EXPECT_FALSE(m.empty());
+    expectPrintable(m);
+    EXPECT_LT(m.size(), 600u);
+  }
+  EXPECT_EQ(messages[3].find("second line"), std::string::npos);  // the version ends at the line's end
+  EXPECT_EQ(detail::printable("a\nb\xff", 80), "a\\x0Ab\\xFF");
+  EXPECT_EQ(detail::printable(std::string(100, 'x'), 10), "xxxxxxxxxx...");
+}
+
+TEST(IoRobustness, RandomBinaryIsDetectedByItsHeaderAndNeverPrinted) {
+  TempDir d;
+  std::mt19937 rng(15);
+  // no NUL in the first 16 bytes (the old detector's window), NULs and control bytes later
+  std::string b;
+  for (int i = 0; i < 4096; ++i) b.push_back(char(i < 16 ? 'a' + rng() % 26 : rng() & 0xFF));
+  writeBytes(d.file("r.bin"), b);
+  std::string m = ioError([&] { openEventSource(d.file("r.bin")); });
+  expectPrintable(m);
+  EXPECT_NE(m.find("binary data"), std::string::npos) << m;
+  EXPECT_LT(m.size(), 200u) << m;
+  // bytes >= 0x80 only (no control byte at all): invalid UTF-8 is binary too
+  std::string h;
+  for (int i = 0; i < 4096; ++i) h.push_back(char(0x80 | (rng() & 0x7F)));
+  writeBytes(d.file("h.bin"), "0.1 1 2 1\n" + h);
+  m = ioError([&] { openEventSource(d.file("h.bin")); });
+  EXPECT_NE(m.find("binary data"), std::string::npos) << m;
+  expectPrintable(m);
+  // UTF-8 text in a comment is still text
+  writeBytes(d.file("t.txt"), "# t [\xc2\xb5s] x y p\n0.1 1 2 1\n");
+  EXPECT_EQ(detectFormat(d.file("t.txt")), Format::Text);
+}
+
+// ---- truncated binary files: the complete packets, a warning ---------------------
+
+TEST(IoRobustness, TruncatedBinaryFilesYieldTheirCompletePackets) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(3000, 240, 180, 4, 2.0);
+  const auto imu = celc::test::randomImu(ev.front().t, ev.back().t, 5);
+  struct Case {
+    std::string name;
+    std::size_t min_events;
+  };
+  writeAedat2(d.file("a.aedat2"), ev, imu);
+  writeAedat31(d.file("a.aedat31"), ev, imu, "DAVIS240C", 500);
+  writeAedat4(d.file("n.aedat4"), ev, imu, 240, 180, Aedat4Compression::None, 500, true);
+  writeAedat4(d.file("l.aedat4"), ev, imu, 240, 180, Aedat4Compression::Lz4, 500, true);
+  writeAedat4(d.file("z.aedat4"), ev, imu, 240, 180, Aedat4Compression::Zstd, 500, false);
+  for (const char* name : {"a.aedat2", "a.aedat31", "n.aedat4", "l.aedat4", "z.aedat4"}) {
+    SCOPED_TRACE(name);
+    const std::string b = readBytes(d.file(name));
+    // cut at 60% of the file: inside an event packet (or the data table)
+    const std::size_t cut = b.size() * 6 / 10 + 3;
+    writeBytes(d.file(std::string("t_") + name), b.substr(0, cut));
+    auto r = openEventSource(d.file(std::string("t_") + name));
+    const auto got = readAllEvents(*r);
+    EXPECT_GT(got.size(), 1000u);
+    EXPECT_LT(got.size(), ev.size());
+    for (std::size_t i = 0; i < got.size(); ++i) ASSERT_NEAR(got[i].t, ev[i].t, 1e-9);
+    EXPECT_GE(r->warnings().truncated, 1u);  // with a data table past the cut: the table too
+    ASSERT_FALSE(r->warnings().messages.empty());
+    EXPECT_NE(r->warnings().messages.back().find("byte " + std::to_string(cut)), std::string::npos)
+        << r->warnings().messages.back();
+    EXPECT_IO_ERROR(celc::test::drain(d.file(std::string("t_") + name), strictOptions()), "truncated",
+                    "byte " + std::to_string(cut));
+  }
+}
+
+// ---- time sanity (issue 13 / 15) ------------------------------------------------
+
+TEST(IoRobustness, BackwardsBeyondToleranceIsAnErrorOrDroppedOrSorted) {
+  TempDir d;
+  writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.3 1 2 1\n0.2995 1 2 1\n0.2 1 2 1\n0.4 1 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), "e.txt: line 4", "backwards_tolerance", "input.backwards");
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto r = openEventSource(d.file("e.txt"), drop);
+  EXPECT_EQ(readAllEvents(*r).size(), 4u);
+  EXPECT_EQ(r->warnings().backwards_time, 2u);  // 0.2995 kept (within 1 ms), 0.2 dropped
+  ReaderOptions sort;
+  sort.backwards = BackwardsPolicy::Sort;
+  auto s = openEventSource(d.file("e.txt"), sort);
+  const auto ev = readAllEvents(*s);
+  ASSERT_EQ(ev.size(), 5u);
+  for (std::size_t i = 1; i < ev.size(); ++i) EXPECT_LE(ev[i - 1].t, ev[i].t);
+  EXPECT_EQ(s->warnings().backwards_time, 2u);
+}
+
+TEST(IoRobustness, ForwardJumpOutlierDroppedGapKeptBothReported) {
+  TempDir d;
+  writeBytes(d.file("o.txt"), "1.0 1 2 1\n1.1 1 2 1\n99.0 1 2 1\n1.2 1 2 1\n1.3 1 2 1\n");
+  auto r = openEventSource(d.file("o.txt"));
+  auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 4u);
+  EXPECT_DOUBLE_EQ(ev[2].t, 1.2);
+  ASSERT_EQ(r->warnings().time_jumps, 1u);
+  EXPECT_NE(r->warnings().messages[0].find("line 3"), std::string::npos) << r->warnings().messages[0];
+  EXPECT_NE(r->warnings().messages[0].find("outlier dropped"), std::string::npos);
+  ReaderOptions tight;
+  tight.max_time_jump = 100.0;  // the bound is the schema option input.max_time_jump
+  auto r2 = openEventSource(d.file("o.txt"), tight);
+  EXPECT_IO_ERROR(readAllEvents(*r2), "line 4", "before the previous event");
+  writeBytes(d.file("g.txt"), "1.0 1 2 1\n1.1 1 2 1\n99.0 1 2 1\n99.1 1 2 1\n");
+  auto r3 = openEventSource(d.file("g.txt"));
+  EXPECT_EQ(readAllEvents(*r3).size(), 4u);
+  EXPECT_EQ(r3->warnings().time_jumps, 1u);
+  EXPECT_NE(r3->warnings().messages[0].find("a gap of"), std::string::npos) << r3->warnings().messages[0];
+}
+
+TEST(IoRobustness, ManyPixelsOutsideTheSensorAreAnError) {
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 1000; ++i) text += std::to_string(0.001 * i + 1.0) + " " + std::to_string(i % 346) + " 10 1\n";
+  writeBytes(d.file("e.txt"), text);
+  ReaderOptions o;
+  o.width = 240;
+  o.height = 180;
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), o), "e.txt: line", "outside the 240x180 sensor",
+                  "max_outside_share");
+  o.max_outside_share = 1.0;
+  auto r = openEventSource(d.file("e.txt"), o);
+  EXPECT_EQ(readAllEvents(*r).size(), 240u * 3);
+}
+
+TEST(IoRobustness, MicrosecondsReadAsSecondsGiveAHint) {
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 200; ++i) text += std::to_string(1600000000 + 7 * i) + " 1 2 1\n";
+  writeBytes(d.file("us.txt"), text);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("us.txt")), "us.txt: line 64", "input.time_scale", "--time-scale 1e-6");
+  ReaderOptions o;
+  o.text_time_scale = 1e-6;
+  EXPECT_EQ(celc::test::drain(d.file("us.txt"), o), 200u);
+}
+
+TEST(IoRobustness, ReaderOptionsSchemaHasTheTimeChecks) {
+  ReaderOptions o;
+  const auto yaml = writeYaml([&](FieldVisitor& v) { describe(v, o); });
+  for (const char* key : {"max_time_jump", "backwards_tolerance", "backwards", "max_outside_share"})
+    EXPECT_NE(yaml.find(key), std::string::npos) << key;
+}
+
+// ---- YAML: a key or section given twice names both lines ------------------------
+
+TEST(IoRobustness, DuplicatedSectionsInCalibrationSceneAndBatchNameBothLines) {
+  TempDir d;
+  auto configError = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no ConfigError";
+    return {};
+  };
+  writeBytes(d.file("c.yaml"), "camera:\n  width: 240\n  height: 180\n  fx: 200\n  fy: 200\n  cx: 120\n  cy: 90\n"
+                               "imu:\n  time_offset: 0.1\nimu:\n  time_offset: 0.2\n");
+  std::string m = configError([&] { (void)loadCalibration(d.file("c.yaml")); });
+  EXPECT_NE(m.find("c.yaml:10"), std::string::npos) << m;
+  EXPECT_NE(m.find("given twice (first at line 8)"), std::string::npos) << m;
+  const std::string scene = readBytes(std::string(CELC_SOURCE_DIR) + "/config/scenes/davis240_rectangles.yaml");
+  writeBytes(d.file("s.yaml"), scene + "duration: 2.0\n");
+  m = configError([&] { (void)loadSynthConfig(d.file("s.yaml")); });
+  EXPECT_NE(m.find("s.yaml:"), std::string::npos) << m;
+  EXPECT_NE(m.find("'duration': given twice (first at line 7)"), std::string::npos) << m;
+  writeBytes(d.file("b.yaml"), "sequences:\n  - label: a\n    path: x\n    path: y\n");
+  m = configError([&] { (void)readBatch(d.file("b.yaml"), [](const std::string&) { return RunConfig{}; }); });
+  EXPECT_NE(m.find("b.yaml:4"), std::string::npos) << m;
+  EXPECT_NE(m.find("given twice (first at line 3)"), std::string::npos) << m;
+}
+
+// ---- found by fuzz_calibration: a YAML syntax error quoting a raw byte ------------
+
+TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
+  TempDir d;
+  writeBytes(d.file("c.yaml"), std::string("camera: \"\\\xcd\xdf\"\n"));  // an unknown escape: a byte >= 0x80
+  try {
+    (void)loadCalibration(d.file("c.yaml"));
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    expectPrintable(m);
+    EXPECT_NE(m.find("c.yaml:1"), std::string::npos) << m;
+  }
+}
