@@ -19,6 +19,7 @@ std::string LinearOptions::validate() const {
   if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
   if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
   if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
+  if (!(min_window_parallax >= 0.0)) e << "min_window_parallax must be >= 0; ";
   return e.str();
 }
 

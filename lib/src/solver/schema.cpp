@@ -20,6 +20,8 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
           o.min_parallax_ratio);
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);
+  v.field({"min_window_parallax", "-", "median static/moving ratio over the clusters below this -> no parallax"},
+          o.min_window_parallax);
   v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
 }
 

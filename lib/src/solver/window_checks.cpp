@@ -106,6 +106,13 @@ bool windowIsDegenerate(const WindowObservations& obs, const MotionModel& motion
     result.parallax = parallax;
     return true;
   }
+  if (parallax < opt.min_window_parallax) {  // NaN (no cluster measured) passes
+    result = failure(SolveStatus::Degenerate, Degeneracy::NoParallax,
+                     "window parallax " + std::to_string(parallax) + " (median over clusters) below " +
+                         std::to_string(opt.min_window_parallax));
+    result.parallax = parallax;
+    return true;
+  }
   return false;
 }
 

@@ -39,6 +39,11 @@ struct LinearOptions {
   /// in time (robust scales); fewer than min_clusters such clusters -> degenerate.
   double min_parallax_ratio = 1.5;
   double min_parallax_px = 0.5;  ///< and the static-line scale exceeds this [px]
+  /// The window's parallax (the median over its clusters of the static /
+  /// moving ratio above) below this -> degenerate / no_parallax, however many
+  /// single clusters pass: a window the rotation explains (pure rotation)
+  /// has a median near 1 even when a few noisy clusters pass (docs/uncertainty.md).
+  double min_window_parallax = 1.1;
   bool resolve_sign = true;      ///< cheirality test; else the sign is arbitrary
   std::string validate() const;
 };
