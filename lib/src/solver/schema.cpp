@@ -22,6 +22,8 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);
   v.field({"min_window_parallax", "-", "median static/moving ratio over the clusters below this -> no parallax"},
           o.min_window_parallax);
+  v.field({"min_window_parallax_clusters", "", "... in windows with at least this many measured clusters"},
+          o.min_window_parallax_clusters);
   v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
 }
 

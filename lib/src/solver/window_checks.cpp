@@ -106,7 +106,8 @@ bool windowIsDegenerate(const WindowObservations& obs, const MotionModel& motion
     result.parallax = parallax;
     return true;
   }
-  if (parallax < opt.min_window_parallax) {  // NaN (no cluster measured) passes
+  if (static_cast<int>(ratios.size()) >= opt.min_window_parallax_clusters &&
+      parallax < opt.min_window_parallax) {
     result = failure(SolveStatus::Degenerate, Degeneracy::NoParallax,
                      "window parallax " + std::to_string(parallax) + " (median over clusters) below " +
                          std::to_string(opt.min_window_parallax));

@@ -44,6 +44,9 @@ struct LinearOptions {
   /// single clusters pass: a window the rotation explains (pure rotation)
   /// has a median near 1 even when a few noisy clusters pass (docs/uncertainty.md).
   double min_window_parallax = 1.1;
+  /// ... applied to windows with at least this many measured clusters (with
+  /// fewer, the per-cluster test alone decides, as it always did).
+  int min_window_parallax_clusters = 6;
   bool resolve_sign = true;      ///< cheirality test; else the sign is arbitrary
   std::string validate() const;
 };
