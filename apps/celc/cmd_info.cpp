@@ -5,6 +5,7 @@
 #include <string>
 
 #include "celc/io/event_reader.hpp"
+#include "celc/pipeline/imu_still.hpp"
 #include "commands.hpp"
 
 namespace celc::app {
@@ -45,6 +46,19 @@ int runInfo(const InfoArgs& a) {
   if (info.imu_samples > 0) {
     std::printf("IMU range:     [%.6f, %.6f] s\n", info.imu_t_first, info.imu_t_last);
     std::printf("IMU rate:      %.2f Hz\n", info.imuRate());
+    // The first still second: its mean gyro rate estimates motion.gyro_bias.
+    try {
+      const StillSpan still = findFirstStill(openEventSource(a.path, o)->readImu());
+      if (still.found)
+        std::printf("gyro at rest:  mean %.6f,%.6f,%.6f rad/s (IMU frame; std %.4f,%.4f,%.4f) over the first "
+                    "still second [%.3f, %.3f] s: an estimate of motion.gyro_bias\n",
+                    still.gyro_mean.x(), still.gyro_mean.y(), still.gyro_mean.z(), still.gyro_std.x(),
+                    still.gyro_std.y(), still.gyro_std.z(), still.t0, still.t1);
+      else
+        std::printf("gyro at rest:  no still second (gyro std <= 0.02 rad/s per axis, |accel| std <= 2%%)\n");
+    } catch (const std::exception& e) {
+      spdlog::warn("IMU not read for the still-second check: {}", e.what());
+    }
   }
   std::printf("warnings:      %llu (timestamps backwards %llu, pixels outside sensor %llu, skipped %llu)\n",
               static_cast<unsigned long long>(info.warnings.total()),

@@ -77,6 +77,37 @@ void printSweepTable(const Sweep& sweep, const std::vector<SweepCell>& cells,
   }
 }
 
+// The uncertainty study: per setting and method the share of ok trials with
+// phi <= 2 sigma_deg (target 0.85-0.99), the median sigma, and how many ok
+// trials claim sigma < 10 deg. OUTDIR/sigma.csv holds the same.
+void runSigmaStudy(const SimulateArgs& a, const SimulateConfig& cfg, const fs::path& out) {
+  std::string csv = "sweep,level,method,trials,n_ok,covered_2sigma,share_2sigma,sigma_median_deg,ok_sigma_below_10deg\n";
+  std::cout << "\nUncertainty calibration: share of ok trials with phi <= 2 sigma_deg (ok trials; median "
+               "sigma_deg; ok trials with sigma_deg < 10)\n\n| setting | level";
+  for (Method m : cfg.methods) std::cout << " | " << toString(m);
+  std::cout << " |\n|---|---";
+  for (size_t i = 0; i < cfg.methods.size(); ++i) std::cout << "|---";
+  std::cout << "|\n";
+  for (const Sweep& sweep : sigmaSweeps()) {
+    Progress progress("simulate sigma " + sweep.name, a.quiet);
+    const auto cells = runSweep(sweep, cfg, a.threads, [&](int done, int total) { progress.update(done, total); });
+    for (size_t i = 0; i < cells.size(); i += cfg.methods.size()) {
+      std::cout << "| " << sweep.name << " | " << fmt::format("{:g}", cells[i].level);
+      for (size_t m = 0; m < cfg.methods.size(); ++m) {
+        const SweepCell& c = cells[i + m];
+        const double share = c.n_ok > 0 ? double(c.covered_2sigma) / c.n_ok : NAN;
+        std::cout << " | " << fmtCell(share) << " (" << c.n_ok << "; " << fmt::format("{:.2g}", c.sigma_median_deg)
+                  << "; " << c.confident_10deg << ")";
+        csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", c.sweep, c.level, toString(c.method), c.trials, c.n_ok,
+                           c.covered_2sigma, share, c.sigma_median_deg, c.confident_10deg);
+      }
+      std::cout << " |\n";
+    }
+  }
+  writeFileAtomically((out / "sigma.csv").string(), csv);
+  std::cout << std::flush;
+}
+
 // Runs a plot script on OUTDIR with Debian's interpreter (or $CELC_PYTHON).
 void runPlotScript(const std::string& name, const fs::path& out) {
   const std::string script = findPlotScript(name);
@@ -152,10 +183,20 @@ void runSimulate(const SimulateArgs& a) {
   if (a.trials > 0) cfg.trials = a.trials;
   if (a.seed >= 0) cfg.seed = static_cast<std::uint64_t>(a.seed);
   if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
-  if (a.study != "paper" && a.study != "peers")
-    throw std::invalid_argument("unknown study '" + a.study + "' (expected paper or peers)");
+  if (a.study != "paper" && a.study != "peers" && a.study != "sigma")
+    throw std::invalid_argument("unknown study '" + a.study + "' (expected paper, peers or sigma)");
   if (a.study == "peers" || a.sweep == "peers") {
     runPeers(a, cfg);
+    return;
+  }
+
+  if (a.study == "sigma") {
+    const fs::path out(a.outdir);
+    if (fs::exists(out / "config.yaml") && !a.force)
+      throw std::runtime_error(out.string() + ": holds results of an earlier run (use --force to overwrite)");
+    fs::create_directories(out);
+    writeFileAtomically((out / "config.yaml").string(), toYaml(cfg));
+    runSigmaStudy(a, cfg, out);
     return;
   }
 
@@ -206,7 +247,8 @@ void registerSimulate(CLI::App& app) {
                   "(the paper's study), or peers (= --study peers)")
       ->capture_default_str();
   cmd->add_option("--study", a->study,
-                  "paper: the paper's sweeps; peers: npt and CELC on the peers' scene (640x480, "
+                  "paper: the paper's sweeps; sigma: the calibration of sigma_deg (share of ok trials with "
+                  "phi <= 2 sigma per setting and method, OUTDIR/sigma.csv); peers: npt and CELC on the peers' scene (640x480, "
                   "f 320 px, T 0.5 s) beside the Cramer-Rao bound, OUTDIR/peers.csv and "
                   "peers_*.png; --trials defaults to 200 there")
       ->capture_default_str();

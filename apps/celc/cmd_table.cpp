@@ -22,6 +22,7 @@ struct TableArgs {
   std::vector<std::string> results;
   std::vector<std::string> labels;  ///< NAME=PATH
   std::string output;
+  double max_sigma_deg = -1.0;  ///< < 0: every ok row
   bool quiet = false, allow_incomplete = false;
 };
 
@@ -137,6 +138,7 @@ void runTable(const TableArgs& a) {
   }
 
   std::vector<SequenceSummary> table;
+  std::vector<std::string> kept_notes;
   for (const auto& g : groups) {
     // Shards of one run merge; a (window, method) seen twice is counted once.
     std::vector<WindowsCsvRow> rows;
@@ -152,6 +154,21 @@ void runTable(const TableArgs& a) {
       }
       if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", s.csv.string(), dup, g.label);
     }
+    if (a.max_sigma_deg >= 0.0) {
+      // Only the windows a user would keep: ok rows above the threshold (or
+      // without sigma_deg, files of the first format) count as not ok.
+      int dropped = 0, ok = 0;
+      for (auto& r : rows) {
+        if (r.status != "ok") continue;
+        ++ok;
+        if (r.sigma_deg <= a.max_sigma_deg) continue;
+        r.status = "sigma_above_max";
+        r.has_v = r.has_metrics = false;
+        ++dropped;
+      }
+      kept_notes.push_back("- " + g.label + ": " + std::to_string(ok - dropped) + " of " + std::to_string(ok) +
+                           " ok rows kept");
+    }
     table.push_back({g.label, summarize(rows)});
   }
   if (!a.output.empty()) {
@@ -160,7 +177,13 @@ void runTable(const TableArgs& a) {
     writeFileAtomically(a.output + ".csv", tableCsv(table));
     spdlog::info("wrote {}.md, {}.tex, {}.csv", a.output, a.output, a.output);
   }
-  std::cout << tableMarkdown(table) << std::flush;
+  std::cout << tableMarkdown(table);
+  if (a.max_sigma_deg >= 0.0) {
+    std::cout << "\nOver the windows with sigma_deg <= " << a.max_sigma_deg
+              << " deg (rows above it, or without sigma_deg, are left out):\n";
+    for (const auto& n : kept_notes) std::cout << n << "\n";
+  }
+  std::cout << std::flush;
 }
 
 }  // namespace
@@ -180,6 +203,10 @@ void registerTable(CLI::App& app) {
                   "NAME=PATH: the results in PATH as the row NAME (repeatable; the same NAME twice "
                   "merges, e.g. shards)");
   cmd->add_option("-o,--output", a->output, "write PREFIX.md, PREFIX.tex, PREFIX.csv");
+  cmd->add_option("--max-sigma", a->max_sigma_deg,
+                  "DEG: only the windows a user would keep, ok rows with sigma_deg <= DEG [deg] "
+                  "(rows without sigma_deg, from older files, are left out)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--allow-incomplete", a->allow_incomplete,
                 "include runs that have not completed, their rows marked '(incomplete)'");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

@@ -14,8 +14,17 @@
 
 namespace celc {
 
-std::string windowsCsvHeader() {
+std::string windowsCsvHeaderV1() {
   return "window,t_start,t_end,n_events,n_clusters,method,status,vx,vy,vz,gt_vx,gt_vy,gt_vz,eps,phi,runtime_ms";
+}
+
+std::string windowsCsvHeader() { return windowsCsvHeaderV1() + ",reason,sigma_deg,parallax,n_lines,wx,wy,wz"; }
+
+std::string padWindowsCsvLine(const std::string& line) {
+  std::string l = line;
+  if (!l.empty() && l.back() == '\r') l.pop_back();
+  if (l.empty() || std::count(l.begin(), l.end(), ',') != 15) return line;
+  return l + ",,,,,,,";
 }
 
 namespace {
@@ -58,7 +67,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     if (!l.empty() && l.back() == '\r') l.pop_back();
     const std::string where = path + ":" + std::to_string(no);
     if (no == 1) {
-      if (l != windowsCsvHeader())
+      if (l != windowsCsvHeader() && l != windowsCsvHeaderV1())
         throw std::runtime_error(where + ": not a celc windows.csv header");
       continue;
     }
@@ -66,8 +75,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     const bool last = i + 1 == lines.size();
     const auto f = splitList(l, ',');
     try {
-      if (f.size() != 16)
-        throw std::runtime_error(where + ": expected 16 columns, got " + std::to_string(f.size()));
+      if (f.size() != 16 && f.size() != 23)
+        throw std::runtime_error(where + ": expected 16 or 23 columns, got " + std::to_string(f.size()));
       WindowsCsvRow r;
       r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
       r.t_start = toDouble(f[1], where, "t_start");
@@ -88,6 +97,15 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         r.phi = toDouble(f[14], where, "phi");
       }
       if (!f[15].empty()) r.runtime_ms = toDouble(f[15], where, "runtime_ms");
+      if (f.size() == 23) {
+        r.reason = f[16];
+        if (!f[17].empty()) r.sigma_deg = toDouble(f[17], where, "sigma_deg");
+        if (!f[18].empty()) r.parallax = toDouble(f[18], where, "parallax");
+        if (!f[19].empty()) r.n_lines = static_cast<int>(toDouble(f[19], where, "n_lines"));
+        r.has_omega = !f[20].empty();
+        if (r.has_omega)
+          r.omega = Vec3(toDouble(f[20], where, "wx"), toDouble(f[21], where, "wy"), toDouble(f[22], where, "wz"));
+      }
       rows.push_back(r);
     } catch (const std::runtime_error&) {
       if (last && !complete_last && tolerate_truncated_tail) break;  // interrupted write
@@ -98,7 +116,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
   return rows;
 }
 
-std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows) {
+std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows, double max_sigma_deg) {
   std::vector<std::string> order;
   std::map<std::string, std::vector<const WindowsCsvRow*>> by;
   for (const auto& r : rows) {
@@ -112,10 +130,21 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows) {
     std::vector<double> eps, phi, rt;
     Vec3 sum = Vec3::Zero();
     std::vector<Vec3> dirs;
+    std::vector<double> kept_phi;
+    Vec3 kept_sum = Vec3::Zero();
+    s.max_sigma_deg = max_sigma_deg;
     for (const WindowsCsvRow* r : by[name]) {
       ++s.windows;
       if (r->status != "ok") continue;
       ++s.ok;
+      if (r->sigma_deg <= max_sigma_deg) {  // NaN (no sigma) is never kept
+        ++s.kept;
+        if (r->has_v && r->v.norm() > 0) kept_sum += r->v.normalized();
+        if (r->has_metrics) {
+          ++s.kept_with_metrics;
+          kept_phi.push_back(r->phi);
+        }
+      }
       rt.push_back(r->runtime_ms);
       if (r->has_v && r->v.norm() > 0) {
         dirs.push_back(r->v.normalized());
@@ -131,6 +160,9 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows) {
     s.phi_mean = mean(phi);
     s.phi_median = median(phi);
     s.runtime_ms_median = median(rt);
+    s.kept_phi_mean = mean(kept_phi);
+    s.kept_phi_median = median(kept_phi);
+    if (s.kept > 0) s.kept_resultant_length = kept_sum.norm() / static_cast<double>(s.kept);
     if (!dirs.empty()) {
       s.resultant_length = sum.norm() / static_cast<double>(dirs.size());
       const Vec3 m = sum.norm() > 0 ? Vec3(sum.normalized()) : dirs.front();
@@ -159,6 +191,16 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
   o << "\neps = |v_gt - v|, phi = acos(v_gt . v) on unit vectors, over the windows with status ok "
        "and ground truth. R = |mean of the unit estimates| over the ok windows (1: every window "
        "gives the same direction); spread = angle of each estimate to their mean direction.\n";
+  // The windows a user would keep: ok and a small enough uncertainty.
+  const double thr = methods.empty() ? kDefaultKeepSigmaDeg : methods.front().max_sigma_deg;
+  o << "\nThe windows a user would keep: status ok and sigma_deg <= " << fmt(thr, 1)
+    << " deg (rows without sigma_deg are not kept).\n\n"
+    << "| method | ok | kept | kept with ground truth | mean phi kept [rad] | median phi kept [rad] | R kept |\n"
+    << "|---|---|---|---|---|---|---|\n";
+  for (const auto& m : methods)
+    o << "| " << m.method << " | " << m.ok << " | " << m.kept << " | " << m.kept_with_metrics << " | "
+      << fmt(m.kept_phi_mean) << " | " << fmt(m.kept_phi_median) << " | " << fmt(m.kept_resultant_length, 3)
+      << " |\n";
   return o.str();
 }
 

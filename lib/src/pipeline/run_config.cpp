@@ -28,6 +28,7 @@ std::string RunConfig::validate() const {
                   cluster.validate() + observations.validate() + solver.validate() + groundtruth.validate();
   if (methods.empty()) e += "methods: at least one; ";
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
+  if (!gyro_bias.allFinite()) e += "motion.gyro_bias must be finite; ";
   // One line: the problems joined by "; ", without the last separator.
   while (!e.empty() && (e.back() == ' ' || e.back() == ';')) e.pop_back();
   return e;
@@ -50,6 +51,8 @@ void describe(FieldVisitor& v, RunConfig& c) {
     s.enumeration({"omega_source", "", "gyro: the recording's IMU; fixed: fixed_omega"}, c.omega_source,
                   {OmegaSource::Gyro, OmegaSource::Fixed});
     s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed"}, c.fixed_omega);
+    s.field({"gyro_bias", "rad/s", "constant gyro bias, IMU frame, subtracted from every sample (celc info estimates it)"},
+            c.gyro_bias);
     describe(s, c.gyro);
   });
   describeClustering(v, c.cluster, c.observations.lines);

@@ -34,6 +34,23 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     if (row.has_metrics) o << row.eps << "," << row.phi;
     else o << ",";
     o << "," << std::setprecision(3) << row.result.time_us * 1e-3;
+    // Quality columns: reason,sigma_deg,parallax,n_lines,wx,wy,wz.
+    const SolverResult& r = row.result;
+    std::string reason;
+    if (!rec.window_status.empty()) reason = rec.window_status;
+    else if (r.status == SolveStatus::Degenerate) reason = toString(r.degeneracy);
+    else if (!r.ok()) reason = toString(r.status);
+    o << "," << reason << ",";
+    if (row.result.ok() && !std::isnan(r.sigma_deg))
+      o << std::setprecision(4) << r.sigma_deg;  // "inf": unobservable at the estimate
+    o << ",";
+    const bool solved = rec.window_status.empty();
+    if (solved && std::isfinite(r.parallax)) o << std::setprecision(4) << r.parallax;
+    o << ",";
+    if (solved) o << r.n_lines;
+    o << std::setprecision(6) << std::fixed;
+    if (rec.has_omega) o << "," << rec.omega.x() << "," << rec.omega.y() << "," << rec.omega.z();
+    else o << ",,,";
     lines.push_back(o.str());
   }
   return lines;
@@ -132,7 +149,7 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& c
         break;
       }
       if (w > resume_after_) break;
-      content += line + "\n";
+      content += padWindowsCsvLine(line) + "\n";
     }
     in.close();
     writeMarker("celc run resumed " + nowText() + "; not complete (interrupted, or stopped on an error)");

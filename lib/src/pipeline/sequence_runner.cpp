@@ -73,6 +73,10 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
       throw std::runtime_error((m.inputs.imu.empty() ? in.events : m.inputs.imu) +
                                ": no IMU samples; give --imu FILE, or --omega wx,wy,wz [rad/s] "
                                "(motion.omega_source: fixed) for a recording without IMU");
+    // The constant gyro bias (IMU frame) comes off every sample here, before
+    // the track rotates the rates into the camera frame.
+    if (!m.config.gyro_bias.isZero(0.0))
+      for (ImuSample& sample : imu) sample.gyro -= m.config.gyro_bias;
     m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
   }
   if (!m.inputs.groundtruth.empty()) {
@@ -97,8 +101,16 @@ std::vector<std::string> SequenceRunner::describe() const {
               std::to_string(m.calib.camera.height) + ", " + toString(m.calib.camera.distortion) + ")");
   if (m.config.omega_source == OmegaSource::Fixed)
     d.push_back("angular velocity: fixed by the configuration (motion.fixed_omega)");
-  else
-    d.push_back("gyroscope: " + std::to_string(m.n_imu) + " samples");
+  else {
+    std::string g = "gyroscope: " + std::to_string(m.n_imu) + " samples";
+    if (!m.config.gyro_bias.isZero(0.0)) {
+      std::ostringstream b;
+      b << ", bias " << m.config.gyro_bias.x() << "," << m.config.gyro_bias.y() << ","
+        << m.config.gyro_bias.z() << " rad/s (IMU frame) subtracted";
+      g += b.str();
+    }
+    d.push_back(g);
+  }
   d.push_back(m.gt ? "ground truth: " + m.inputs.groundtruth + " (" + std::to_string(m.n_poses) + " poses)"
                    : std::string("ground truth: none (no metrics)"));
   return d;
@@ -146,7 +158,11 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     }
     motion = cfg.motion == MotionModelKind::GyroIntegrated ? gw.motionModel(t0)
                                                            : MotionModel::constantTwist(gw.mean_omega, t0);
+    rec.omega = gw.mean_omega;
+  } else {
+    rec.omega = cfg.fixed_omega;
   }
+  rec.has_omega = true;
 
   // Clustering in pixel space-time.
   start = Clock::now();

@@ -28,6 +28,7 @@ std::vector<MethodOutcome> scoreResults(const std::vector<SolverResult>& results
     o.phi = e.phi;
     o.phi_sign_agnostic = e.phi_sign_agnostic;
     o.time_us = r.time_us;
+    o.sigma_deg = r.sigma_deg;
   }
   return out;
 }

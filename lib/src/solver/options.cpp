@@ -1,6 +1,7 @@
 // Validation of the solver options.
 #include "celc/solver/options.hpp"
 
+#include <cmath>
 #include <sstream>
 
 namespace celc {
@@ -18,6 +19,7 @@ std::string LinearOptions::validate() const {
   if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
   if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
   if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
+  if (!(min_window_parallax >= 0.0)) e << "min_window_parallax must be >= 0; ";
   return e.str();
 }
 
@@ -40,8 +42,19 @@ std::string MlOptions::validate() const {
   return e;
 }
 
+std::string UncertaintyOptions::validate() const {
+  std::string e;
+  if (max_events < 0) e += "uncertainty.max_events must be >= 0; ";
+  for (double s : {scale_celc, scale_celc_opt, scale_celc_ml, scale_ce3lc, scale_npt})
+    if (!(s >= 0.0) || !std::isfinite(s)) {
+      e += "uncertainty.scale_* must be finite and >= 0; ";
+      break;
+    }
+  return e;
+}
+
 std::string SolverOptions::validate() const {
-  return linear.validate() + refine.validate() + npt.validate() + ml.validate();
+  return linear.validate() + refine.validate() + npt.validate() + ml.validate() + uncertainty.validate();
 }
 
 }  // namespace celc

@@ -20,6 +20,10 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
           o.min_parallax_ratio);
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);
+  v.field({"min_window_parallax", "-", "median static/moving ratio over the clusters below this -> no parallax"},
+          o.min_window_parallax);
+  v.field({"min_window_parallax_clusters", "", "... in windows with at least this many measured clusters"},
+          o.min_window_parallax_clusters);
   v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
 }
 
@@ -53,11 +57,23 @@ void describe(FieldVisitor& v, MlOptions& o) {
           o.screen_events);
 }
 
+void describe(FieldVisitor& v, UncertaintyOptions& o) {
+  v.field({"enabled", "", "report sigma_deg, the direction's standard deviation, per estimate"}, o.enabled);
+  v.field({"max_events", "events", "events per window used for it (0 = all)"}, o.max_events);
+  v.field({"scale_celc", "-", "calibration factor of sigma_deg for celc"}, o.scale_celc);
+  v.field({"scale_celc_opt", "-", "... for celc_opt"}, o.scale_celc_opt);
+  v.field({"scale_celc_ml", "-", "... for celc_ml"}, o.scale_celc_ml);
+  v.field({"scale_ce3lc", "-", "... for ce3lc"}, o.scale_ce3lc);
+  v.field({"scale_npt", "-", "... for npt"}, o.scale_npt);
+}
+
 void describe(FieldVisitor& v, SolverOptions& o) {
   v.section({"linear", "", "robust linear stage (CELC, CE3LC)"}, [&](FieldVisitor& s) { describe(s, o.linear); });
   v.section({"refine", "", "Ceres refinement (celc_opt, celc_ml)"}, [&](FieldVisitor& s) { describe(s, o.refine); });
   v.section({"npt", "", "N-point linear solver (Gao et al. 2024)"}, [&](FieldVisitor& s) { describe(s, o.npt); });
   v.section({"ml", "", "celc_ml: joint refinement of v and the lines"}, [&](FieldVisitor& s) { describe(s, o.ml); });
+  v.section({"uncertainty", "", "sigma_deg per estimate (Fisher information at the estimate)"},
+            [&](FieldVisitor& s) { describe(s, o.uncertainty); });
   v.field({"check_parallax", "", "degenerate (no parallax) windows are detected once per window"},
           o.check_parallax);
 }

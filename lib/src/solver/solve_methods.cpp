@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "ce3lc.hpp"
+#include "celc/solver/direction_information.hpp"
 #include "celc/solver/npt.hpp"
 #include "celc/solver/solver.hpp"
 #include "celc_linear.hpp"
@@ -77,6 +78,25 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         break;
       }
     }
+  }
+  // What every method shares (the window's verdict), and each estimate's
+  // uncertainty at its own direction.
+  const UncertaintyOptions& u = options.uncertainty;
+  for (size_t i = 0; i < out.size(); ++i) {
+    SolverResult& r = out[i];
+    r.parallax = window.parallax;
+    r.n_lines = window.n_lines;
+    r.sigma_deg = NAN;
+    if (!r.ok() || !u.enabled) continue;
+    double scale = 1.0;
+    switch (methods[i]) {
+      case Method::Celc: scale = u.scale_celc; break;
+      case Method::CelcOpt: scale = u.scale_celc_opt; break;
+      case Method::CelcMl: scale = u.scale_celc_ml; break;
+      case Method::Ce3lc: scale = u.scale_ce3lc; break;
+      case Method::Npt: scale = u.scale_npt; break;
+    }
+    r.sigma_deg = directionSigmaDeg(obs, motion, r.v, scale, u.max_events);
   }
   return out;
 }

@@ -81,6 +81,7 @@ bool windowIsDegenerate(const WindowObservations& obs, const MotionModel& motion
   // The parallax test looks at up to 120 events per cluster.
   constexpr int kParallaxEvents = 120;
   int with_events = 0, with_parallax = 0;
+  std::vector<double> ratios;
   for (int c : usable) {
     if (obs.clusters[c].size() < 8) continue;
     ++with_events;
@@ -88,11 +89,29 @@ bool windowIsDegenerate(const WindowObservations& obs, const MotionModel& motion
     if (p.static_px >= opt.min_parallax_px &&
         p.static_px >= opt.min_parallax_ratio * std::max(p.moving_px, 1e-12))
       ++with_parallax;
+    if (p.static_px > 0.0 || p.moving_px > 0.0) ratios.push_back(p.static_px / std::max(p.moving_px, 1e-12));
   }
+  // The window's parallax: the median ratio over the clusters (reported only).
+  double parallax = NAN;
+  if (!ratios.empty()) {
+    std::sort(ratios.begin(), ratios.end());
+    const size_t n = ratios.size();
+    parallax = n % 2 ? ratios[n / 2] : 0.5 * (ratios[n / 2 - 1] + ratios[n / 2]);
+  }
+  result.parallax = parallax;
   if (with_events > 0 && with_parallax < opt.min_clusters) {
     result = failure(SolveStatus::Degenerate, Degeneracy::NoParallax,
                      std::to_string(with_parallax) + " clusters show parallax, need " +
                          std::to_string(opt.min_clusters));
+    result.parallax = parallax;
+    return true;
+  }
+  if (static_cast<int>(ratios.size()) >= opt.min_window_parallax_clusters &&
+      parallax < opt.min_window_parallax) {
+    result = failure(SolveStatus::Degenerate, Degeneracy::NoParallax,
+                     "window parallax " + std::to_string(parallax) + " (median over clusters) below " +
+                         std::to_string(opt.min_window_parallax));
+    result.parallax = parallax;
     return true;
   }
   return false;
@@ -103,9 +122,10 @@ SolverResult checkWindow(const WindowObservations& obs, const MotionModel& motio
   const auto start = Clock::now();
   SolverResult result;
   if (rejectInput(obs, motion, opt, result)) return result;
-  if (!windowIsDegenerate(obs, motion, usableClusters(obs, opt.min_cluster_events), opt,
-                          check_parallax, result))
+  const std::vector<int> usable = usableClusters(obs, opt.min_cluster_events);
+  if (!windowIsDegenerate(obs, motion, usable, opt, check_parallax, result))
     result.status = SolveStatus::Ok;
+  result.n_lines = static_cast<int>(usable.size());
   result.time_us = microsecondsSince(start);
   return result;
 }

@@ -4,6 +4,7 @@
 /// per-method summary of a run, and the error tables in the paper's layout
 /// (Tables 1 and 2: per sequence the rows eps and phi, one column per method,
 /// the best in bold) as Markdown, LaTeX (booktabs) and CSV.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -12,8 +13,14 @@
 
 namespace celc {
 
-/// The header of windows.csv.
+/// The header of windows.csv: the 16 columns of the first format, then the
+/// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz (README, docs/runs.md).
 std::string windowsCsvHeader();
+/// The header of files written before the quality columns (still read).
+std::string windowsCsvHeaderV1();
+/// A row of the first format (16 columns) padded with empty quality columns;
+/// other lines are returned as they are.
+std::string padWindowsCsvLine(const std::string& line);
 
 struct WindowsCsvRow {
   std::int64_t window = 0;
@@ -24,12 +31,22 @@ struct WindowsCsvRow {
   bool has_v = false, has_gt = false, has_metrics = false;
   Vec3 v = Vec3::Zero(), gt = Vec3::Zero();
   double eps = 0.0, phi = 0.0, runtime_ms = 0.0;
+  // Quality columns (empty in files of the first format).
+  std::string reason;           ///< degeneracy or failure reason; empty when ok
+  double sigma_deg = NAN;       ///< standard deviation of the direction [deg]; NaN: none
+  double parallax = NAN;        ///< the window's parallax ratio [-]; NaN: none
+  int n_lines = -1;             ///< usable clusters; -1: none
+  bool has_omega = false;
+  Vec3 omega = Vec3::Zero();    ///< angular velocity used [rad/s], camera frame
 };
 
 /// Reads a windows.csv; throws std::runtime_error("FILE:LINE: ...") on a wrong
 /// header, column count or number. An incomplete last line (an interrupted
 /// write) is ignored when `tolerate_truncated_tail`.
 std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate_truncated_tail = true);
+
+/// The summary's default threshold on sigma_deg for the windows a user would keep [deg].
+inline constexpr double kDefaultKeepSigmaDeg = 5.0;
 
 /// Per method over a run's windows.
 struct MethodSummary {
@@ -43,10 +60,19 @@ struct MethodSummary {
   /// Mean resultant length of the sign-resolved unit estimates (1 = all equal)
   /// and the median angle to their mean direction [rad].
   double resultant_length = NAN, spread_median = NAN;
+  /// The windows a user would keep: ok and sigma_deg <= max_sigma_deg.
+  double max_sigma_deg = NAN;   ///< the threshold used [deg]
+  int kept = 0;                 ///< ok rows with sigma_deg <= max_sigma_deg
+  int kept_with_metrics = 0;
+  double kept_phi_mean = NAN, kept_phi_median = NAN;   ///< [rad], over kept rows with ground truth
+  double kept_resultant_length = NAN;                  ///< R over the kept rows
 };
 
 /// Summaries in the order methods first appear.
-std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows);
+/// With max_sigma_deg finite, the ok rows whose sigma_deg exceeds it (or
+/// have none) count as not kept: `kept` and the kept_* fields describe the rest.
+std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows,
+                                     double max_sigma_deg = kDefaultKeepSigmaDeg);
 
 /// summary.md of a run: per method windows ok, mean and median eps and phi.
 std::string summaryMarkdown(const std::string& title, const std::vector<MethodSummary>& methods,

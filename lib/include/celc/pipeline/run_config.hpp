@@ -38,6 +38,11 @@ struct RunConfig {
   MotionModelKind motion = MotionModelKind::ConstantTwist;
   OmegaSource omega_source = OmegaSource::Gyro;
   Vec3 fixed_omega = Vec3::Zero();  ///< [rad/s], camera frame, with OmegaSource::Fixed
+  /// Constant gyroscope bias [rad/s], IMU frame: subtracted from every gyro
+  /// sample before the calibration's R_cam_imu rotates it into the camera frame
+  /// (SequenceRunner, where the gyro track is built). `celc info` reports the
+  /// mean rate over the recording's first still second, an estimate of it.
+  Vec3 gyro_bias = Vec3::Zero();
   GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;

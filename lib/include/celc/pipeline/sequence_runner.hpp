@@ -50,6 +50,11 @@ struct WindowRecord {
   bool has_gt = false;
   Vec3 gt = Vec3::Zero();       ///< unit ground-truth direction (camera frame at t0)
   double gt_speed = 0.0;        ///< [m/s]
+  /// The angular velocity the solvers used [rad/s], camera frame: the fixed
+  /// one, or the window's mean gyro rate (gyro bias subtracted); has_omega
+  /// false when the window has none (no_gyro, not_covered, gyro_gap).
+  bool has_omega = false;
+  Vec3 omega = Vec3::Zero();
   StageTimes times;
 };
 

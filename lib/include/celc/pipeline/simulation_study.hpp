@@ -22,6 +22,10 @@ struct Sweep {
   std::vector<double> levels;
   /// Sets the swept parameter of the scene to a level.
   std::function<void(LineSceneOptions&, double)> apply;
+  /// Trials without a true direction (speed 0) are scored: an ok result
+  /// counts with phi = eps = pi (the sigma study's pure rotation). Else they
+  /// count as not ok, as in the paper's speed sweep.
+  bool score_without_truth = false;
 };
 
 /// The paper's sweeps: event_noise, line_noise, omega_noise, speed, interval,
@@ -29,6 +33,10 @@ struct Sweep {
 const std::vector<Sweep>& paperSweeps();
 /// Looks a sweep up by name; throws std::invalid_argument listing the names.
 const Sweep& findSweep(const std::string& name);
+/// The settings of the uncertainty study (`celc simulate --study sigma`):
+/// the default and a few levels of each paper sweep, plus `pure_rotation`
+/// (speed 0; |w| 0.3-3 rad/s; windows 0.05-1 s).
+const std::vector<Sweep>& sigmaSweeps();
 
 /// One row of `<sweep>.csv`.
 struct SweepCell {
@@ -42,6 +50,11 @@ struct SweepCell {
   double phi_median_sign_agnostic = 0.0;
   double time_median_us = 0.0;  ///< median solver time of the ok trials
   int sign_right = 0;           ///< ok trials with phi < pi/2
+  /// ok trials with phi <= 2 sigma_deg (the calibration of the uncertainty),
+  /// and ok trials with sigma_deg below 10 deg.
+  int covered_2sigma = 0;
+  int confident_10deg = 0;
+  double sigma_median_deg = NAN;  ///< median sigma_deg of the ok trials
 };
 
 /// Runs every level of a sweep with `threads` workers (0 = all cores).

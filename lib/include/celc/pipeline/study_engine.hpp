@@ -35,6 +35,7 @@ struct MethodOutcome {
   double phi = 0.0;                ///< [rad]
   double phi_sign_agnostic = 0.0;  ///< min(phi, pi - phi) [rad]
   double time_us = 0.0;            ///< solver time of the method
+  double sigma_deg = NAN;          ///< the estimate's standard deviation [deg] (SolverResult)
 };
 
 /// One trial: an outcome per method (in the study's method order; missing

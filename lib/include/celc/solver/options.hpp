@@ -39,6 +39,14 @@ struct LinearOptions {
   /// in time (robust scales); fewer than min_clusters such clusters -> degenerate.
   double min_parallax_ratio = 1.5;
   double min_parallax_px = 0.5;  ///< and the static-line scale exceeds this [px]
+  /// The window's parallax (the median over its clusters of the static /
+  /// moving ratio above) below this -> degenerate / no_parallax, however many
+  /// single clusters pass: a window the rotation explains (pure rotation)
+  /// has a median near 1 even when a few noisy clusters pass (docs/uncertainty.md).
+  double min_window_parallax = 1.1;
+  /// ... applied to windows with at least this many measured clusters (with
+  /// fewer, the per-cluster test alone decides, as it always did).
+  int min_window_parallax_clusters = 6;
   bool resolve_sign = true;      ///< cheirality test; else the sign is arbitrary
   std::string validate() const;
 };
@@ -90,11 +98,30 @@ struct MlOptions {
   std::string validate() const;  ///< empty when valid
 };
 
+/// The uncertainty reported with every estimate (SolverResult::sigma_deg):
+/// the standard deviation of the direction sqrt(trace C) from the Fisher
+/// information of the event-line likelihood at the estimate and the fitted
+/// lines, C = s^2 S^-1 with s the robust scale of the residuals there
+/// (direction_information.hpp), times a per-method factor. The factors
+/// calibrate the Fisher value (the ML bound) to each method's actual spread,
+/// so that about 9 in 10 windows have phi <= 2 sigma (docs/uncertainty.md).
+struct UncertaintyOptions {
+  bool enabled = true;          ///< compute sigma_deg (off: NaN)
+  int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
+  double scale_celc = 2.5;      ///< [-] factor for method celc
+  double scale_celc_opt = 2.5;  ///< [-] for celc_opt
+  double scale_celc_ml = 1.0;   ///< [-] for celc_ml (the ML estimate: the Fisher value itself)
+  double scale_ce3lc = 8.0;     ///< [-] for ce3lc (not calibrated: heavy-tailed errors)
+  double scale_npt = 30.0;      ///< [-] for npt (not calibrated: heavy-tailed errors)
+  std::string validate() const;  ///< empty when valid
+};
+
 struct SolverOptions {
   LinearOptions linear;
   RefineOptions refine;
   NptOptions npt;
   MlOptions ml;
+  UncertaintyOptions uncertainty;
   /// Run the parallax test of the window checks (solveMethods, once per
   /// window). Off where every window is known to move and outliers would
   /// inflate the test's robust scales (the peer study).
@@ -107,6 +134,7 @@ void describe(FieldVisitor& v, LinearOptions& options);
 void describe(FieldVisitor& v, RefineOptions& options);
 void describe(FieldVisitor& v, NptOptions& options);
 void describe(FieldVisitor& v, MlOptions& options);
+void describe(FieldVisitor& v, UncertaintyOptions& options);
 void describe(FieldVisitor& v, SolverOptions& options);
 
 }  // namespace celc

@@ -2,6 +2,7 @@
 /// \file result.hpp
 /// What a solver returns for one window: a status (never an exception on
 /// data), the direction and what the solve saw.
+#include <cmath>
 #include <string>
 
 #include "celc/core/types.hpp"
@@ -27,6 +28,17 @@ struct SolverResult {
   double residual_px = 0.0;       ///< robust residual scale (1.4826 MAD) [px]
   double sign_margin = 0.0;       ///< cheirality vote: (votes for - against) / clusters, in [0, 1] after resolution
   double time_us = 0.0;           ///< wall time of this method alone [us]
+  /// Standard deviation of the direction [deg] (solver/direction_information.hpp,
+  /// SolverOptions::uncertainty): set by solveMethods for ok results; +inf when
+  /// the direction is unobservable at the estimate, NaN when not computed.
+  double sigma_deg = NAN;
+  /// The window's measured parallax, shared by every method (solveMethods):
+  /// the median over the clusters with >= 8 events of the ratio of the robust
+  /// scales of the rotation-compensated events about one static line and about
+  /// a line moving linearly in time [-] (1: no parallax; the test needs
+  /// min_parallax_ratio). NaN when the test did not run.
+  double parallax = NAN;
+  int n_lines = 0;                ///< usable clusters of the window (shared by every method)
   bool ok() const { return status == SolveStatus::Ok; }
 };
 

@@ -1,0 +1,127 @@
+// Fisher information about the velocity direction, lines as nuisance.
+#include "celc/solver/direction_information.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "celc/solver/celc_residual.hpp"
+#include "sampling.hpp"
+
+namespace celc {
+namespace {
+
+using Mat32 = Eigen::Matrix<double, 3, 2>;
+using Mat4 = Eigen::Matrix4d;
+using Mat24 = Eigen::Matrix<double, 2, 4>;
+
+// Orthonormal basis of the tangent plane of the unit sphere at u.
+Mat32 tangentBasis(const Vec3& u) {
+  const Vec3 a = std::abs(u.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 b1 = u.cross(a).normalized();
+  Mat32 B;
+  B.col(0) = b1;
+  B.col(1) = u.cross(b1);
+  return B;
+}
+
+// Moore-Penrose pseudo-inverse of a symmetric positive semi-definite matrix.
+template <typename M>
+M pinvSymmetric(const M& A) {
+  const Eigen::SelfAdjointEigenSolver<M> es(A);
+  const auto& ev = es.eigenvalues();
+  const double tol = 1e-10 * std::max(std::abs(ev(ev.size() - 1)), 1e-300);
+  M D = M::Zero();
+  for (int i = 0; i < ev.size(); ++i)
+    if (ev(i) > tol) D(i, i) = 1.0 / ev(i);
+  return es.eigenvectors() * D * es.eigenvectors().transpose();
+}
+
+}  // namespace
+
+DirectionInformation directionInformation(const WindowObservations& obs, const MotionModel& motion,
+                                          const Vec3& direction, int max_events, bool keep_residuals) {
+  DirectionInformation out;
+  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(obs.focal_px > 0.0)) {
+    out.message = "invalid direction or focal length";
+    return out;
+  }
+  std::size_t total = 0;
+  for (const auto& c : obs.clusters) total += c.size();
+  const std::size_t stride =
+      max_events > 0 ? std::max<std::size_t>(1, total / static_cast<std::size_t>(max_events)) : 1;
+  const Vec3 v = direction.normalized();
+  const Mat32 Bv = tangentBasis(v);
+  for (const auto& c : obs.clusters) {
+    if (!(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
+    if (!(c.l1.normal.norm() > 0.0) || !(c.l3.normal.norm() > 0.0)) continue;
+    const ClusterFrame fr = makeClusterFrame(c, motion);
+    const Vec3 m1 = fr.m1.normalized(), m3 = fr.m3.normalized();
+    const Mat32 B1 = tangentBasis(m1), B3 = tangentBasis(m3);
+    Eigen::Matrix2d Ivv = Eigen::Matrix2d::Zero();
+    Mat24 Ivl = Mat24::Zero();
+    Mat4 Ill = Mat4::Zero();
+    int n = 0;
+    for (size_t k = 0; k < c.size() && k < c.bearings.size(); k += stride) {
+      if (!std::isfinite(c.times[k]) || !c.bearings[k].allFinite()) continue;
+      Mat3 Rk, Pk;
+      motion.pose(c.times[k], Rk, Pk);
+      const EventTerm e = makeEventTerm(fr, Rk, Pk, c.bearings[k]);
+      Vec3 gv, g1, g3;
+      const double d = eventDistance(e, v, m1, m3, obs.focal_px, &gv, &g1, &g3);
+      if (!std::isfinite(d) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite()) continue;
+      const Eigen::Vector2d jv = Bv.transpose() * gv;
+      Eigen::Vector4d jl;
+      jl << B1.transpose() * g1, B3.transpose() * g3;
+      Ivv += jv * jv.transpose();
+      Ivl += jv * jl.transpose();
+      Ill += jl * jl.transpose();
+      if (keep_residuals) out.residuals_px.push_back(d);
+      ++n;
+    }
+    if (n == 0) continue;
+    out.events += n;
+    ++out.lines;
+    out.schur += Ivv - Ivl * pinvSymmetric(Ill) * Ivl.transpose();
+  }
+  if (out.events == 0) {
+    out.message = "no usable events (clusters need l1, l3 with l3.t > l1.t)";
+    return out;
+  }
+  out.ok = true;
+  return out;
+}
+
+DirectionCovariance directionCovariance(const Eigen::Matrix2d& schur, double sigma_px) {
+  DirectionCovariance out;
+  if (sigma_px == 0.0) {
+    out.observable = true;  // noise-free: zero covariance
+    return out;
+  }
+  Eigen::Matrix2d S = schur / (sigma_px * sigma_px);
+  S = 0.5 * (S + S.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+  if (!(es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(1), 1e-300))) {
+    out.rms_rad = std::numeric_limits<double>::infinity();
+    out.covariance.setConstant(std::numeric_limits<double>::infinity());
+    return out;
+  }
+  out.observable = true;
+  out.covariance = S.inverse();
+  out.rms_rad = std::sqrt(out.covariance.trace());
+  return out;
+}
+
+double directionSigmaDeg(const WindowObservations& obs, const MotionModel& motion,
+                         const Vec3& direction, double scale, int max_events) {
+  DirectionInformation info = directionInformation(obs, motion, direction, max_events, true);
+  if (!info.ok) return NAN;
+  const double s = 1.4826 * detail::medianAbs(info.residuals_px);
+  if (!(s > 0.0) || !std::isfinite(s)) return NAN;
+  const DirectionCovariance c = directionCovariance(info.schur, s);
+  if (!c.observable) return std::numeric_limits<double>::infinity();
+  return scale * c.rms_rad * 180.0 / M_PI;
+}
+
+}  // namespace celc
