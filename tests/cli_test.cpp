@@ -77,7 +77,7 @@ TEST(Cli, SolveOnLabelledEventsRecoversVelocity) {
     calib << "camera: {width: 346, height: 260, fx: 320, fy: 320, cx: 173, cy: 130}\n";
   }
   const auto r = runCelc("solve '" + (d / "events.csv").string() + "' --omega 0,0,2 --calib '" +
-                             (d / "calib.yaml").string() + "' --interval-fraction 0.1",
+                             (d / "calib.yaml").string() + "' ",
                          d);
   ASSERT_EQ(r.status, 0) << readAll(d / "stderr.txt");
   std::stringstream ss(r.out);

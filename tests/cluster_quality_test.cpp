@@ -177,7 +177,7 @@ TEST(ClusterQuality, BoundaryLinesMatchTrueLines) {
     ObservationReport rep;
     const WindowObservations obs =
         toObservations(w.events, r, [&](const Vec2& p) { return w.camera.bearing(p); },
-                       w.camera.focal(), ObservationOptions{}, &rep);
+                       w.camera.focal(), ObservationOptions{}, nullptr, &rep);
     EXPECT_EQ(rep.n_used, static_cast<int>(obs.clusters.size()));
     EXPECT_GE(rep.n_used, 7);
     for (const ClusterObservation& c : obs.clusters) {
@@ -297,7 +297,7 @@ TEST(ClusterDegenerate, ObservationsFromNothing) {
   const ClusterResult r = clusterEvents({}, ClusterOptions{});
   ObservationReport rep;
   const WindowObservations obs = toObservations(
-      {}, r, [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 200.0, ObservationOptions{}, &rep);
+      {}, r, [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 200.0, ObservationOptions{}, nullptr, &rep);
   EXPECT_TRUE(obs.clusters.empty());
   EXPECT_EQ(rep.n_used, 0);
 }

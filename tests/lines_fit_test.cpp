@@ -81,7 +81,9 @@ TEST(LinesFit, EndLinesAtClusterEnds) {
   std::vector<double> t;
   std::vector<Vec3> b;
   line.sample(2000, 0.0, 0.1, 0.5, 4, t, b);  // times 0..0.1 s
-  LineFitOptions opt;  // 5 ms intervals
+  LineFitOptions opt;  // the paper's: still lines over 5 ms intervals
+  opt.model = LineModel::Static;
+  opt.interval_fraction = 0.0;
   const ClusterLines cl = fitClusterLines(t, b, kFocal, opt);
   ASSERT_TRUE(cl.ok());
   EXPECT_FALSE(cl.l1.slid);
@@ -112,6 +114,8 @@ TEST(LinesFit, SparseEndSlidesTowardCentre) {
   t.insert(t.end(), t2.begin(), t2.end());
   b.insert(b.end(), b2.begin(), b2.end());
   LineFitOptions opt;
+  opt.model = LineModel::Static;
+  opt.interval_fraction = 0.0;
   opt.min_events = 8;
   const ClusterLines cl = fitClusterLines(t, b, kFocal, opt);
   ASSERT_EQ(cl.l1.status, LineFitStatus::Ok);
@@ -122,6 +126,77 @@ TEST(LinesFit, SparseEndSlidesTowardCentre) {
   EXPECT_LT(cl.l1.t_last, cl.l1.t_end);
   EXPECT_LT(angleDeg(cl.l1.line.normal, line.normalAt(cl.l1.line.t)), 0.5);
   EXPECT_FALSE(cl.l3.slid);
+}
+
+// The moving model (the default): a line moving 0.2 normalised units/s
+// (40 px/s) is fitted exactly at the interval's mean time however long the
+// interval, and a sparse end grows its interval instead of being rejected.
+TEST(LinesFit, MovingLineIsExactAtItsTimeAndSparseEndsGrow) {
+  const MovingLine line;
+  std::vector<double> t;
+  std::vector<Vec3> b;
+  line.sample(2000, 0.0, 0.5, 0.0, 4, t, b);
+  for (double fraction : {0.05, 0.2, 0.5}) {
+    LineFitOptions opt;
+    opt.interval_fraction = fraction;
+    const ClusterLines cl = fitClusterLines(t, b, kFocal, opt);
+    ASSERT_TRUE(cl.ok()) << fraction;
+    for (const FittedLine* f : {&cl.l1, &cl.l2, &cl.l3}) {
+      EXPECT_EQ(f->status, LineFitStatus::Ok);
+      // Noise-free: exact to rounding (a still-line fit is off by the motion).
+      EXPECT_LT(angleDeg(f->line.normal, line.normalAt(f->line.t)), 1e-6) << fraction;
+      EXPECT_LT(f->rms_px, 1e-6);
+      EXPECT_GE(f->line.t, f->t_first);
+      EXPECT_LE(f->line.t, f->t_last);
+    }
+    // Interval of the requested share; the line at its events' mean time.
+    EXPECT_NEAR(cl.l1.t_end - cl.l1.t_begin, fraction * (t.back() - t.front()), 1e-12);
+    EXPECT_NEAR(cl.l1.line.t, 0.5 * (cl.l1.t_first + cl.l1.t_last), 0.01 * fraction);
+  }
+  // 20 events over 0.5 s with 0.5 px noise: the 20% intervals (about 4
+  // events) grow until they hold min_events = 8.
+  std::vector<double> ts;
+  std::vector<Vec3> bs;
+  line.sample(20, 0.0, 0.5, 0.5, 5, ts, bs);
+  const ClusterLines sparse = fitClusterLines(ts, bs, kFocal, LineFitOptions{});
+  ASSERT_TRUE(sparse.ok());
+  EXPECT_TRUE(sparse.l1.slid && sparse.l3.slid);
+  EXPECT_GE(sparse.l1.n_events, 8);
+  EXPECT_GT(sparse.l3.line.t - sparse.l1.line.t, 0.1);
+  // A 0.5 px error at the ends of a 64 px line: about 1 deg.
+  EXPECT_LT(angleDeg(sparse.l1.line.normal, line.normalAt(sparse.l1.line.t)), 2.0);
+  EXPECT_LT(angleDeg(sparse.l3.line.normal, line.normalAt(sparse.l3.line.t)), 2.0);
+}
+
+// The moving model removes the rotation before fitting: a still 3D line seen
+// by a camera rotating at 3 rad/s is fitted exactly over a long interval.
+TEST(LinesFit, MovingModelRemovesTheRotation) {
+  const Vec3 w(0.5, -2.0, 2.2);  // |w| = 3 rad/s
+  const MotionModel motion = MotionModel::constantTwist(w, 0.0);
+  const Vec3 P(0.3, -0.2, 4.0), d = Vec3(1.0, 0.4, 0.2).normalized();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(-0.8, 0.8);
+  std::vector<double> t;
+  std::vector<Vec3> b;
+  for (int i = 0; i < 600; ++i) {
+    const double ti = 0.3 * i / 599.0;
+    const Vec3 Xc = motion.rotation(ti).transpose() * (P + U(rng) * d);  // camera still at the origin
+    t.push_back(ti);
+    b.push_back(Xc / Xc.z());
+  }
+  auto trueNormal = [&](double ti) {
+    const Mat3 Rt = motion.rotation(ti).transpose();
+    return Vec3((Rt * P).cross(Rt * d));
+  };
+  LineFitOptions opt;
+  opt.interval_fraction = 0.5;  // 0.45 rad of rotation inside each interval
+  const ClusterLines moving = fitClusterLines(t, b, kFocal, opt, &motion);
+  ASSERT_TRUE(moving.ok());
+  EXPECT_LT(angleDeg(moving.l1.line.normal, trueNormal(moving.l1.line.t)), 1e-6);
+  EXPECT_LT(angleDeg(moving.l3.line.normal, trueNormal(moving.l3.line.t)), 1e-6);
+  // Without the rotation, a normal linear in time absorbs it only to first order.
+  const ClusterLines blind = fitClusterLines(t, b, kFocal, opt);
+  EXPECT_GT(angleDeg(blind.l1.line.normal, trueNormal(blind.l1.line.t)), 0.1);
 }
 
 TEST(LinesFit, QualityFlags) {

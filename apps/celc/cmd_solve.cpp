@@ -8,25 +8,26 @@
 #include <map>
 #include <sstream>
 
+#include "celc/cluster/to_observations.hpp"
 #include "celc/config/config.hpp"
 #include "celc/core/text.hpp"
+#include "celc/core/yaml.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/io/calibration.hpp"
 #include "celc/io/labelled_events.hpp"
-#include "celc/lines/line_fit.hpp"
+#include "celc/pipeline/run_config.hpp"
 #include "celc/solver/solver.hpp"
 #include "commands.hpp"
+#include "run_common.hpp"
 
 namespace celc::app {
 namespace {
 
 struct SolveArgs {
-  std::string events, calib, methods = "celc,celc_opt,celc_ml,ce3lc,npt", omega = "0,0,0", gyro;
+  std::string events, calib, methods, omega = "0,0,0", gyro, config;
+  std::vector<std::string> sets;
   bool normalized = false, quiet = false, verbose = false;
   double focal = 320.0;
-  double interval_ms = 5.0;
-  double interval_fraction = 0.0;
-  int min_events = 8;
 };
 
 Vec3 parseVec3(const std::string& text, const std::string& what) {
@@ -69,47 +70,61 @@ MotionModel loadGyro(const std::string& path, double t_ref) {
 
 void runSolve(const SolveArgs& a) {
   configureLogging(a.quiet, a.verbose);
-  const auto events = readLabelledEvents(a.events);
+  // The run configuration: its lines, observations and solver sections (the
+  // pipeline's own defaults), then -c FILE and --set.
+  RunConfig cfg = a.config.empty() ? RunConfig{} : loadRunConfig(a.config);
+  applySets(a.sets, cfg);
+  if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
+  if (const std::string err = cfg.validate(); !err.empty()) throw std::runtime_error("configuration: " + err);
+
+  const auto labelled = readLabelledEvents(a.events);
   if (a.calib.empty() && !a.normalized)
     throw std::runtime_error("solve: pixel events need --calib FILE (or pass --normalized)");
   CameraModel cam;
   if (!a.calib.empty()) cam = loadCalibration(a.calib).camera;
   else cam.fx = cam.fy = a.focal;
 
-  // Group by cluster (id >= 0), sorted by time.
-  std::map<int, std::vector<LabelledEvent>> groups;
-  for (const auto& e : events)
-    if (e.cluster >= 0) groups[e.cluster].push_back(e);
-  WindowObservations obs;
-  obs.focal_px = cam.focal();
-  LineFitOptions fit;
-  fit.interval_s = a.interval_ms * 1e-3;
-  fit.interval_fraction = a.interval_fraction;
-  fit.min_events = a.min_events;
-  if (const auto err = fit.validate(); !err.empty()) throw std::runtime_error("solve: " + err);
+  // The labels as a clustering result (cluster ids in order of first
+  // appearance), so that the pipeline's toObservations builds the input.
+  std::vector<Event> events;
+  ClusterResult clusters;
+  clusters.status = ClusterStatus::Ok;
+  std::map<int, int> index_of;
   double t_min = 1e300;
-  for (auto& [id, evs] : groups) {
-    std::sort(evs.begin(), evs.end(), [](const auto& x, const auto& y) { return x.t < y.t; });
-    ClusterObservation c;
-    c.id = id;
-    for (const auto& e : evs) {
-      c.times.push_back(e.t);
-      c.bearings.push_back(a.normalized ? Vec3(e.x, e.y, 1.0) : cam.bearing(Vec2(e.x, e.y)));
+  for (const auto& e : labelled) {
+    events.push_back(Event{e.t, static_cast<float>(e.x), static_cast<float>(e.y), true});
+    int label = -1;
+    if (e.cluster >= 0) {
+      auto [it, added] = index_of.emplace(e.cluster, static_cast<int>(clusters.clusters.size()));
+      if (added) {
+        ClusterStats stats;
+        stats.id = e.cluster;
+        clusters.clusters.push_back(stats);
+      }
+      label = it->second;
+      t_min = std::min(t_min, e.t);
     }
-    if (!attachFittedLines(c, obs.focal_px, fit)) {
-      spdlog::warn("cluster {}: too few events to fit its start and end lines; skipped", id);
-      continue;
-    }
-    t_min = std::min(t_min, c.times.front());
-    obs.clusters.push_back(std::move(c));
+    clusters.labels.push_back(label);
   }
-  spdlog::info("solve: {} events, {} clusters with lines", events.size(), obs.clusters.size());
-  if (obs.clusters.empty()) t_min = 0.0;
+  if (clusters.clusters.empty()) t_min = 0.0;
   const MotionModel motion = a.gyro.empty()
                                  ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_min)
                                  : loadGyro(a.gyro, t_min);
-  const auto methods = parseMethodList(a.methods);
-  const auto results = solveMethods(obs, motion, methods, SolverOptions{});
+  // Event positions are floats: 3e-5 px at 300 px, 6e-8 in normalised units.
+  const BearingFunction bearing = [&](const Vec2& p) {
+    return a.normalized ? Vec3(p.x(), p.y(), 1.0) : cam.bearing(p);
+  };
+  ObservationReport report;
+  const WindowObservations obs =
+      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
+  for (std::size_t k = 0; k < clusters.clusters.size(); ++k)
+    if (std::find(report.used_ids.begin(), report.used_ids.end(), clusters.clusters[k].id) ==
+        report.used_ids.end())
+      spdlog::warn("cluster {}: skipped (fewer than {} events, or its start and end lines could not be fitted)",
+                   clusters.clusters[k].id, cfg.observations.min_events);
+  spdlog::info("solve: {} events, {} clusters with lines", events.size(), obs.clusters.size());
+  const auto& methods = cfg.methods;
+  const auto results = solveMethods(obs, motion, methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
   std::cout << "method,status,vx,vy,vz,runtime_us\n";
   for (size_t i = 0; i < methods.size(); ++i) {
     const auto& r = results[i];
@@ -128,8 +143,8 @@ void registerSolve(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "solve",
       "Solvers alone on labelled events (CSV header t,x,y,cluster; seconds, pixels; cluster -1 = "
-      "unassigned). Fits each cluster's l1/l3 (and l2) from its first/last events and prints "
-      "method,status,vx,vy,vz,runtime_us to stdout (v: unit direction, camera frame).");
+      "unassigned). Builds each cluster's observation and lines as `celc run` does (its configuration: "
+      "-c / --set) and prints method,status,vx,vy,vz,runtime_us to stdout (v: unit direction, camera frame).");
   cmd->add_option("events", a->events, "labelled events CSV")->required()->check(CLI::ExistingFile);
   cmd->add_option("--omega", a->omega, "constant angular velocity wx,wy,wz [rad/s], camera frame")
       ->capture_default_str();
@@ -141,14 +156,17 @@ void registerSolve(CLI::App& app) {
   cmd->add_flag("--normalized", a->normalized, "x, y are normalised (undistorted) coordinates");
   cmd->add_option("--focal", a->focal, "focal length [px] for pixel thresholds with --normalized")
       ->capture_default_str();
-  cmd->add_option("--methods", a->methods, "comma-separated methods")->capture_default_str();
-  cmd->add_option("--interval-ms", a->interval_ms, "end-interval length for l1/l3 [ms]")
-      ->capture_default_str();
-  cmd->add_option("--interval-fraction", a->interval_fraction,
-                  "end interval as a fraction of the cluster's duration (overrides --interval-ms)")
-      ->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--min-events", a->min_events, "events an end interval needs (it slides inward)")
-      ->capture_default_str();
+  cmd->add_option("-c,--config", a->config, "YAML run configuration (config/run.yaml): its lines, "
+                  "observations, solver, methods and seed are used")->check(CLI::ExistingFile);
+  cmd->add_option("--set", a->sets,
+                  "override a configuration key, e.g. --set lines.interval_fraction=0.3 (repeatable; "
+                  "`celc config --keys` lists them)");
+  {
+    RunConfig defaults;
+    const Describe schema = [&](FieldVisitor& v) { describe(v, defaults); };
+    cmd->add_option("--methods", a->methods,
+                    "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "methods"));
+  }
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");
   cmd->add_flag("-v,--verbose", a->verbose, "debug logging");
   cmd->callback([a]() { runSolve(*a); });

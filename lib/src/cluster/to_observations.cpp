@@ -15,7 +15,8 @@ std::string ObservationOptions::validate() const {
 
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
-                                  const ObservationOptions& options, ObservationReport* report) {
+                                  const ObservationOptions& options, const MotionModel* motion,
+                                  ObservationReport* report) {
   WindowObservations out;
   out.focal_px = focal_px;
   ObservationReport rep;
@@ -50,7 +51,7 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
       ++rep.n_too_few_events;
       continue;
     }
-    const ClusterLines lines = fitClusterLines(obs.times, obs.bearings, focal_px, options.lines);
+    const ClusterLines lines = fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion);
     if (!lines.ok()) {
       ++rep.n_line_fit_failed;
       continue;

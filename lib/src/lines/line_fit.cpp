@@ -5,7 +5,11 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "moving_line.hpp"
+
 namespace celc {
+
+std::string toString(LineModel model) { return model == LineModel::Moving ? "moving" : "static"; }
 
 std::string LineFitOptions::validate() const {
   std::ostringstream err;
@@ -13,6 +17,9 @@ std::string LineFitOptions::validate() const {
   if (!(interval_fraction >= 0.0 && interval_fraction <= 0.5))
     err << "interval_fraction must be in [0, 0.5]; ";
   if (min_events < 2) err << "min_events must be >= 2; ";
+  if (model == LineModel::Moving && min_events < 6)
+    err << "min_events must be >= 6 with the moving line model (five degrees of freedom); ";
+  if (!(target_length_px >= 0.0)) err << "target_length_px must be >= 0; ";
   if (!(max_rms_px > 0.0)) err << "max_rms_px must be > 0; ";
   if (!(min_length_px >= 0.0)) err << "min_length_px must be >= 0; ";
   return err.str();
@@ -78,7 +85,14 @@ FittedLine fitLine(const std::vector<Vec3>& bearings, const std::vector<double>&
 }
 
 namespace {
-// Fits the events with times in [t0, t1). While the interval holds fewer than
+void applyThresholds(FittedLine& f, const LineFitOptions& opt) {
+  if (f.status != LineFitStatus::Ok) return;
+  f.rms_ok = f.rms_px <= opt.max_rms_px;
+  f.length_ok = f.length_px >= opt.min_length_px;
+  if (!f.rms_ok || !f.length_ok) f.status = LineFitStatus::PoorFit;
+}
+
+// Static model: fits the events with times in [t0, t1). While the interval holds fewer than
 // min_events it slides toward `centre` by half its length; it stops sliding
 // once it reaches the centre.
 FittedLine fitInterval(const std::vector<double>& times, const std::vector<Vec3>& bearings,
@@ -98,11 +112,7 @@ FittedLine fitInterval(const std::vector<double>& times, const std::vector<Vec3>
       if (e - b >= opt.min_events) {
         f = fitLine(std::vector<Vec3>(bearings.begin() + b, bearings.begin() + e),
                     std::vector<double>(times.begin() + b, times.begin() + e), focal_px);
-        if (f.status == LineFitStatus::Ok) {
-          f.rms_ok = f.rms_px <= opt.max_rms_px;
-          f.length_ok = f.length_px >= opt.min_length_px;
-          if (!f.rms_ok || !f.length_ok) f.status = LineFitStatus::PoorFit;
-        }
+        applyThresholds(f, opt);
       } else {
         f.n_events = static_cast<int>(e - b);
       }
@@ -116,14 +126,69 @@ FittedLine fitInterval(const std::vector<double>& times, const std::vector<Vec3>
     slid = true;
   }
 }
+// Moving model: each interval starts at `len` and grows by half while it
+// holds fewer than min_events events or spans less than target_length_px,
+// up to half the cluster's duration, or three quarters while it holds too
+// few events (sparse clusters: l1 and l3 then share events, but their mean
+// times still differ by a quarter of the duration). `where` < 0: at the start, > 0: at the
+// end, 0: centred on the middle. The line is evaluated at the mean time of
+// the interval's events, where the fitted n(t) is the data's own average: at
+// the interval's edge a motion of a pixel or two, seen through integer pixel
+// positions as a staircase, would tilt the fitted slope and bias the line.
+FittedLine fitGrowing(const std::vector<double>& times, const detail::DerotatedEvents& ev,
+                      double len, int where, double focal_px, const MotionModel* motion,
+                      const LineFitOptions& opt) {
+  const double ts = times.front(), te = times.back(), tm = 0.5 * (ts + te);
+  const double half = 0.5 * (te - ts), most = 0.75 * (te - ts);
+  len = std::min(len, half);
+  FittedLine best;
+  bool grown = false;
+  for (int iter = 0; iter < 64; ++iter) {
+    const double t0 = where < 0 ? ts : where > 0 ? te - len : tm - 0.5 * len;
+    const double t1 = where < 0 ? ts + len : where > 0 ? te : tm + 0.5 * len;
+    // Closed at both ends: the first / last event belongs to its interval.
+    const auto b = static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t0) - times.begin());
+    const auto e = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t1) - times.begin());
+    FittedLine f;
+    if (e >= b + static_cast<std::size_t>(opt.min_events)) {
+      double t_line = 0.0;
+      for (std::size_t j = b; j < e; ++j) t_line += times[j] - ts;
+      t_line = ts + t_line / static_cast<double>(e - b);
+      const Mat3 R_line = motion ? motion->rotation(t_line) : Mat3::Identity();
+      f = detail::fitMovingLine(times, ev, b, e, t_line, R_line, focal_px);
+    } else {
+      f.n_events = static_cast<int>(e - b);
+    }
+    f.t_begin = t0;
+    f.t_end = t1;
+    f.slid = grown;
+    best = f;
+    const bool enough = f.status == LineFitStatus::Ok && f.length_px >= opt.target_length_px;
+    const double cap = f.n_events < opt.min_events ? most : half;
+    if (enough || len >= cap) break;
+    len = std::min(cap, 1.5 * len);
+    grown = true;
+  }
+  applyThresholds(best, opt);
+  return best;
+}
 }  // namespace
 
 ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector<Vec3>& bearings,
-                             double focal_px, const LineFitOptions& opt) {
+                             double focal_px, const LineFitOptions& opt, const MotionModel* motion) {
   ClusterLines out;
   if (times.size() < 2 || times.size() != bearings.size()) return out;
   if (!(focal_px > 0.0) || !std::is_sorted(times.begin(), times.end())) return out;
   const double ts = times.front(), te = times.back(), tm = 0.5 * (ts + te);
+  if (opt.model == LineModel::Moving) {
+    const double len = opt.interval_fraction > 0.0 ? opt.interval_fraction * (te - ts) : opt.interval_s;
+    if (!(len > 0.0) || !(te > ts)) return out;
+    const detail::DerotatedEvents ev = detail::derotate(times, bearings, motion);
+    out.l1 = fitGrowing(times, ev, len, -1, focal_px, motion, opt);
+    out.l3 = fitGrowing(times, ev, len, +1, focal_px, motion, opt);
+    out.l2 = fitGrowing(times, ev, len, 0, focal_px, motion, opt);
+    return out;
+  }
   const double len = opt.interval_fraction > 0.0 ? opt.interval_fraction * (te - ts)
                                                  : std::min(opt.interval_s, 0.5 * (te - ts));
   if (!(len > 0.0)) return out;
@@ -135,8 +200,9 @@ ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector
   return out;
 }
 
-bool attachFittedLines(ClusterObservation& cluster, double focal_px, const LineFitOptions& options) {
-  const ClusterLines lines = fitClusterLines(cluster.times, cluster.bearings, focal_px, options);
+bool attachFittedLines(ClusterObservation& cluster, double focal_px, const LineFitOptions& options,
+                       const MotionModel* motion) {
+  const ClusterLines lines = fitClusterLines(cluster.times, cluster.bearings, focal_px, options, motion);
   if (!lines.ok()) return false;
   cluster.l1 = lines.l1.line;
   cluster.l3 = lines.l3.line;

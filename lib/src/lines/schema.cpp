@@ -4,11 +4,18 @@
 namespace celc {
 
 void describe(FieldVisitor& v, LineFitOptions& o) {
-  v.field({"interval_s", "s", "length of each end interval (l1 at the start, l3 at the end)"}, o.interval_s);
-  v.field({"interval_fraction", "-", "> 0: the interval is this share of the cluster's duration"},
+  v.enumeration({"model", "", "moving: rotation removed, line linear in time (exact at constant v); static: the paper's still line"},
+                o.model, {LineModel::Moving, LineModel::Static});
+  v.field({"interval_fraction", "-", "each end interval starts as this share of the cluster's duration; 0 = interval_s"},
           o.interval_fraction);
-  v.field({"min_events", "events", "an interval needs this many; it slides inwards otherwise"}, o.min_events);
-  v.field({"max_rms_px", "px", "a fit with a larger RMS point-line distance is flagged"}, o.max_rms_px);
+  v.field({"interval_s", "s", "end interval length when interval_fraction is 0 (the paper: static, 0.005)"},
+          o.interval_s);
+  v.field({"min_events", "events", "an interval needs this many (moving: it grows; static: it slides inwards)"},
+          o.min_events);
+  v.field({"target_length_px", "px", "moving: an interval grows until its events span this far along the line"},
+          o.target_length_px);
+  v.field({"max_rms_px", "px", "a fit with a larger residual scale (moving: 1.4826 MAD; static: RMS) is flagged"},
+          o.max_rms_px);
   v.field({"min_length_px", "px", "a fit shorter than this along the line is flagged"}, o.min_length_px);
 }
 

@@ -185,7 +185,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   };
   ObservationReport report;
   const WindowObservations obs =
-      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &report);
+      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
   rec.n_clusters = static_cast<int>(obs.clusters.size());
   rec.times.lines = secondsSince(start);
 

@@ -16,14 +16,6 @@ CameraModel PeerSceneOptions::defaultCamera() {
   return c;
 }
 
-LineFitOptions PeerSceneOptions::defaultLineFit() {
-  LineFitOptions o;
-  o.interval_fraction = 0.1;
-  o.min_events = 4;
-  o.max_rms_px = 1e9;
-  return o;
-}
-
 std::string PeerSceneOptions::validate() const {
   std::ostringstream e;
   if (n_lines < 1) e << "n_lines must be >= 1; ";
@@ -36,7 +28,6 @@ std::string PeerSceneOptions::validate() const {
   if (!(min_separation_px >= 0.0)) e << "min_separation_px must be >= 0; ";
   if (!(depth_range[0] > 0.0 && depth_range[1] >= depth_range[0])) e << "depth_range must be 0 < min <= max; ";
   if (max_attempts < 1 || max_motion_draws < 1) e << "max_attempts and max_motion_draws must be >= 1; ";
-  if (min_fit_events < 2) e << "min_fit_events must be >= 2; ";
   e << camera.validate() << line_fit.validate();
   return e.str();
 }
@@ -135,7 +126,8 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
       trial.true_motion.pose(t, R, P);
       const Vec3 Xc = inCamera(R, P * v, seg[0] + s * (seg[1] - seg[0]));
       const Vec2 px = cam.project(Xc);
-      const Vec2 noisy = px + Vec2(noise(rng), noise(rng));
+      Vec2 noisy = px + Vec2(noise(rng), noise(rng));
+      if (o.integer_pixels) noisy = noisy.array().round().matrix();
       raw.push_back({t, cam.bearing(px), cam.bearing(noisy), true});
     }
     std::sort(raw.begin(), raw.end(), [](const Raw& x, const Raw& y) { return x.t < y.t; });
@@ -157,12 +149,8 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
     ct.l1 = trueLine(R0, p0, t0);
     ct.l3 = trueLine(R1, p1, t1);
     ct.has_l2 = false;
-    LineFitOptions fit = o.line_fit;
-    if (!c.times.empty())
-      fit.interval_fraction = std::min(
-          0.5, std::max(fit.interval_fraction, static_cast<double>(o.min_fit_events) /
-                                                   static_cast<double>(c.times.size())));
-    if (attachFittedLines(c, trial.observations.focal_px, fit)) ++trial.lines_fitted;
+    if (attachFittedLines(c, trial.observations.focal_px, o.line_fit, &trial.given_motion))
+      ++trial.lines_fitted;
   }
   trial.ok = true;
   return trial;

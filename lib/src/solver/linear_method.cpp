@@ -43,11 +43,15 @@ SolverResult nullspaceResult(const NullspaceSolution& ns, const WindowObservatio
   r.iterations = ns.iterations;
   r.rows_used = rows;
   r.residual_px = ns.scale * obs.focal_px;
-  if (ns.sigma_second <= 0.0 || ns.sigma_min > opt.max_sigma_ratio * ns.sigma_second) {
+  // Direction standard deviation implied by the gap (options.hpp) [deg].
+  const double ratio = ns.sigma_second > 0.0 ? ns.sigma_min / ns.sigma_second : 1.0;
+  const double gap = rows * (1.0 / (ratio * ratio) - 1.0);
+  const double implied_deg = gap > 0.0 ? 180.0 / M_PI / std::sqrt(gap) : HUGE_VAL;
+  if (ns.sigma_second <= 0.0 || !(implied_deg <= opt.max_nullspace_sigma_deg)) {
     r.status = SolveStatus::Degenerate;
     r.degeneracy = Degeneracy::NullspaceNotUnique;
-    r.message = "two smallest singular values too close (ratio " +
-                std::to_string(ns.sigma_second > 0 ? ns.sigma_min / ns.sigma_second : 1.0) + ")";
+    r.message = "two smallest singular values too close (ratio " + std::to_string(ratio) + " over " +
+                std::to_string(rows) + " rows: direction std about " + std::to_string(implied_deg) + " deg)";
     return r;
   }
   r.v = ns.v.normalized();

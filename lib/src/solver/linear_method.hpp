@@ -20,7 +20,8 @@ bool rejectInput(const WindowObservations& obs, const MotionModel& motion,
 
 /// The result of a nullspace solution over `rows` rows: Failed when it did not
 /// converge; Degenerate (NullspaceNotUnique) when
-/// sigma_min > options.max_sigma_ratio * sigma_second; else Ok with v unit and,
+/// the direction std the singular values imply exceeds
+/// options.max_nullspace_sigma_deg (options.hpp); else Ok with v unit and,
 /// with options.resolve_sign, its sign resolved by the cheirality test.
 SolverResult nullspaceResult(const NullspaceSolution& solution, const WindowObservations& obs,
                              const MotionModel& motion, const LinearOptions& options, int rows,

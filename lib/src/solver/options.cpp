@@ -16,7 +16,7 @@ std::string LinearOptions::validate() const {
     e << "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";
   if (min_clusters < 1) e << "min_clusters must be >= 1; ";
   if (min_cluster_events < 2) e << "min_cluster_events must be >= 2; ";
-  if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
+  if (!(max_nullspace_sigma_deg > 0.0)) e << "max_nullspace_sigma_deg must be > 0; ";
   if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
   if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
   if (!(min_window_parallax >= 0.0)) e << "min_window_parallax must be >= 0; ";

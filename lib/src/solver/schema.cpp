@@ -16,7 +16,9 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"min_clusters", "", "fewer usable clusters -> degenerate"}, o.min_clusters);
   v.field({"min_cluster_events", "events", "a cluster needs this many events to be usable"},
           o.min_cluster_events);
-  v.field({"max_sigma_ratio", "-", "sigma_min / sigma_second above this -> degenerate"}, o.max_sigma_ratio);
+  v.field({"max_nullspace_sigma_deg", "deg",
+           "degenerate when the two smallest singular values imply a direction std above this"},
+          o.max_nullspace_sigma_deg);
   v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
           o.min_parallax_ratio);
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);

@@ -40,10 +40,11 @@ struct ObservationReport {
 /// Builds the solver input of a window. Clusters keep their ClusterResult id in
 /// ClusterObservation::id. Events whose bearing is not finite are left out.
 /// `focal_px` converts normalised distances to pixels (fit thresholds are in px)
-/// and is stored in WindowObservations::focal_px. Never throws on data.
+/// and is stored in WindowObservations::focal_px. `motion` gives the rotation
+/// the line fit removes (line_fit.hpp; nullptr: no rotation). Never throws on data.
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
-                                  const ObservationOptions& options,
+                                  const ObservationOptions& options, const MotionModel* motion,
                                   ObservationReport* report = nullptr);
 
 }  // namespace celc

@@ -22,8 +22,8 @@
 ///  - the solvers get the angular velocity with an error of fixed magnitude
 ///    omega_error about a random axis.
 /// CELC's l1 / l3 and CE3LC's l2 are fitted from each cluster's own events
-/// (attachFittedLines, by default over the first / last 10% of the
-/// cluster's duration), never taken from the ground truth.
+/// (attachFittedLines with the given motion, as `celc run` does), never taken
+/// from the ground truth.
 #include <array>
 #include <random>
 #include <string>
@@ -50,19 +50,14 @@ struct PeerSceneOptions {
   Vec2 depth_range{2.0, 6.0};        ///< endpoint depth z [m]
   int max_attempts = 2000;           ///< segment draws per line before the motion is drawn again
   int max_motion_draws = 200;        ///< motion draws (w axis, v direction) before giving up
-  /// Sparse clusters: each end interval is at least min_fit_events / n of the
-  /// cluster's duration (at most half), so that l1 / l3 rest on about this many
-  /// events (with 20 events per line: the first and last 40%).
-  int min_fit_events = 8;
+  /// Event pixels rounded to integers after the noise (as a DAVIS delivers them).
+  bool integer_pixels = false;
   CameraModel camera = defaultCamera();
-  /// interval_fraction 0.1 (first and last 10%), min_events 4, and no PoorFit
-  /// flag (max_rms_px = 1e9: outliers inflate the plain RMS; the Huber fit
-  /// itself is robust).
-  LineFitOptions line_fit = defaultLineFit();
+  /// The tool's line fit (its defaults: the moving model, with the given rotation).
+  LineFitOptions line_fit;
   std::string validate() const;      ///< empty when valid
 
   static CameraModel defaultCamera();  ///< 640 x 480, f = 320 px, (cx, cy) = (320, 240)
-  static LineFitOptions defaultLineFit();
 };
 
 /// One generated trial.

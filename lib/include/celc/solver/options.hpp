@@ -31,9 +31,14 @@ struct LinearOptions {
   int grid_rows = 200;           ///< rows used to score the grid
   int min_clusters = 2;          ///< fewer usable clusters -> degenerate
   int min_cluster_events = 5;    ///< a cluster needs this many events to be usable
-  /// A 2-D nullspace: sigma_min / sigma_second above this -> degenerate. The
-  /// sigmas are RMS geometric residuals along the best and second-best directions.
-  double max_sigma_ratio = 0.9;
+  /// A 2-D nullspace: degenerate when the direction's standard deviation that
+  /// the two smallest singular values imply exceeds this [deg]. With sigma_min,
+  /// sigma_second the RMS geometric residuals along the best and second-best
+  /// directions over n rows, the cost rises by n (sigma_second^2 - sigma_min^2)
+  /// from one to the other, so the direction's standard deviation is about
+  /// 1 / sqrt(n (sigma_second^2 / sigma_min^2 - 1)) [rad]: a fixed ratio would
+  /// call a window with many events degenerate though it fixes v well.
+  double max_nullspace_sigma_deg = 30.0;
   /// A cluster shows parallax when its events, rotation-compensated, are this
   /// many times farther from one static line than from a line moving linearly
   /// in time (robust scales); fewer than min_clusters such clusters -> degenerate.
