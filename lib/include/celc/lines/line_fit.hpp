@@ -46,7 +46,7 @@ struct LineFitOptions {
   LineModel model = LineModel::Moving;
   /// Each end interval starts as this share of the cluster's duration (moving
   /// model; it then grows as needed, up to 0.5). 0 = use interval_s.
-  double interval_fraction = 0.2;
+  double interval_fraction = 0.1;
   /// Length of each end interval [s] when interval_fraction is 0 (static
   /// model: always; the paper's 5 ms).
   double interval_s = 0.005;
