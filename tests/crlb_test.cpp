@@ -109,9 +109,10 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
 // peer scene at parallax 0.125 (V = 1 m/s), 0.5 px, the single-start joint
 // refinement ends in a wrong basin in about a quarter of the trials
 // (docs/peers.md). With 16 more starts, keeping the lowest robust cost, the
-// cost never gets worse and the error spread shrinks (measured on these 24
-// trials: RMS 19.0 -> 10.7 deg, trials above 15 deg 4 -> 2; asserted: RMS
-// below 0.7x, no more trials above 15 deg).
+// cost never gets worse and the error spread shrinks. Measured on these 24
+// trials: RMS 19.0 -> 10.7 deg with the paper's still 10% lines; with the
+// moving-line fit (lines/line_fit.hpp) the single start lands better,
+// RMS 14.1 -> 10.75 deg. Asserted: RMS below 0.85x, no more trials above 15 deg.
 TEST(MultiStart, JointRefinementEscapesWrongBasins) {
   std::mt19937_64 rng(11);
   SolverOptions one, many;
@@ -135,6 +136,6 @@ TEST(MultiStart, JointRefinementEscapesWrongBasins) {
     far_many += pb > 15.0;
   }
   ASSERT_GE(n, 20);
-  EXPECT_LT(std::sqrt(ss_many / n), 0.7 * std::sqrt(ss_one / n));
+  EXPECT_LT(std::sqrt(ss_many / n), 0.85 * std::sqrt(ss_one / n));
   EXPECT_LE(far_many, far_one);
 }

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "celc/eval/metrics.hpp"
@@ -119,6 +121,39 @@ TEST(LinesMotion, SparseClustersKeepEveryLineAndEveryMethodAnswers) {
         EXPECT_EQ(std::count(r.deg[k].begin(), r.deg[k].end(), 180.0), 0)
             << toString(methods[k]) << " with " << events << " events per line";
       }
+  }
+}
+
+// The table of docs/lines.md (opt-in, prints medians; not a check):
+//   CELC_LINES_STUDY=1 build/celc_tests --gtest_filter=LinesMotion.Study
+TEST(LinesMotion, Study) {
+  if (!std::getenv("CELC_LINES_STUDY")) GTEST_SKIP() << "set CELC_LINES_STUDY=1 to print the table";
+  const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::Ce3lc, Method::Npt};
+  LineFitOptions paper;
+  paper.model = LineModel::Static;
+  paper.interval_fraction = 0.0;
+  std::printf("| scene | lines | celc | celc_opt | ce3lc | npt |\n|---|---|---|---|---|---|\n");
+  auto row = [&](const char* name, PeerSceneOptions o, int n) {
+    for (int model = 0; model < 2; ++model) {
+      o.line_fit = model == 0 ? LineFitOptions{} : paper;
+      const Outcome r = runScenes(o, methods, n, 500);
+      std::printf("| %s | %s |", name, model == 0 ? "moving (default)" : "static 5 ms (paper)");
+      for (const auto& d : r.deg) std::printf(" %.3g |", median(d));
+      std::printf("\n");
+    }
+  };
+  row("float, 4 m/s, 0.2 s, still", davis240Scene(4.0, 0.2, 0.0), 20);
+  row("float, 4 m/s, 0.2 s, 3 rad/s", davis240Scene(4.0, 0.2, 3.0), 20);
+  for (double omega : {0.0, 3.0}) {
+    PeerSceneOptions o = davis240Scene(3.0, 0.5, omega);
+    o.integer_pixels = true;
+    o.events_per_line = 2000;
+    row(omega == 0.0 ? "integer, 3 m/s, 0.5 s, still" : "integer, 3 m/s, 0.5 s, 3 rad/s", o, 20);
+  }
+  for (int events : {20, 200}) {
+    PeerSceneOptions o;  // the peers' scene: 640 x 480, f 320, 2 m/s, 1 px, 15 deg/s
+    o.events_per_line = events;
+    row(events == 20 ? "peers, 5 x 20" : "peers, 5 x 200", o, 50);
   }
 }
 
