@@ -109,6 +109,46 @@ TEST(Cli, SolveOnLabelledEventsRecoversVelocity) {
   fs::remove_all(d);
 }
 
+// `celc solve` builds its input with the pipeline's code and configuration:
+// --set and -c reach the line fit and the solvers, and bad keys are errors.
+TEST(Cli, SolveTakesTheRunConfiguration) {
+  const fs::path d = tempDir("solveconfig");
+  LineSceneOptions o;
+  o.event_noise_px = 0.5;
+  o.events_per_line = 400;
+  std::mt19937_64 rng(5);
+  const auto tr = generateLineScene(o, rng);
+  {
+    std::ofstream csv(d / "events.csv");
+    csv << "t,x,y,cluster\n";
+    csv.precision(12);
+    for (size_t i = 0; i < tr.pixel_events.size(); ++i)
+      csv << tr.pixel_events[i].t << "," << tr.pixel_events[i].x << "," << tr.pixel_events[i].y
+          << "," << tr.labels[i] << "\n";
+    std::ofstream calib(d / "calib.yaml");
+    calib << "camera: {width: 346, height: 260, fx: 320, fy: 320, cx: 173, cy: 130}\n";
+    std::ofstream cfg(d / "run.yaml");
+    cfg << "lines:\n  model: static\n  interval_fraction: 0.1\nmethods: [celc]\n";
+  }
+  const std::string base = "solve '" + (d / "events.csv").string() + "' --omega 0,0,2 --calib '" +
+                           (d / "calib.yaml").string() + "' ";
+  const auto moving = runCelc(base + "--methods celc", d);
+  ASSERT_EQ(moving.status, 0) << readAll(d / "stderr.txt");
+  const auto by_file = runCelc(base + "-c '" + (d / "run.yaml").string() + "'", d);
+  ASSERT_EQ(by_file.status, 0) << readAll(d / "stderr.txt");
+  const auto by_set = runCelc(base + "--methods celc --set lines.model=static --set lines.interval_fraction=0.1", d);
+  ASSERT_EQ(by_set.status, 0) << readAll(d / "stderr.txt");
+  // The same configuration by file and by --set; another line model, another answer.
+  auto row = [](const std::string& out) { return out.substr(out.find('\n') + 1, out.rfind(',') - out.find('\n') - 1); };
+  EXPECT_EQ(row(by_file.out), row(by_set.out));
+  EXPECT_NE(row(moving.out), row(by_set.out));
+  EXPECT_EQ(row(moving.out).rfind("celc,ok,", 0), 0u) << moving.out;
+  const auto bad = runCelc(base + "--set lines.modle=static", d);
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(readAll(d / "stderr.txt").find("modle"), std::string::npos);
+  fs::remove_all(d);
+}
+
 TEST(Cli, SolveBadInputNamesFileAndLine) {
   const fs::path d = tempDir("bad");
   {
