@@ -73,6 +73,10 @@ TEST(CliTrust, ThreadCountsAreChecked) {
   expectOneLineError(runCelc(run + "--threads 100000", d), {"--threads 100000"});
   expectOneLineError(runCelc(run + "--set cluster.threads=0", d), {"threads"});
   EXPECT_FALSE(fs::exists(d / "o"));
+  const std::string simulate = "simulate --sweep default --trials 2 -q -o " + q(d / "s") + " ";
+  expectOneLineError(runCelc(simulate + "--threads -1", d), {"--threads"});
+  expectOneLineError(runCelc(simulate + "--threads 100000", d), {"--threads"});
+  EXPECT_FALSE(fs::exists(d / "s"));
   fs::remove_all(d);
 }
 

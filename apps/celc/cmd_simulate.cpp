@@ -12,6 +12,7 @@
 #include "celc/pipeline/peer_study.hpp"
 #include "celc/pipeline/simulation_study.hpp"
 #include "commands.hpp"
+#include "run_common.hpp"
 #include "progress.hpp"
 
 namespace fs = std::filesystem;
@@ -262,7 +263,9 @@ void registerSimulate(CLI::App& app) {
   cmd->add_option("--set", a->sets,
                   "override any configuration key, e.g. --set scene.n_lines=8 (repeatable; YAML values; "
                   "`celc config --show simulate --keys` lists every key)");
-  cmd->add_option("--threads", a->threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "worker threads (0 = all cores, at most 1024)")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str();
   cmd->add_option("--methods", a->methods,
                   "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "study.methods"));
   cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
