@@ -178,6 +178,7 @@ void runPeers(const SimulateArgs& a, const SimulateConfig& cfg) {
 
 void runSimulate(const SimulateArgs& a) {
   configureLogging(a.quiet, a.verbose);
+  checkThreads(a.threads);
   SimulateConfig cfg;
   if (!a.config.empty()) cfg = loadSimulateConfig(a.config);
   for (const std::string& assignment : a.sets) applySimulateSetting(assignment, cfg);
@@ -264,7 +265,6 @@ void registerSimulate(CLI::App& app) {
                   "override any configuration key, e.g. --set scene.n_lines=8 (repeatable; YAML values; "
                   "`celc config --show simulate --keys` lists every key)");
   cmd->add_option("--threads", a->threads, "worker threads (0 = all cores, at most 1024)")
-      ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
   cmd->add_option("--methods", a->methods,
                   "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "study.methods"));
