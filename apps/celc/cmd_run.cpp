@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "celc/io/event_reader.hpp"
 #include "celc/io/sequence_layout.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
@@ -23,6 +24,16 @@ void runRun(const RunArgs& a) {
   configureLogging(a.o.quiet, a.o.verbose);
   SequenceJob job;
   job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
+  // A ROS bag carries its camera (sensor_msgs/CameraInfo) and a bag or HDF5
+  // file its ground truth: what the options do not name comes from the file.
+  std::error_code ec;
+  if (fs::is_regular_file(a.input, ec) && isContainerFormat(detectFormat(a.input))) {
+    if (job.inputs.calib.empty() && detectFormat(a.input) == Format::RosBag) job.inputs.calib = a.input;
+    if (job.inputs.groundtruth.empty()) {
+      ReaderOptions o = buildRunConfig(a.o).reader;
+      if (!openEventSource(a.input, o)->readPoses().empty()) job.inputs.groundtruth = a.input;
+    }
+  }
   job.config = buildRunConfig(a.o);
   job.mode = outputMode(a.o);
   job.threads = a.o.threads;
@@ -50,7 +61,9 @@ void registerRun(CLI::App& app) {
       "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (" +
           sequenceLayoutSummary() +
           ") or an events/aedat file with --calib "
-          "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
+          "(and --groundtruth), or a ROS bag / HDF5 file (camera and ground truth from the file unless "
+          "--calib / --groundtruth say otherwise; topics found by type, or --topic-events/--topic-imu/--topic-pose). "
+          "Writes OUTDIR/windows.csv (one row per window and method), "
           "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");

@@ -20,6 +20,8 @@ struct RunOverrides {
   int threads = 0;  ///< 0 = all cores; checked by checkThreads
   bool force = false, resume = false, quiet = false, verbose = false;
   std::string shard;
+  /// --topic-events / --topic-imu / --topic-pose (ROS bags; empty: not given).
+  std::string topic_events, topic_imu, topic_pose;
 };
 
 /// Adds the shared options to a subcommand.
