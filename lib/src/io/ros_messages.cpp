@@ -37,8 +37,10 @@ PoseSample readPose(RosCursor& c, double t) {
   p.t = t;
   const std::size_t at = c.offset();
   p.position = c.vec3("pose.position");
-  const double x = c.get<double>("pose.orientation"), y = c.get<double>("pose.orientation"),
-               z = c.get<double>("pose.orientation"), w = c.get<double>("pose.orientation");
+  const double x = c.get<double>("pose.orientation");
+  const double y = c.get<double>("pose.orientation");
+  const double z = c.get<double>("pose.orientation");
+  const double w = c.get<double>("pose.orientation");
   const Eigen::Quaterniond q(w, x, y, z);
   const double n = q.norm();
   if (!(n > 1e-12) || !std::isfinite(n) || !p.position.allFinite())

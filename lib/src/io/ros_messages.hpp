@@ -98,8 +98,10 @@ class RosCursor {
   }
   Vec3 vec3(const char* what) {
     need(24, what);
-    Vec3 v(get<double>(what), get<double>(what), get<double>(what));
-    return v;
+    const double x = get<double>(what);  // one statement each: argument order is unspecified
+    const double y = get<double>(what);
+    const double z = get<double>(what);
+    return Vec3(x, y, z);
   }
 
  private:
