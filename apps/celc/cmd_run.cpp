@@ -26,8 +26,7 @@ void runRun(const RunArgs& a) {
   job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
   // A ROS bag carries its camera (sensor_msgs/CameraInfo) and a bag or HDF5
   // file its ground truth: what the options do not name comes from the file.
-  std::error_code ec;
-  if (fs::is_regular_file(a.input, ec) && isContainerFormat(detectFormat(a.input))) {
+  if (isContainerFile(a.input)) {
     if (job.inputs.calib.empty() && detectFormat(a.input) == Format::RosBag) job.inputs.calib = a.input;
     if (job.inputs.groundtruth.empty()) {
       ReaderOptions o = buildRunConfig(a.o).reader;

@@ -1,6 +1,5 @@
 #include "celc/io/calibration.hpp"
 
-#include <filesystem>
 
 #include "io/aedat_readers.hpp"
 
@@ -122,8 +121,7 @@ Calibration loadCalibTxt(const std::string& path, int width, int height) {
 
 Calibration loadCalibration(const std::string& path, int width, int height) {
   // A ROS bag: the camera of its sensor_msgs/CameraInfo topic (no IMU or body section).
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec) && detectFormat(path) == Format::RosBag) {
+  if (isContainerFile(path) && detectFormat(path) == Format::RosBag) {
     Calibration c;
     if (!detail::bagCameraModel(path, c.camera))
       throw IoError(path + ": no sensor_msgs/CameraInfo topic: give the calibration (--calib FILE)");

@@ -254,6 +254,26 @@ bool exists(const std::string& p) {
 }
 }  // namespace
 
+/// Format::RosBag / Format::Hdf5 from the first bytes of a file, else Format::Text.
+static Format containerMagic(const std::string& head) {
+  if (head.rfind("#ROSBAG V", 0) == 0) return Format::RosBag;
+  // The HDF5 superblock signature sits at byte 0, 512, 1024 or 2048 (after a user block).
+  static const char kHdf5Signature[] = "\x89HDF\r\n\x1a\n";
+  for (std::size_t at : {0, 512, 1024, 2048})
+    if (head.size() >= at + 8 && head.compare(at, 8, kHdf5Signature, 8) == 0) return Format::Hdf5;
+  return Format::Text;
+}
+
+bool isContainerFile(const std::string& path) {
+  if (!exists(path)) return false;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  std::string head(2056, '\0');
+  head.resize(std::fread(&head[0], 1, head.size(), f));
+  std::fclose(f);
+  return isContainerFormat(containerMagic(head));
+}
+
 Format detectFormat(const std::string& path) {
   if (isDir(path)) {
     if (!isSequenceDirectory(path))
@@ -270,11 +290,7 @@ Format detectFormat(const std::string& path) {
   if (head.rfind("#!AER-DAT2.0", 0) == 0) return Format::Aedat2;
   if (head.rfind("#!AER-DAT3.1", 0) == 0) return Format::Aedat31;
   if (head.rfind("#!AER-DAT4.0", 0) == 0) return Format::Aedat4;
-  if (head.rfind("#ROSBAG V", 0) == 0) return Format::RosBag;
-  // The HDF5 superblock signature sits at byte 0, 512, 1024, 2048... (after a user block).
-  static const char kHdf5Signature[] = "\x89HDF\r\n\x1a\n";
-  for (std::size_t at : {0, 512, 1024, 2048})
-    if (head.size() >= at + 8 && head.compare(at, 8, kHdf5Signature, 8) == 0) return Format::Hdf5;
+  if (const Format c = containerMagic(head); isContainerFormat(c)) return c;
   if (head.rfind("#!AER-DAT", 0) == 0) {
     const std::size_t eol = head.find_first_of("\r\n");
     throw IoError(path + ": byte 0: unsupported AEDAT version '" +

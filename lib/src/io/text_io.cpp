@@ -1,6 +1,5 @@
 #include "celc/io/text_io.hpp"
 
-#include <filesystem>
 
 #include <algorithm>
 #include <array>
@@ -265,8 +264,7 @@ std::vector<ImuSample> readImuText(const std::string& path, const ReaderOptions&
 }
 
 std::vector<PoseSample> readPosesText(const std::string& path, const ReaderOptions& options) {
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec) && isContainerFormat(detectFormat(path))) {
+  if (isContainerFile(path)) {
     // A ROS bag or HDF5 file named as the ground truth: its pose topic / dataset.
     std::vector<PoseSample> poses = openEventSource(path, options)->readPoses();
     for (std::size_t i = 1; i < poses.size(); ++i)

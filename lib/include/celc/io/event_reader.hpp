@@ -231,6 +231,9 @@ Format detectFormat(const std::string& path);
 /// True for the container formats that carry IMU, poses and (bags) the camera
 /// calibration besides the events: ROS bag and HDF5.
 bool isContainerFormat(Format format);
+/// True when `path` is a regular file that starts like a ROS bag or an HDF5
+/// file (its magic bytes only; never throws).
+bool isContainerFile(const std::string& path);
 
 /// A summary from one full pass (what `celc info` prints).
 struct FileInfo {
