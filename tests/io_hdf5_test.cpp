@@ -8,6 +8,7 @@
 #include "celc/io/event_reader.hpp"
 #include "celc/io/text_io.hpp"
 #include "io_fixtures.hpp"
+#include "cli_util.hpp"
 #include "io_test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -91,6 +92,12 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
   std::string m = ioErrorOf([] { openEventSource(fixture("bad_layout.h5")); });
   EXPECT_NE(m.find("bad_layout.h5: neither the DSEC layout (/events/x"), std::string::npos) << m;
   EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  m = ioErrorOf([] { openEventSource(fixture("bad_dsec.h5")); });
+  EXPECT_NE(m.find("bad_dsec.h5: dataset /events/p is missing"), std::string::npos) << m;
+  m = ioErrorOf([] { openEventSource(fixture("bad_mvsec.h5")); });
+  EXPECT_NE(m.find("bad_mvsec.h5: dataset /davis/left/events: has 3 columns, expected 4 (x, y, t, p)"),
+            std::string::npos)
+      << m;
   celc::test::TempDir dir;
   std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
   const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -104,4 +111,22 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
     EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
   }
+}
+
+// A compressed dataset whose filter plugin cannot be found: the error names the filter and the package.
+TEST(IoHdf5, MissingFilterPluginIsNamed) {
+  CELC_REQUIRE_IO_FIXTURES();
+  if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
+  const fs::path d = celc::test::freshTempDir("io_hdf5_filter");
+  const auto r = celc::test::runCelc("info '" + fixture("seq_blosc.h5") + "'", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // the same with a plugin folder that holds no plugin
+  const std::string cmd = "HDF5_PLUGIN_PATH='" + d.string() + "' " CELC_BINARY " info '" + fixture("seq_blosc.h5") +
+                          "' > /dev/null 2> '" + (d / "err.txt").string() + "'";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  const std::string err = celc::test::readAll(d / "err.txt");
+  EXPECT_NE(err.find("seq_blosc.h5: dataset /events/x: compressed with filter 32001"), std::string::npos) << err;
+  EXPECT_NE(err.find("hdf5-filter-plugin-blosc-serial"), std::string::npos) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
+  fs::remove_all(d);
 }
