@@ -15,7 +15,9 @@
 // conn_count, chunk_count}, 0x05 chunk {compression, size}, 0x06 chunk info
 // {ver, chunk_pos, start_time, end_time, count}, 0x07 connection {conn, topic},
 // 0x04 index data, 0x02 message data.
+#include <bzlib.h>
 #include <console_bridge/console.h>
+#include <roslz4/lz4s.h>
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
@@ -87,6 +89,45 @@ BagRecord readRecord(BinFile& f, std::uint64_t at, const char* what) {
   return r;
 }
 
+/// The records of one decompressed chunk (offset -> op): each header's fields
+/// and each data length must lie inside the chunk.
+std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64_t chunk_at,
+                                                  const std::vector<unsigned char>& b) {
+  std::map<std::uint32_t, std::uint8_t> ops;
+  auto bad = [&](std::size_t p, const std::string& what) {
+    f.fail(chunk_at, "chunk record at offset " + std::to_string(p) + ": " + what + kReindexHint);
+  };
+  std::size_t p = 0;
+  while (p < b.size()) {
+    const std::size_t start = p;
+    if (b.size() - p < 4) bad(start, "cut header length");
+    const auto hlen = loadLE<std::uint32_t>(b.data() + p);
+    p += 4;
+    if (hlen > b.size() - p) bad(start, "header of " + std::to_string(hlen) + " bytes beyond the chunk's end");
+    const std::size_t hend = p + hlen;
+    std::uint8_t op = 0;
+    while (p < hend) {
+      if (hend - p < 4) bad(start, "cut header field");
+      const auto flen = loadLE<std::uint32_t>(b.data() + p);
+      p += 4;
+      if (flen > hend - p) bad(start, "header field longer than its header");
+      const char* field = reinterpret_cast<const char*>(b.data() + p);
+      const void* eq = std::memchr(field, '=', flen);
+      if (!eq) bad(start, "header field without '='");
+      if (flen == 4 && std::memcmp(field, "op=", 3) == 0) op = std::uint8_t(field[3]);
+      p += flen;
+    }
+    if (b.size() - p < 4) bad(start, "cut data length");
+    const auto dlen = loadLE<std::uint32_t>(b.data() + p);
+    p += 4;
+    if (dlen > b.size() - p) bad(start, "data of " + std::to_string(dlen) + " bytes beyond the chunk's end");
+    p += dlen;
+    if (op != 0x02 && op != 0x07) bad(start, "op " + std::to_string(int(op)) + " inside a chunk");
+    ops[std::uint32_t(start)] = op;
+  }
+  return ops;
+}
+
 /// The checks of a format 2.0 bag described at the top of the file.
 /// Returns the number of chunks per compression.
 std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptions& o) {
@@ -139,24 +180,32 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
                      std::to_string(c.data_len));
     ++compressions[comp->second];
     const std::uint64_t end = c.data_at + c.data_len;
-    // An uncompressed chunk is read by the library straight from the file: every
-    // record inside must fit in the chunk (a damaged header length would size an allocation).
+    // The library reads the chunk's records from its (decompressed) buffer
+    // without bounds of its own: every record must parse inside the chunk, and
+    // every index entry must point at the start of a message data record.
+    if (c.data_len > std::uint64_t(o.max_packet_bytes) + (1 << 20))
+      f.fail(at, "chunk data of " + std::to_string(c.data_len) + " bytes, more than input.max_packet_bytes");
+    std::vector<unsigned char> raw(c.data_len);
+    f.seek(c.data_at);
+    f.readExact(raw.data(), raw.size(), "chunk data");
+    std::vector<unsigned char> plain;
     if (comp->second == "none") {
-      for (std::uint64_t r = c.data_at; r < end;) {
-        unsigned char len4[4];
-        for (const char* what : {"record header", "record data"}) {
-          if (end - r < 4) f.fail(r, std::string("chunk at byte ") + std::to_string(at) + ": " + what + " length cut by the chunk's end");
-          f.seek(r);
-          f.readExact(len4, 4, what);
-          const auto len = loadLE<std::uint32_t>(len4);
-          if (len > end - r - 4)
-            f.fail(r, std::string("chunk at byte ") + std::to_string(at) + ": " + what + " of " + std::to_string(len) +
-                          " bytes beyond the chunk's end" + kReindexHint);
-          r += 4 + len;
-        }
-      }
+      plain.swap(raw);
+    } else {
+      plain.resize(size);
+      unsigned int out = size;
+      const bool ok =
+          comp->second == "bz2"
+              ? BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(plain.data()), &out,
+                                           reinterpret_cast<char*>(raw.data()), unsigned(raw.size()), 0, 0) == BZ_OK
+              : roslz4_buffToBuffDecompress(reinterpret_cast<char*>(raw.data()), unsigned(raw.size()),
+                                            reinterpret_cast<char*>(plain.data()), &out) == ROSLZ4_OK;
+      if (!ok || out != size)
+        f.fail(at, "corrupt " + comp->second + " chunk (it does not decompress to its " + std::to_string(size) +
+                       " bytes)");
     }
-    // The index records after the chunk: each entry's offset must lie inside the (uncompressed) chunk.
+    const std::map<std::uint32_t, std::uint8_t> records = chunkRecords(f, at, plain);
+    // The index records after the chunk: each entry on a message record of the chunk.
     for (std::uint64_t r = end; r < index_pos;) {
       const BagRecord ix = readRecord(f, r, "index data record");
       if (ix.op() != 0x04) break;
@@ -168,9 +217,11 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
       f.readExact(entries.data(), entries.size(), "index data");
       for (std::uint32_t k = 0; k < count; ++k) {
         const auto offset = loadLE<std::uint32_t>(entries.data() + 12 * k + 8);
-        if (std::uint64_t(offset) + 8 > size)
-          f.fail(ix.data_at + 12 * k + 8, "index entry offset " + std::to_string(offset) + " outside its " +
-                                               std::to_string(size) + "-byte chunk" + kReindexHint);
+        auto it = records.find(offset);
+        if (it == records.end() || it->second != 0x02)
+          f.fail(ix.data_at + 12 * k + 8, "index entry offset " + std::to_string(offset) +
+                                               " is not a message record of the chunk at byte " + std::to_string(at) +
+                                               kReindexHint);
       }
       r = ix.data_at + ix.data_len;
     }
