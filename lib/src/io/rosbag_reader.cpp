@@ -164,6 +164,7 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
     f.fail(index_pos, "index section holds " + std::to_string(conns) + " connections and " +
                           std::to_string(chunks.size()) + " chunk infos, the header says " +
                           std::to_string(conn_count) + " and " + std::to_string(chunk_count) + kReindexHint);
+  std::vector<unsigned char> raw, plain;  // reused: one allocation for every chunk
   for (const std::uint64_t at : chunks) {
     const BagRecord c = readRecord(f, at, "chunk record");
     std::uint32_t size = 0;
@@ -185,12 +186,11 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
     // every index entry must point at the start of a message data record.
     if (c.data_len > std::uint64_t(o.max_packet_bytes) + (1 << 20))
       f.fail(at, "chunk data of " + std::to_string(c.data_len) + " bytes, more than input.max_packet_bytes");
-    std::vector<unsigned char> raw(c.data_len);
+    raw.resize(c.data_len);
     f.seek(c.data_at);
     f.readExact(raw.data(), raw.size(), "chunk data");
-    std::vector<unsigned char> plain;
     if (comp->second == "none") {
-      plain.swap(raw);
+      plain.assign(raw.begin(), raw.end());
     } else {
       plain.resize(size);
       unsigned int out = size;
