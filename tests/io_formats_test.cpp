@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "celc/io/event_reader.hpp"
@@ -74,6 +75,22 @@ TEST(IoFormats, SameSequenceGivesTheSameWindowsRowsInEveryFormat) {
   }
   // The bag run found its ground truth: metrics are filled.
   EXPECT_NE(reference[1].find(",ok,"), std::string::npos) << reference[1];
+  // `celc batch`: a bag entry, its topic named by the YAML key input.topic_events.
+  std::ofstream(d / "batch.yaml") << "sequences:\n  - {label: bag, path: '" << fixture("seq_lz4.bag")
+                                  << "', config: {input: {topic_events: /dvs/events}}}\n";
+  const auto b = celc::test::runCelc("batch '" + (d / "batch.yaml").string() + "' -o '" + (d / "batch").string() +
+                                         "'" + kFast,
+                                     d);
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(rowsWithoutRuntime(d / "batch" / "bag" / "windows.csv"), reference);
+  std::ofstream(d / "bad.yaml") << "sequences:\n  - {label: bag, path: '" << fixture("seq_lz4.bag")
+                                << "', config: {input: {topic_events: /dvs/imu}}}\n";
+  const auto bad = celc::test::runCelc("batch '" + (d / "bad.yaml").string() + "' -o '" + (d / "bad").string() +
+                                           "'" + kFast,
+                                       d);
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("seq_lz4.bag: topic /dvs/imu: unknown message type sensor_msgs/Imu"), std::string::npos)
+      << bad.err;
   fs::remove_all(d);
 }
 

@@ -4,7 +4,6 @@
 #include <filesystem>
 #include <iostream>
 
-#include "celc/io/event_reader.hpp"
 #include "celc/io/sequence_layout.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
@@ -24,16 +23,8 @@ void runRun(const RunArgs& a) {
   configureLogging(a.o.quiet, a.o.verbose);
   SequenceJob job;
   job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
-  // A ROS bag carries its camera (sensor_msgs/CameraInfo) and a bag or HDF5
-  // file its ground truth: what the options do not name comes from the file.
-  if (isContainerFile(a.input)) {
-    if (job.inputs.calib.empty() && detectFormat(a.input) == Format::RosBag) job.inputs.calib = a.input;
-    if (job.inputs.groundtruth.empty()) {
-      ReaderOptions o = buildRunConfig(a.o).reader;
-      if (!openEventSource(a.input, o)->readPoses().empty()) job.inputs.groundtruth = a.input;
-    }
-  }
   job.config = buildRunConfig(a.o);
+  defaultContainerInputs(job.inputs, job.config.reader);
   job.mode = outputMode(a.o);
   job.threads = a.o.threads;
   if (!a.o.shard.empty()) std::tie(job.shard_index, job.shard_count) = parseShard(a.o.shard);

@@ -9,6 +9,7 @@
 
 #include "celc/core/text.hpp"
 #include "celc/core/yaml.hpp"
+#include "celc/io/event_reader.hpp"
 
 namespace celc::app {
 
@@ -135,6 +136,13 @@ RunConfig buildRunConfig(const RunOverrides& o) {
 OutputMode outputMode(const RunOverrides& o) {
   if (o.force && o.resume) return OutputMode::ResumeOrReplace;
   return o.resume ? OutputMode::Resume : (o.force ? OutputMode::Force : OutputMode::Create);
+}
+
+void defaultContainerInputs(RunInputs& inputs, const ReaderOptions& reader) {
+  if (!isContainerFile(inputs.events)) return;
+  if (inputs.calib.empty() && detectFormat(inputs.events) == Format::RosBag) inputs.calib = inputs.events;
+  if (inputs.groundtruth.empty() && !openEventSource(inputs.events, reader)->readPoses().empty())
+    inputs.groundtruth = inputs.events;
 }
 
 void printSummary(const std::string& title, const SequenceOutcome& out) {
