@@ -210,6 +210,17 @@ class Hdf5Reader final : public EventReader {
     if (rank > 0) H5Sget_simple_extent_dims(d.space.get(), d.dims.data(), nullptr);
     // A filtered (compressed) dataset whose filter is not available cannot be read: say which.
     H5Id plist(H5Dget_create_plist(d.id.get()), H5Pclose);
+    // A chunk is decompressed whole: its size is bounded like an AEDAT packet.
+    if (plist.valid() && rank > 0 && H5Pget_layout(plist.get()) == H5D_CHUNKED) {
+      std::vector<hsize_t> chunk(std::size_t(rank), 0);
+      H5Id type(H5Dget_type(d.id.get()), H5Tclose);
+      double bytes = type.valid() ? double(H5Tget_size(type.get())) : 8.0;
+      if (H5Pget_chunk(plist.get(), rank, chunk.data()) == rank)
+        for (hsize_t c : chunk) bytes *= double(c);
+      if (bytes > double(options_.max_packet_bytes))
+        fail(name, "chunks of " + std::to_string(std::uint64_t(bytes)) +
+                       " bytes, more than input.max_packet_bytes = " + std::to_string(options_.max_packet_bytes));
+    }
     const int nf = plist.valid() ? H5Pget_nfilters(plist.get()) : 0;
     for (int i = 0; i < nf; ++i) {
       unsigned flags = 0, cd[8];
