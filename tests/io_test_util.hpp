@@ -39,7 +39,7 @@ inline std::vector<Event> randomEvents(std::size_t n, int width, int height, uns
   long long t_us = (long long)(t0 * 1e6);
   for (auto& e : ev) {
     t_us += dt(rng);
-    e.t = double(t_us) * 1e-6;
+    e.t = double(t_us) / 1e6;  // as the readers convert whole microseconds (correctly rounded)
     e.x = float(ux(rng));
     e.y = float(uy(rng));
     e.on = pol(rng) == 1;
@@ -55,7 +55,7 @@ inline std::vector<ImuSample> randomImu(double t0, double t1, unsigned seed) {
   const long long a = (long long)std::ceil(t0 * 1e3), b = (long long)std::floor(t1 * 1e3);
   for (long long k = a; k < b; ++k) {
     ImuSample s;
-    s.t = double(k) * 1e-3;
+    s.t = double(k) / 1e3;
     s.gyro = Vec3(u(rng), u(rng), u(rng)) * 3.0;
     s.accel = Vec3(u(rng), u(rng), u(rng)) * 20.0;
     imu.push_back(s);

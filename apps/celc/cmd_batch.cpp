@@ -40,6 +40,7 @@ void runBatch(const BatchArgs& a) {
     job.inputs = e.inputs;
     job.config = e.config;
     applySets(o.sets, job.config);  // the command line wins over the batch file
+    defaultContainerInputs(job.inputs, job.config.reader);
     job.config.windows.t_start = std::max(job.config.windows.t_start, e.t_start);
     job.config.windows.t_end = std::min(job.config.windows.t_end, e.t_end);
     job.outdir = (fs::path(a.outdir) / e.label).string();

@@ -17,6 +17,7 @@ struct InfoArgs {
   std::string imu_columns = "auto";
   double time_scale = 1.0;
   bool strict = false;
+  std::string topic_events, topic_imu, topic_pose;
 };
 
 int runInfo(const InfoArgs& a) {
@@ -26,6 +27,9 @@ int runInfo(const InfoArgs& a) {
   o.imu_columns = parseImuColumns(a.imu_columns);
   o.text_time_scale = a.time_scale;
   o.strict = a.strict;
+  o.topic_events = a.topic_events;
+  o.topic_imu = a.topic_imu;
+  o.topic_pose = a.topic_pose;
   const FileInfo info = scanFile(a.path, o);
   std::printf("file:          %s\n", info.path.c_str());
   std::printf("format:        %s\n", toString(info.format).c_str());
@@ -74,7 +78,7 @@ void registerInfo(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   auto* cmd = app.add_subcommand(
       "info", "What an event recording holds: format, sensor size, counts, ON share, duration, rates, warnings");
-  cmd->add_option("input", args->path, "events file (events.txt, .aedat, .aedat2, .aedat31, .aedat4) or RPG/UZH-FPV directory")
+  cmd->add_option("input", args->path, "events file (events.txt, .aedat, .aedat2, .aedat31, .aedat4, ROS .bag, HDF5 .h5/.hdf5) or RPG/UZH-FPV directory; a bag lists its topics with types, counts and rates")
       ->required();
   cmd->add_option("--width", args->width, "sensor width [px]; overrides the file's (0 = from the file, or unknown)");
   cmd->add_option("--height", args->height, "sensor height [px]; overrides the file's (0 = from the file, or unknown)");
@@ -82,6 +86,10 @@ void registerInfo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--time-scale", args->time_scale, "text timestamps times this = seconds (1e-6 for us)")
       ->capture_default_str();
+  cmd->add_option("--topic-events", args->topic_events, "ROS bag events topic (default: the dvs_msgs/EventArray topic)");
+  cmd->add_option("--topic-imu", args->topic_imu, "ROS bag IMU topic (default: the sensor_msgs/Imu topic)");
+  cmd->add_option("--topic-pose", args->topic_pose,
+                  "ROS bag pose topic (default: the geometry_msgs/PoseStamped or nav_msgs/Odometry topic)");
   cmd->add_flag("--strict", args->strict, "treat warnings (backwards timestamps, pixels outside) as errors");
   cmd->callback([args]() {
     const int rc = runInfo(*args);

@@ -24,6 +24,7 @@ void runRun(const RunArgs& a) {
   SequenceJob job;
   job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
   job.config = buildRunConfig(a.o);
+  defaultContainerInputs(job.inputs, job.config.reader);
   job.mode = outputMode(a.o);
   job.threads = a.o.threads;
   if (!a.o.shard.empty()) std::tie(job.shard_index, job.shard_count) = parseShard(a.o.shard);
@@ -50,7 +51,9 @@ void registerRun(CLI::App& app) {
       "Velocity per window of a recorded sequence: INPUT is an RPG/UZH-FPV directory (" +
           sequenceLayoutSummary() +
           ") or an events/aedat file with --calib "
-          "(and --groundtruth). Writes OUTDIR/windows.csv (one row per window and method), "
+          "(and --groundtruth), or a ROS bag / HDF5 file (camera and ground truth from the file unless "
+          "--calib / --groundtruth say otherwise; topics found by type, or --topic-events/--topic-imu/--topic-pose). "
+          "Writes OUTDIR/windows.csv (one row per window and method), "
           "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");

@@ -9,6 +9,7 @@
 
 #include "celc/core/text.hpp"
 #include "celc/core/yaml.hpp"
+#include "celc/io/event_reader.hpp"
 
 namespace celc::app {
 
@@ -28,6 +29,9 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
                   "assume this constant angular velocity wx,wy,wz [rad/s, camera frame] instead of "
                   "the gyroscope (recordings without IMU)");
   cmd->add_option("--motion-model", o.motion_model, fieldHelp(schema, "motion.model"));
+  cmd->add_option("--topic-events", o.topic_events, fieldHelp(schema, "input.topic_events"));
+  cmd->add_option("--topic-imu", o.topic_imu, fieldHelp(schema, "input.topic_imu"));
+  cmd->add_option("--topic-pose", o.topic_pose, fieldHelp(schema, "input.topic_pose"));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores, at most 1024)")->capture_default_str();
   cmd->add_option("--set", o.sets,
                   "override any configuration key, e.g. --set cluster.smoothness_deg=15 "
@@ -119,6 +123,9 @@ RunConfig buildRunConfig(const RunOverrides& o) {
     c.omega_source = OmegaSource::Fixed;
     c.fixed_omega = Vec3(w[0], w[1], w[2]);
   }
+  if (!o.topic_events.empty()) c.reader.topic_events = o.topic_events;
+  if (!o.topic_imu.empty()) c.reader.topic_imu = o.topic_imu;
+  if (!o.topic_pose.empty()) c.reader.topic_pose = o.topic_pose;
   applySets(o.sets, c);
   // Windows run in parallel: keep each window's clustering on one thread.
   if (o.threads != 1) c.cluster.threads = 1;
@@ -129,6 +136,13 @@ RunConfig buildRunConfig(const RunOverrides& o) {
 OutputMode outputMode(const RunOverrides& o) {
   if (o.force && o.resume) return OutputMode::ResumeOrReplace;
   return o.resume ? OutputMode::Resume : (o.force ? OutputMode::Force : OutputMode::Create);
+}
+
+void defaultContainerInputs(RunInputs& inputs, const ReaderOptions& reader) {
+  if (!isContainerFile(inputs.events)) return;
+  if (inputs.calib.empty() && detectFormat(inputs.events) == Format::RosBag) inputs.calib = inputs.events;
+  if (inputs.groundtruth.empty() && !openEventSource(inputs.events, reader)->readPoses().empty())
+    inputs.groundtruth = inputs.events;
 }
 
 void printSummary(const std::string& title, const SequenceOutcome& out) {

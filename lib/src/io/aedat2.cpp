@@ -204,7 +204,7 @@ class Aedat2Reader final : public EventReader {
             continue;
           }
           Event e;
-          e.t = double(t) * 1e-6;
+          e.t = double(t) / 1e6;  // correctly rounded: the same double as the text "S.UUUUUU"
           e.x = float(x);
           e.y = float(h1 - yr);
           e.on = (a & 0x800u) != 0;
@@ -227,7 +227,7 @@ class Aedat2Reader final : public EventReader {
           imu_next_ = idx + 1;
           if (imu_next_ == 7) {
             ImuSample s;
-            s.t = double(imu_t_) * 1e-6;
+            s.t = double(imu_t_) / 1e6;
             const double ka = kGravity / h_.accel_lsb_per_g;
             const double kg = kDegToRad / h_.gyro_lsb_per_dps;
             s.accel = Vec3(imu_raw_[0] * ka, imu_raw_[1] * ka, imu_raw_[2] * ka);

@@ -97,7 +97,7 @@ class Aedat31Reader final : public EventReader {
             continue;
           }
           Event e;
-          e.t = double(t) * 1e-6;
+          e.t = double(t) / 1e6;  // correctly rounded: the same double as the text "S.UUUUUU"
           e.x = float(x);
           e.y = float(y);
           e.on = (d & 2u) != 0;
@@ -178,7 +178,7 @@ class Aedat31Reader final : public EventReader {
         if ((loadLE<std::uint32_t>(p) & 1u) == 0) continue;
         const auto ts = loadLE<std::int32_t>(p + 4);
         ImuSample s;
-        s.t = double((std::int64_t(overflow) << 31) | std::int64_t(std::uint32_t(ts) & 0x7FFFFFFFu)) * 1e-6;
+        s.t = double((std::int64_t(overflow) << 31) | std::int64_t(std::uint32_t(ts) & 0x7FFFFFFFu)) / 1e6;
         float v[6];
         for (int k = 0; k < 6; ++k) v[k] = loadLE<float>(p + 8 + 4 * k);
         s.accel = Vec3(v[0], v[1], v[2]) * kGravity;

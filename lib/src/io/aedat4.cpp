@@ -211,7 +211,7 @@ class Aedat4Reader final : public EventReader {
         continue;
       }
       Event e;
-      e.t = double(t) * 1e-6;
+      e.t = double(t) / 1e6;  // correctly rounded: the same double as the text "S.UUUUUU"
       e.x = float(x);
       e.y = float(y);
       e.on = on;
@@ -345,7 +345,7 @@ class Aedat4Reader final : public EventReader {
         for (std::size_t i = 0; i < count; ++i) {
           auto it = b.table(b.deref(first + 4 * i));
           ImuSample s;
-          s.t = double(b.scalar<std::int64_t>(it, 0, 0)) * 1e-6;
+          s.t = double(b.scalar<std::int64_t>(it, 0, 0)) / 1e6;
           float v[6];
           for (int k = 0; k < 6; ++k) v[k] = b.scalar<float>(it, 2 + k, 0.0f);
           s.accel = Vec3(v[0], v[1], v[2]) * kGravity;

@@ -1,6 +1,9 @@
 #include "celc/io/calibration.hpp"
 
 
+#include "io/aedat_readers.hpp"
+
+
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
@@ -117,6 +120,13 @@ Calibration loadCalibTxt(const std::string& path, int width, int height) {
 }
 
 Calibration loadCalibration(const std::string& path, int width, int height) {
+  // A ROS bag: the camera of its sensor_msgs/CameraInfo topic (no IMU or body section).
+  if (isContainerFile(path) && detectFormat(path) == Format::RosBag) {
+    Calibration c;
+    if (!detail::bagCameraModel(path, c.camera))
+      throw IoError(path + ": no sensor_msgs/CameraInfo topic: give the calibration (--calib FILE)");
+    return c;
+  }
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   if (ext == ".yaml" || ext == ".yml") return loadCalibrationYaml(path);

@@ -23,9 +23,13 @@ std::string toString(Format format) {
     case Format::Aedat2: return "AEDAT 2.0";
     case Format::Aedat31: return "AEDAT 3.1";
     case Format::Aedat4: return "AEDAT 4.0";
+    case Format::RosBag: return "ROS bag";
+    case Format::Hdf5: return "HDF5";
   }
   return "unknown";
 }
+
+bool isContainerFormat(Format format) { return format == Format::RosBag || format == Format::Hdf5; }
 
 std::string toString(ImuColumns columns) {
   switch (columns) {
@@ -52,6 +56,8 @@ ImuColumns parseImuColumns(const std::string& name) {
   throw std::invalid_argument("unknown IMU column order '" + name + "' (auto | rpg | gyro_first)");
 }
 
+ReaderOptions::ReaderOptions() = default;
+
 std::string ReaderOptions::validate() const {
   if (width < 0 || height < 0) return "width and height must be >= 0";
   if ((width == 0) != (height == 0)) return "give both width and height, or neither";
@@ -64,6 +70,9 @@ std::string ReaderOptions::validate() const {
   if (!(backwards_tolerance >= 0.0) || !std::isfinite(backwards_tolerance))
     return "backwards_tolerance must be >= 0 and finite";
   if (!(max_outside_share >= 0.0 && max_outside_share <= 1.0)) return "max_outside_share must be in [0, 1]";
+  for (const std::string* topic : {&topic_events, &topic_imu, &topic_pose})
+    if (topic->size() > 256 || detail::firstNonTextByte(*topic) != std::string::npos)
+      return "a topic name must be text of at most 256 characters";
   return {};
 }
 
@@ -245,6 +254,26 @@ bool exists(const std::string& p) {
 }
 }  // namespace
 
+/// Format::RosBag / Format::Hdf5 from the first bytes of a file, else Format::Text.
+static Format containerMagic(const std::string& head) {
+  if (head.rfind("#ROSBAG V", 0) == 0) return Format::RosBag;
+  // The HDF5 superblock signature sits at byte 0, 512, 1024 or 2048 (after a user block).
+  static const char kHdf5Signature[] = "\x89HDF\r\n\x1a\n";
+  for (std::size_t at : {0, 512, 1024, 2048})
+    if (head.size() >= at + 8 && head.compare(at, 8, kHdf5Signature, 8) == 0) return Format::Hdf5;
+  return Format::Text;
+}
+
+bool isContainerFile(const std::string& path) {
+  if (!exists(path)) return false;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  std::string head(2056, '\0');
+  head.resize(std::fread(&head[0], 1, head.size(), f));
+  std::fclose(f);
+  return isContainerFormat(containerMagic(head));
+}
+
 Format detectFormat(const std::string& path) {
   if (isDir(path)) {
     if (!isSequenceDirectory(path))
@@ -261,6 +290,7 @@ Format detectFormat(const std::string& path) {
   if (head.rfind("#!AER-DAT2.0", 0) == 0) return Format::Aedat2;
   if (head.rfind("#!AER-DAT3.1", 0) == 0) return Format::Aedat31;
   if (head.rfind("#!AER-DAT4.0", 0) == 0) return Format::Aedat4;
+  if (const Format c = containerMagic(head); isContainerFormat(c)) return c;
   if (head.rfind("#!AER-DAT", 0) == 0) {
     const std::size_t eol = head.find_first_of("\r\n");
     throw IoError(path + ": byte 0: unsupported AEDAT version '" +
@@ -291,6 +321,8 @@ std::unique_ptr<EventReader> openEventSource(const std::string& path, const Read
     case Format::Aedat2: return detail::openAedat2(path, options);
     case Format::Aedat31: return detail::openAedat31(path, options);
     case Format::Aedat4: return detail::openAedat4(path, options);
+    case Format::RosBag: return detail::openRosBag(path, options);
+    case Format::Hdf5: return detail::openHdf5(path, options);
   }
   throw IoError(path + ": unknown format");
 }
@@ -327,6 +359,15 @@ FileInfo scanFile(const std::string& path, const ReaderOptions& options) {
   }
   info.warnings = reader->warnings();
   info.notes = reader->notes();
+  if (isContainerFormat(info.format)) {
+    const auto poses = reader->readPoses();
+    if (!poses.empty()) {
+      char line[160];
+      std::snprintf(line, sizeof line, "ground-truth poses: %zu in [%.6f, %.6f] s", poses.size(), poses.front().t,
+                    poses.back().t);
+      info.notes.push_back(line);
+    }
+  }
   const auto imu = reader->readImu();
   info.imu_samples = imu.size();
   if (!imu.empty()) {

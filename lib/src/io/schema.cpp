@@ -23,6 +23,12 @@ void describe(FieldVisitor& v, ReaderOptions& o) {
                 o.backwards, {BackwardsPolicy::Error, BackwardsPolicy::Drop, BackwardsPolicy::Sort});
   v.field({"max_outside_share", "-", "share of events outside the sensor that stops the reading"},
           o.max_outside_share);
+  v.field({"topic_events", "", "ROS bag events topic, dvs_msgs/EventArray (empty = the one such topic)"},
+          o.topic_events);
+  v.field({"topic_imu", "", "ROS bag IMU topic, sensor_msgs/Imu (empty = the one such topic)"}, o.topic_imu);
+  v.field({"topic_pose", "",
+           "ROS bag ground-truth topic, geometry_msgs/PoseStamped or nav_msgs/Odometry (empty = the one such topic)"},
+          o.topic_pose);
 }
 
 void describe(FieldVisitor& v, WindowOptions& o) {

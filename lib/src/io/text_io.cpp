@@ -1,5 +1,6 @@
 #include "celc/io/text_io.hpp"
 
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -263,6 +264,15 @@ std::vector<ImuSample> readImuText(const std::string& path, const ReaderOptions&
 }
 
 std::vector<PoseSample> readPosesText(const std::string& path, const ReaderOptions& options) {
+  if (isContainerFile(path)) {
+    // A ROS bag or HDF5 file named as the ground truth: its pose topic / dataset.
+    std::vector<PoseSample> poses = openEventSource(path, options)->readPoses();
+    for (std::size_t i = 1; i < poses.size(); ++i)
+      if (!(poses[i].t > poses[i - 1].t))
+        throw IoError(path + ": pose " + std::to_string(i) + ": pose timestamps must increase (" +
+                      std::to_string(poses[i].t) + " after " + std::to_string(poses[i - 1].t) + ")");
+    return poses;
+  }
   LineReader lr(path);
   Layout layout;
   auto byCount = [](std::size_t n, Layout& l) {

@@ -33,7 +33,8 @@ Calibration loadCalibrationYaml(const std::string& path);
 /// (DAVIS240C 240x180 by default).
 Calibration loadCalibTxt(const std::string& path, int width = 240, int height = 180);
 
-/// By extension: .yaml / .yml -> YAML, otherwise calib.txt.
+/// A ROS bag: the camera of its sensor_msgs/CameraInfo. Otherwise by
+/// extension: .yaml / .yml -> YAML, otherwise calib.txt.
 Calibration loadCalibration(const std::string& path, int width = 240, int height = 180);
 
 }  // namespace celc

@@ -7,8 +7,11 @@
 ///
 /// Formats: RPG / Event Camera Dataset / UZH-FPV text (a directory holding
 /// events.txt [+ imu.txt], or a single events text file), AEDAT 2.0 (jAER,
-/// DAVIS), AEDAT 3.1 (cAER) and AEDAT 4.0 (DV). openEventSource() detects the
-/// format from the magic line (`#!AER-DAT2.0`, `#!AER-DAT3.1`, `#!AER-DAT4.0`).
+/// DAVIS), AEDAT 3.1 (cAER), AEDAT 4.0 (DV), ROS 1 bags (format 2.0 and 1.2;
+/// dvs_msgs/EventArray, sensor_msgs/Imu, geometry_msgs/PoseStamped or
+/// nav_msgs/Odometry, sensor_msgs/CameraInfo) and HDF5 (the DSEC and MVSEC
+/// layouts). openEventSource() detects the format from the magic bytes
+/// (`#!AER-DAT2.0`, `#!AER-DAT3.1`, `#!AER-DAT4.0`, `#ROSBAG V`, the HDF5 signature).
 ///
 /// Bad-input policy (docs/io.md):
 ///  - errors (an IoError naming the file and the line or byte offset): bad magic,
@@ -42,7 +45,7 @@ class IoError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Format { Text, RpgDirectory, Aedat2, Aedat31, Aedat4 };
+enum class Format { Text, RpgDirectory, Aedat2, Aedat31, Aedat4, RosBag, Hdf5 };
 std::string toString(Format format);
 
 /// Column order of an IMU text file (when the file has no header naming them).
@@ -71,6 +74,9 @@ inline constexpr int kMaxReaderSensorSide = 4096;
 inline constexpr std::size_t kSortBufferEvents = std::size_t(1) << 20;
 
 struct ReaderOptions {
+  /// Out of line: it keeps GCC 12 from a false -Wmaybe-uninitialized on the
+  /// topic strings of a value-initialised temporary holding these options.
+  ReaderOptions();
   /// Sensor size [px] when the file does not say (text formats); 0 = unknown:
   /// no pixel-range check. A non-zero value overrides the size in the file.
   int width = 0;
@@ -95,6 +101,12 @@ struct ReaderOptions {
   /// Share of events with a pixel outside the sensor beyond which reading stops
   /// with an error (checked once 100 such events are seen): a wrong sensor size.
   double max_outside_share = 0.05;
+  /// ROS bag topics (empty = found by message type: the one topic of
+  /// dvs_msgs/EventArray, of sensor_msgs/Imu, of geometry_msgs/PoseStamped or
+  /// nav_msgs/Odometry; several candidates are an error naming them).
+  std::string topic_events;
+  std::string topic_imu;
+  std::string topic_pose;
   /// Empty when valid, else what is wrong.
   std::string validate() const;
 };
@@ -133,6 +145,9 @@ class EventReader {
   virtual std::vector<ImuSample> readImu() = 0;
   /// Number of IMU samples without keeping them (default: readImu().size()).
   virtual std::uint64_t countImu() { return readImu().size(); }
+  /// Ground-truth poses T_world_body stored with the events (ROS bag pose
+  /// topic, MVSEC davis/left/pose), in time order; empty when the source has none.
+  virtual std::vector<PoseSample> readPoses() { return {}; }
   /// Skips ahead so that the next event read is the first with t >= t_start [s]
   /// (some earlier events of the same packet may remain; callers filter).
   /// Returns false when the reader cannot seek (then nothing changes).
@@ -213,6 +228,12 @@ std::unique_ptr<EventReader> openEventSource(const std::string& path,
                                              const ReaderOptions& options = {});
 /// Format of a path without opening a reader. Throws IoError when unreadable.
 Format detectFormat(const std::string& path);
+/// True for the container formats that carry IMU, poses and (bags) the camera
+/// calibration besides the events: ROS bag and HDF5.
+bool isContainerFormat(Format format);
+/// True when `path` is a regular file that starts like a ROS bag or an HDF5
+/// file (its magic bytes only; never throws).
+bool isContainerFile(const std::string& path);
 
 /// A summary from one full pass (what `celc info` prints).
 struct FileInfo {

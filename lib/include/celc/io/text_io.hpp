@@ -27,7 +27,8 @@ std::unique_ptr<EventReader> openTextEvents(const std::string& events_path,
 std::vector<ImuSample> readImuText(const std::string& path, const ReaderOptions& options = {});
 
 /// All poses T_world_body of a ground-truth text file (quaternion normalised;
-/// a zero quaternion is an error). Throws IoError (file and line).
+/// a zero quaternion is an error). Throws IoError (file and line). A ROS bag
+/// or HDF5 file given instead gives the poses it carries (EventReader::readPoses).
 std::vector<PoseSample> readPosesText(const std::string& path, const ReaderOptions& options = {});
 
 }  // namespace celc

@@ -1,0 +1,330 @@
+// HDF5 event recordings through the HDF5 C library (Debian libhdf5-dev; a
+// compressed dataset needs its filter plugin, e.g. hdf5-filter-plugin-blosc-serial
+// for blosc). Two layouts, told apart by their datasets:
+//  - DSEC: /events/{x,y} (uint16 [px]), /events/t (integer [us] after
+//    /t_offset), /events/p (0/1), /t_offset (int64 [us], 0 when absent),
+//    /ms_to_idx (index of the first event of each millisecond; used to seek);
+//  - MVSEC: /davis/left/events (N x 4 float64: x [px], y [px], t [s], p in
+//    {-1, 1}), /davis/left/imu (N x 6: accel [m/s^2] then gyro [rad/s], or
+//    gyro first with input.imu_columns: gyro_first) with /davis/left/imu_ts
+//    [s], /davis/left/pose (N x 4 x 4 T_world_body [m]) with /davis/left/pose_ts [s].
+// Events are read in hyperslabs of kBlockEvents: a window never loads the file.
+// Every dimension read from the file is checked before it sizes anything.
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "io/aedat_readers.hpp"
+#include "io/binary_file.hpp"
+
+namespace celc::detail {
+namespace {
+
+constexpr hsize_t kBlockEvents = hsize_t(1) << 16;
+constexpr hsize_t kMaxSideSamples = hsize_t(1) << 28;  ///< IMU / pose rows read at once
+
+/// An HDF5 identifier closed on scope exit.
+class H5Id {
+ public:
+  H5Id() = default;
+  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5Id(H5Id&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+  H5Id& operator=(H5Id&& o) noexcept {
+    std::swap(id_, o.id_);
+    std::swap(close_, o.close_);
+    return *this;
+  }
+  H5Id(const H5Id&) = delete;
+  H5Id& operator=(const H5Id&) = delete;
+  ~H5Id() {
+    if (id_ >= 0 && close_) close_(id_);
+  }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+/// A dataset opened with its shape.
+struct Dataset {
+  std::string name;
+  H5Id id, space;
+  std::vector<hsize_t> dims;
+};
+
+enum class Layout { Dsec, Mvsec };
+
+class Hdf5Reader final : public EventReader {
+ public:
+  Hdf5Reader(const std::string& path, const ReaderOptions& o) {
+    path_ = path;
+    options_ = o;
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures come back as return codes, reported here
+    file_ = H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file_.valid()) throw IoError(path + ": byte 0: not a readable HDF5 file (damaged or truncated?)");
+    if (exists("/events/x") || exists("/events/t")) {
+      layout_ = Layout::Dsec;
+      for (const char* n : {"x", "y", "t", "p"}) {
+        dsec_[n[0] == 'x' ? 0 : n[0] == 'y' ? 1 : n[0] == 't' ? 2 : 3] = open(std::string("/events/") + n, 1);
+      }
+      count_ = dsec_[0].dims[0];
+      for (const Dataset& d : dsec_)
+        if (d.dims[0] != count_)
+          fail(d.name, "holds " + std::to_string(d.dims[0]) + " values, /events/x " + std::to_string(count_));
+      if (exists("/t_offset")) {
+        Dataset off = open("/t_offset", 0);
+        if (H5Dread(off.id.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &t_offset_us_) < 0)
+          fail(off.name, "cannot read the scalar offset");
+      }
+      notes_.push_back("HDF5 layout DSEC: /events/{x,y,t,p}" + std::string(exists("/ms_to_idx") ? ", /ms_to_idx" : "") +
+                       ", t_offset " + std::to_string(t_offset_us_) + " us");
+      x_.resize(kBlockEvents);
+      y_.resize(kBlockEvents);
+      t_.resize(kBlockEvents);
+      p_.resize(kBlockEvents);
+    } else if (exists("/davis/left/events")) {
+      layout_ = Layout::Mvsec;
+      mvsec_ = open("/davis/left/events", 2);
+      if (mvsec_.dims[1] != 4)
+        fail(mvsec_.name, "has " + std::to_string(mvsec_.dims[1]) + " columns, expected 4 (x, y, t, p)");
+      count_ = mvsec_.dims[0];
+      notes_.push_back(std::string("HDF5 layout MVSEC: /davis/left/events") +
+                       (exists("/davis/left/imu") ? ", /davis/left/imu" : "") +
+                       (exists("/davis/left/pose") ? ", /davis/left/pose" : ""));
+      rows_.resize(kBlockEvents * 4);
+    } else {
+      throw IoError(path + ": neither the DSEC layout (/events/x, /events/y, /events/t, /events/p) nor the MVSEC "
+                           "layout (/davis/left/events) is in the file");
+    }
+    notes_.push_back(std::to_string(count_) + " events in the file");
+    width_ = o.width;
+    height_ = o.height;
+  }
+  Format format() const override { return Format::Hdf5; }
+
+  bool next(std::vector<Event>& batch, std::size_t max) override {
+    batch.clear();
+    if (max == 0) max = 1;
+    while (batch.size() < max) {
+      if (cur_ == have_) {
+        if (!refill()) break;
+        continue;
+      }
+      drain(batch, max);
+    }
+    if (batch.size() < max) release(batch, max);
+    return !batch.empty();
+  }
+
+  std::vector<ImuSample> readImu() override {
+    std::vector<ImuSample> imu;
+    if (layout_ != Layout::Mvsec || !exists("/davis/left/imu")) return imu;
+    Dataset values = open("/davis/left/imu", 2), stamps = open("/davis/left/imu_ts", 1);
+    if (values.dims[1] != 6) fail(values.name, "has " + std::to_string(values.dims[1]) + " columns, expected 6");
+    if (values.dims[0] != stamps.dims[0])
+      fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
+                            " IMU rows");
+    const std::vector<double> v = readAll(values, 6), t = readAll(stamps, 1);
+    const bool gyro_first = options_.imu_columns == ImuColumns::GyroFirst;
+    imu.resize(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double* r = &v[6 * i];
+      imu[i].t = t[i];
+      imu[i].accel = gyro_first ? Vec3(r[3], r[4], r[5]) : Vec3(r[0], r[1], r[2]);
+      imu[i].gyro = gyro_first ? Vec3(r[0], r[1], r[2]) : Vec3(r[3], r[4], r[5]);
+      if (!std::isfinite(t[i]) || !imu[i].accel.allFinite() || !imu[i].gyro.allFinite())
+        fail(values.name, "row " + std::to_string(i) + ": a non-finite value");
+    }
+    return imu;
+  }
+
+  std::vector<PoseSample> readPoses() override {
+    std::vector<PoseSample> poses;
+    if (layout_ != Layout::Mvsec || !exists("/davis/left/pose")) return poses;
+    Dataset values = open("/davis/left/pose", 3), stamps = open("/davis/left/pose_ts", 1);
+    if (values.dims[1] != 4 || values.dims[2] != 4) fail(values.name, "is not N x 4 x 4");
+    if (values.dims[0] != stamps.dims[0])
+      fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
+                            " poses");
+    const std::vector<double> v = readAll(values, 16), t = readAll(stamps, 1);
+    poses.resize(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      Eigen::Matrix4d T;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) T(r, c) = v[16 * i + 4 * r + c];
+      const Mat3 R = T.topLeftCorner<3, 3>();
+      if (!T.allFinite() || !std::isfinite(t[i]) || (R.transpose() * R - Mat3::Identity()).norm() > 1e-3)
+        fail(values.name, "pose " + std::to_string(i) + ": not a finite rigid transform");
+      poses[i].t = t[i];
+      poses[i].position = T.topRightCorner<3, 1>();
+      poses[i].orientation = Eigen::Quaterniond(R).normalized();
+    }
+    return poses;
+  }
+
+  bool seekTime(double t_start) override {
+    if (layout_ != Layout::Dsec || !exists("/ms_to_idx") || !std::isfinite(t_start)) return false;
+    Dataset ms = open("/ms_to_idx", 1);
+    const double rel_ms = std::floor((t_start * 1e6 - double(t_offset_us_)) / 1000.0);
+    if (rel_ms <= 0) return true;
+    const hsize_t k = hsize_t(std::min(rel_ms, double(ms.dims[0] ? ms.dims[0] - 1 : 0)));
+    if (ms.dims[0] == 0) return false;
+    std::uint64_t idx = 0;
+    H5Id mem(H5Screate_simple(1, std::vector<hsize_t>{1}.data(), nullptr), H5Sclose);
+    hsize_t start = k, one = 1;
+    H5Sselect_hyperslab(ms.space.get(), H5S_SELECT_SET, &start, nullptr, &one, nullptr);
+    if (H5Dread(ms.id.get(), H5T_NATIVE_UINT64, mem.get(), ms.space.get(), H5P_DEFAULT, &idx) < 0)
+      fail(ms.name, "cannot read entry " + std::to_string(k));
+    next_ = std::min<hsize_t>(idx, count_);
+    cur_ = have_ = 0;
+    return true;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& dataset, const std::string& what) const {
+    throw IoError(path_ + ": dataset " + dataset + ": " + what);
+  }
+
+  bool exists(const std::string& name) const {
+    // Each link along the path must exist before the next is asked about.
+    std::size_t p = 0;
+    while ((p = name.find('/', p + 1)) != std::string::npos)
+      if (H5Lexists(file_.get(), name.substr(0, p).c_str(), H5P_DEFAULT) <= 0) return false;
+    return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0;
+  }
+
+  Dataset open(const std::string& name, int rank) const {
+    Dataset d;
+    d.name = name;
+    if (!exists(name)) throw IoError(path_ + ": dataset " + name + " is missing");
+    d.id = H5Id(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!d.id.valid()) fail(name, "cannot be opened (not a dataset?)");
+    d.space = H5Id(H5Dget_space(d.id.get()), H5Sclose);
+    const int r = H5Sget_simple_extent_ndims(d.space.get());
+    if (r != rank) fail(name, "has rank " + std::to_string(r) + ", expected " + std::to_string(rank));
+    d.dims.assign(std::size_t(std::max(rank, 0)), 0);
+    if (rank > 0) H5Sget_simple_extent_dims(d.space.get(), d.dims.data(), nullptr);
+    // A filtered (compressed) dataset whose filter is not available cannot be read: say which.
+    H5Id plist(H5Dget_create_plist(d.id.get()), H5Pclose);
+    // A chunk is decompressed whole: its size is bounded like an AEDAT packet.
+    if (plist.valid() && rank > 0 && H5Pget_layout(plist.get()) == H5D_CHUNKED) {
+      std::vector<hsize_t> chunk(std::size_t(rank), 0);
+      H5Id type(H5Dget_type(d.id.get()), H5Tclose);
+      double bytes = type.valid() ? double(H5Tget_size(type.get())) : 8.0;
+      if (H5Pget_chunk(plist.get(), rank, chunk.data()) == rank)
+        for (hsize_t c : chunk) bytes *= double(c);
+      if (bytes > double(options_.max_packet_bytes))
+        fail(name, "chunks of " + std::to_string(std::uint64_t(bytes)) +
+                       " bytes, more than input.max_packet_bytes = " + std::to_string(options_.max_packet_bytes));
+    }
+    const int nf = plist.valid() ? H5Pget_nfilters(plist.get()) : 0;
+    for (int i = 0; i < nf; ++i) {
+      unsigned flags = 0, cd[8];
+      std::size_t ncd = 8;
+      char fname[64] = {0};
+      const H5Z_filter_t f = H5Pget_filter2(plist.get(), unsigned(i), &flags, &ncd, cd, sizeof fname, fname, nullptr);
+      if (f >= 0 && H5Zfilter_avail(f) <= 0)
+        fail(name, "compressed with filter " + std::to_string(int(f)) + " (" + printable(fname, 40) +
+                       ") that this HDF5 library cannot load (blosc: install hdf5-filter-plugin-blosc-serial)");
+    }
+    return d;
+  }
+
+  /// Every value of a small dataset (IMU, poses) as double, `cols` per row.
+  std::vector<double> readAll(const Dataset& d, std::size_t cols) const {
+    if (d.dims[0] > kMaxSideSamples) fail(d.name, "holds more than " + std::to_string(kMaxSideSamples) + " rows");
+    std::vector<double> v(std::size_t(d.dims[0]) * cols);
+    if (!v.empty() && H5Dread(d.id.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+      fail(d.name, "cannot be read as numbers");
+    return v;
+  }
+
+  /// Reads rows [next_, next_ + n) of `d` (rank 1 or rows x cols) into `dst`.
+  void readBlock(const Dataset& d, hid_t type, void* dst, hsize_t n) {
+    hsize_t start[2] = {next_, 0}, count[2] = {n, d.dims.size() > 1 ? d.dims[1] : 1};
+    const int rank = int(d.dims.size());
+    H5Id mem(H5Screate_simple(rank, count, nullptr), H5Sclose);
+    if (H5Sselect_hyperslab(d.space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0 ||
+        H5Dread(d.id.get(), type, mem.get(), d.space.get(), H5P_DEFAULT, dst) < 0)
+      fail(d.name, "event " + std::to_string(next_) + ": cannot read " + std::to_string(n) +
+                       " values (damaged file, or a compressed chunk whose filter is missing)");
+  }
+
+  bool refill() {
+    if (next_ >= count_) return false;
+    const hsize_t n = std::min(kBlockEvents, count_ - next_);
+    if (layout_ == Layout::Dsec) {
+      readBlock(dsec_[0], H5T_NATIVE_UINT16, x_.data(), n);
+      readBlock(dsec_[1], H5T_NATIVE_UINT16, y_.data(), n);
+      readBlock(dsec_[2], H5T_NATIVE_INT64, t_.data(), n);
+      readBlock(dsec_[3], H5T_NATIVE_UINT8, p_.data(), n);
+    } else {
+      readBlock(mvsec_, H5T_NATIVE_DOUBLE, rows_.data(), n);
+    }
+    block_start_ = next_;
+    next_ += n;
+    have_ = std::size_t(n);
+    cur_ = 0;
+    return true;
+  }
+
+  void drain(std::vector<Event>& batch, std::size_t max) {
+    for (; cur_ < have_ && batch.size() < max; ++cur_) {
+      auto where = [&] {
+        return path_ + ": dataset " + (layout_ == Layout::Dsec ? "/events" : "/davis/left/events") + ", event " +
+               std::to_string(block_start_ + cur_);
+      };
+      Event e;
+      double x, y;
+      if (layout_ == Layout::Dsec) {
+        x = x_[cur_];
+        y = y_[cur_];
+        std::int64_t us = 0;
+        if (__builtin_add_overflow(t_offset_us_, t_[cur_], &us))
+          throw IoError(where() + ": timestamp " + std::to_string(t_[cur_]) + " us plus t_offset overflows");
+        e.t = double(us) / 1e6;  // as exact as the text: a correctly rounded quotient
+        e.on = p_[cur_] != 0;
+      } else {
+        const double* r = &rows_[4 * cur_];
+        x = r[0];
+        y = r[1];
+        e.t = r[2];
+        e.on = r[3] > 0;
+        if (!std::isfinite(e.t) || !(x >= 0 && x < 65536) || !(y >= 0 && y < 65536) || x != std::floor(x) ||
+            y != std::floor(y))
+          throw IoError(where() + ": not an event (x, y whole pixels, t finite)");
+      }
+      if ((width_ > 0 && x >= width_) || (height_ > 0 && y >= height_)) {
+        outsideSensor(where(), x, y);
+        continue;
+      }
+      e.x = float(x);
+      e.y = float(y);
+      admit(batch, e, where);
+    }
+  }
+
+  H5Id file_;
+  Layout layout_ = Layout::Dsec;
+  Dataset dsec_[4];  ///< x, y, t, p
+  Dataset mvsec_;
+  std::int64_t t_offset_us_ = 0;
+  hsize_t count_ = 0, next_ = 0, block_start_ = 0;
+  std::size_t have_ = 0, cur_ = 0;
+  std::vector<std::uint16_t> x_, y_;
+  std::vector<std::int64_t> t_;
+  std::vector<std::uint8_t> p_;
+  std::vector<double> rows_;
+};
+
+}  // namespace
+
+std::unique_ptr<EventReader> openHdf5(const std::string& path, const ReaderOptions& o) {
+  return std::make_unique<Hdf5Reader>(path, o);
+}
+
+}  // namespace celc::detail
