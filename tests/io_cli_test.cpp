@@ -52,7 +52,14 @@ TEST(IoCli, InfoBadFileIsOneLineErrorNonZeroExit) {
   celc::test::writeBytes(d.file("w.txt"), "0.2 1 2 1\n0.1995 1 2 1\n");  // within input.backwards_tolerance
   ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("w.txt"), out), 0) << out;
   EXPECT_NE(out.find("timestamps backwards 1"), std::string::npos) << out;
+  EXPECT_NE(out.find("time jumps and gaps 0, truncated end 0"), std::string::npos) << out;
   EXPECT_NE(run(std::string(CELC_BINARY) + " info --strict " + d.file("w.txt"), out), 0);
+  // One outlier timestamp (1e7 s) among 1 ms steps: dropped, counted as a time jump.
+  std::string jump;
+  for (int i = 0; i < 50; ++i) jump += std::to_string(1.0 + i * 1e-3) + " 1 2 1\n" + (i == 20 ? "10000000 1 2 1\n" : "");
+  celc::test::writeBytes(d.file("j.txt"), jump);
+  ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("j.txt"), out), 0) << out;
+  EXPECT_NE(out.find("time jumps and gaps 1,"), std::string::npos) << out;
   celc::test::writeBytes(d.file("b.txt"), "0.2 1 2 1\n0.1 1 2 1\n");  // beyond it: an error naming the line
   EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("b.txt"), out), 0);
   EXPECT_NE(out.find("b.txt: line 2: timestamp"), std::string::npos) << out;

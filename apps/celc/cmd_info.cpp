@@ -64,11 +64,14 @@ int runInfo(const InfoArgs& a) {
       spdlog::warn("IMU not read for the still-second check: {}", e.what());
     }
   }
-  std::printf("warnings:      %llu (timestamps backwards %llu, pixels outside sensor %llu, skipped %llu)\n",
+  std::printf("warnings:      %llu (timestamps backwards %llu, pixels outside sensor %llu, skipped %llu, "
+              "time jumps and gaps %llu, truncated end %llu)\n",
               static_cast<unsigned long long>(info.warnings.total()),
               static_cast<unsigned long long>(info.warnings.backwards_time),
               static_cast<unsigned long long>(info.warnings.outside_sensor),
-              static_cast<unsigned long long>(info.warnings.skipped_records));
+              static_cast<unsigned long long>(info.warnings.skipped_records),
+              static_cast<unsigned long long>(info.warnings.time_jumps),
+              static_cast<unsigned long long>(info.warnings.truncated));
   for (const auto& m : info.warnings.messages) std::printf("  warning: %s\n", m.c_str());
   return 0;
 }
