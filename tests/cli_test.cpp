@@ -59,6 +59,18 @@ TEST(Cli, SimulateIsDeterministicAcrossThreadCounts) {
   fs::remove_all(d);
 }
 
+// DIR/events.csv (t,x,y,cluster) and DIR/calib.yaml of a line scene, for `celc solve`.
+static void writeLabelledScene(const fs::path& d, const LineSceneTrial& tr) {
+  std::ofstream csv(d / "events.csv");
+  csv << "t,x,y,cluster\n";
+  csv.precision(12);
+  for (size_t i = 0; i < tr.pixel_events.size(); ++i)
+    csv << tr.pixel_events[i].t << "," << tr.pixel_events[i].x << "," << tr.pixel_events[i].y << ","
+        << tr.labels[i] << "\n";
+  std::ofstream calib(d / "calib.yaml");
+  calib << "camera: {width: 346, height: 260, fx: 320, fy: 320, cx: 173, cy: 130}\n";
+}
+
 TEST(Cli, SolveOnLabelledEventsRecoversVelocity) {
   const fs::path d = tempDir("solve");
   LineSceneOptions o;
@@ -66,16 +78,7 @@ TEST(Cli, SolveOnLabelledEventsRecoversVelocity) {
   o.events_per_line = 600;
   std::mt19937_64 rng(3);
   const auto tr = generateLineScene(o, rng);
-  {
-    std::ofstream csv(d / "events.csv");
-    csv << "t,x,y,cluster\n";
-    csv.precision(12);
-    for (size_t i = 0; i < tr.pixel_events.size(); ++i)
-      csv << tr.pixel_events[i].t << "," << tr.pixel_events[i].x << "," << tr.pixel_events[i].y
-          << "," << tr.labels[i] << "\n";
-    std::ofstream calib(d / "calib.yaml");
-    calib << "camera: {width: 346, height: 260, fx: 320, fy: 320, cx: 173, cy: 130}\n";
-  }
+  writeLabelledScene(d, tr);
   const auto r = runCelc("solve '" + (d / "events.csv").string() + "' --omega 0,0,2 --calib '" +
                              (d / "calib.yaml").string() + "' ",
                          d);
@@ -118,15 +121,8 @@ TEST(Cli, SolveTakesTheRunConfiguration) {
   o.events_per_line = 400;
   std::mt19937_64 rng(5);
   const auto tr = generateLineScene(o, rng);
+  writeLabelledScene(d, tr);
   {
-    std::ofstream csv(d / "events.csv");
-    csv << "t,x,y,cluster\n";
-    csv.precision(12);
-    for (size_t i = 0; i < tr.pixel_events.size(); ++i)
-      csv << tr.pixel_events[i].t << "," << tr.pixel_events[i].x << "," << tr.pixel_events[i].y
-          << "," << tr.labels[i] << "\n";
-    std::ofstream calib(d / "calib.yaml");
-    calib << "camera: {width: 346, height: 260, fx: 320, fy: 320, cx: 173, cy: 130}\n";
     std::ofstream cfg(d / "run.yaml");
     cfg << "lines:\n  model: static\n  interval_fraction: 0.1\nmethods: [celc]\n";
   }

@@ -12,6 +12,7 @@
 
 #include "celc/eval/metrics.hpp"
 #include "celc/sim/peer_scene.hpp"
+#include "celc/sim/render_sequence.hpp"
 #include "celc/solver/solver.hpp"
 
 namespace celc::test {
@@ -19,21 +20,10 @@ namespace {
 
 const double kDeg = 180.0 / M_PI;
 
-// DAVIS240-like camera: 240 x 180, f = 200 px.
-CameraModel davis240() {
-  CameraModel c;
-  c.width = 240;
-  c.height = 180;
-  c.fx = c.fy = 200.0;
-  c.cx = 120.0;
-  c.cy = 90.0;
-  return c;
-}
-
 // A DAVIS240 moving at V through segments 3-6 m away, no pixel noise.
 PeerSceneOptions davis240Scene(double speed, double duration, double omega_rad_s) {
   PeerSceneOptions o;
-  o.camera = davis240();
+  o.camera = cameraPreset("davis240");  // 240 x 180, f = 200 px, no distortion
   o.speed = speed;
   o.duration = duration;
   o.depth_range = Vec2(3.0, 6.0);
