@@ -68,8 +68,9 @@ inline void twistSeriesCoefficients(double x, double& A, double& B, double& C) {
 
 /// The EventLineTerms of one cluster's events without 3x3 products: the
 /// cluster's constants are formed once (TwistRowConstants for a constant
-/// twist; other motion models take R_k and P_k from the model). Equal to
-/// celcRow up to rounding.
+/// twist; other motion models take R_k and P_k from the model). row() equals
+/// celcRow up to rounding under a constant twist, and is celcRow otherwise
+/// (the pose costs most there). Keeps references to frame and motion.
 class ClusterRowTerms {
  public:
   ClusterRowTerms(const ClusterFrame& frame, const MotionModel& motion);
@@ -78,8 +79,10 @@ class ClusterRowTerms {
   void row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) const;
   /// The constant twist's constants; null for other motion models.
   const TwistRowConstants* twist() const { return twist_ ? &k_ : nullptr; }
+  const ClusterFrame& frame() const { return *frame_; }
 
  private:
+  const ClusterFrame* frame_;
   const MotionModel* motion_;
   bool twist_;
   TwistRowConstants k_;

@@ -2,6 +2,7 @@
 #include "sign_test.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <vector>
 
@@ -21,17 +22,33 @@ struct SignVotes {
 
   SignVotes(const ClusterObservation& c, const ClusterFrame& frame, const MotionModel& motion)
       : cl(&c), terms(frame, motion) {}
+  // lambda of the event (t, f); NaN when it sees neither plane. Under a
+  // constant twist from the cluster's terms, else from the pose as the row
+  // of celcRow (bit-identical to the former test there).
+  double depth(double t, const Vec3& f, const MotionModel& motion, const Vec3& v) const {
+    double a1, a3, d1, d3;  // m_i.f' and m_i.(p_i - p_k)
+    if (terms.twist()) {
+      const EventLineTerms e = terms.at(t);
+      a1 = e.g1.dot(f), a3 = e.g3.dot(f), d1 = e.s.dot(v), d3 = e.u.dot(v);
+    } else {
+      const ClusterFrame& fr = terms.frame();
+      Mat3 Rk, Pk;
+      motion.pose(t, Rk, Pk);
+      const Vec3 fp = Rk * f, pk = Pk * v;
+      a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
+      d1 = fr.m1.dot(fr.Ps * v - pk), d3 = fr.m3.dot(fr.Pe * v - pk);
+    }
+    const double den = a1 * a1 + a3 * a3;
+    if (!(den > 1e-24)) return NAN;
+    return (a1 * d1 + a3 * d3) / den;
+  }
   size_t remaining() const { return next < cl->size() ? (cl->size() - 1 - next) / stride + 1 : 0; }
   // Counts votes until the majority cannot change (or all are counted).
-  void count(const Vec3& v, bool all) {
+  void count(const MotionModel& motion, const Vec3& v, bool all) {
     for (; next < cl->size(); next += stride) {
       if (!all && static_cast<size_t>(std::abs(pos - neg)) > remaining()) return;
-      const EventLineTerms e = terms.at(cl->times[next]);
-      const Vec3& f = cl->bearings[next];
-      const double a1 = e.g1.dot(f), a3 = e.g3.dot(f);
-      const double den = a1 * a1 + a3 * a3;
-      if (!(den > 1e-24)) continue;
-      const double lambda = (a1 * e.s.dot(v) + a3 * e.u.dot(v)) / den;
+      const double lambda = depth(cl->times[next], cl->bearings[next], motion, v);
+      if (std::isnan(lambda)) continue;
       if (lambda > 0) ++pos;
       else if (lambda < 0) ++neg;
     }
@@ -54,7 +71,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   for (int c : frames.clusters()) {
     SignVotes& s = clusters.emplace_back(obs.clusters[c], frames[c], motion);
     s.stride = std::max<size_t>(1, s.cl->size() / kSignVotesPerCluster);
-    s.count(v, false);
+    s.count(motion, v, false);
   }
   int votes = 0, voters = 0;
   for (const auto& s : clusters) {
@@ -71,7 +88,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   }
   long event_balance = 0;
   for (auto& s : clusters) {
-    s.count(v, true);
+    s.count(motion, v, true);
     if (s.pos != s.neg) event_balance += s.pos - s.neg;
   }
   d.sign = event_balance >= 0 ? 1 : -1;
