@@ -9,6 +9,7 @@
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
 #include "solver/constraint_rows.hpp"
+#include "solver/irls_kernel.hpp"
 #include "solver/robust_nullspace.hpp"
 #include "solver/sign_test.hpp"
 #include "solver/window_checks.hpp"
@@ -140,9 +141,11 @@ TEST(SignTest, SequentialCountMatchesFullCount) {
 // 8 rad/s over the 0.5 s window (up to 4 rad, both coefficient branches) and
 // the gyro-integrated model. 1e-12 relative to the row's size allows for the
 // different order of operations (and for so3's closed form of C, which loses
-// digits to cancellation at small angles).
+// digits to cancellation at small angles). Also the rows formed across a
+// cluster's events into packed columns (PackedRows::appendTwistRows).
 TEST(ConstraintRows, BuilderMatchesCelcRow) {
   std::mt19937_64 rng(21);
+  int packed_clusters = 0;
   for (int trial = 0; trial < 12; ++trial) {
     LineSceneOptions o;
     o.events_per_line = 40;
@@ -153,6 +156,19 @@ TEST(ConstraintRows, BuilderMatchesCelcRow) {
     for (const auto& cl : tr.observations.clusters) {
       const ClusterFrame frame = makeClusterFrame(cl, motion);
       const detail::ClusterRowTerms terms(frame, motion);
+      // The same rows formed across the events, where the series applies.
+      const detail::TwistRowConstants* twist = terms.twist();
+      std::vector<double> t, fx, fy, fz;
+      bool in_range = twist != nullptr;
+      for (size_t k = 0; k < cl.size(); ++k) {
+        t.push_back(cl.times[k]);
+        fx.push_back(cl.bearings[k].x()), fy.push_back(cl.bearings[k].y()), fz.push_back(cl.bearings[k].z());
+        if (twist) in_range = in_range && twist->w2 * std::pow(t[k] - twist->t_ref, 2) < detail::kTwistSeriesLimit;
+      }
+      detail::PackedRows packed(cl.size(), 2);
+      if (in_range) {
+        ASSERT_TRUE(packed.appendTwistRows(*twist, t.data(), fx.data(), fy.data(), fz.data(), t.size()));
+      }
       for (size_t k = 0; k < cl.size(); ++k) {
         const detail::ConstraintRow ref = detail::celcRow(frame, motion, cl.times[k], cl.bearings[k]);
         Vec3 a, n0, n1;
@@ -161,7 +177,16 @@ TEST(ConstraintRows, BuilderMatchesCelcRow) {
         EXPECT_LT((a - ref.a).norm(), 1e-12 * scale) << "trial " << trial << " event " << k;
         EXPECT_LT((n0 - ref.N.row(0).transpose()).norm(), 1e-12 * scale) << "trial " << trial;
         EXPECT_LT((n1 - ref.N.row(1).transpose()).norm(), 1e-12 * scale) << "trial " << trial;
+        if (!in_range) continue;
+        const double* c = packed.data() + k;
+        const size_t s = packed.stride();
+        const Vec3 pa(c[0], c[s], c[2 * s]), p0(c[3 * s], c[4 * s], c[5 * s]), p1(c[6 * s], c[7 * s], c[8 * s]);
+        EXPECT_LT((pa - ref.a).norm(), 1e-12 * scale) << "trial " << trial << " event " << k;
+        EXPECT_LT((p0 - ref.N.row(0).transpose()).norm(), 1e-12 * scale) << "trial " << trial;
+        EXPECT_LT((p1 - ref.N.row(1).transpose()).norm(), 1e-12 * scale) << "trial " << trial;
       }
+      if (in_range) ++packed_clusters;
     }
   }
+  EXPECT_GE(packed_clusters, 20);  // the kernel ran (twists up to 2 rad/s: 30 clusters)
 }

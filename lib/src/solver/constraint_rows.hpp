@@ -47,7 +47,7 @@ struct TwistRowConstants {
 };
 
 /// B and C by their Taylor series in x = |phi|^2 <= kTwistSeriesLimit, to the
-/// x^10 term (truncation below 1e-20 relative; no cancellation, unlike the
+/// x^10 term (truncation below 1e-19 relative; no cancellation, unlike the
 /// closed form of C at small angles); A = 1 - x C. Inline: the row kernel
 /// evaluates it across events.
 constexpr double kTwistSeriesLimit = 2.25;  // |phi| <= 1.5 rad
