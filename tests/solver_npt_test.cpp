@@ -1,10 +1,12 @@
 // Method npt (Gao et al., CVPR 2024) and the peers' scene it is compared on.
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "celc/core/yaml.hpp"
 #include "celc/sim/line_scene.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/npt.hpp"
@@ -118,6 +120,124 @@ TEST(Npt, NoiseLevelMatchesPublishedReference) {
     const double med = medianOf(phi);
     EXPECT_GT(med, ref.median_deg / 1.8) << "V " << ref.speed << " sigma " << ref.sigma;
     EXPECT_LT(med, ref.median_deg * 1.8) << "V " << ref.speed << " sigma " << ref.sigma;
+  }
+}
+
+namespace {
+// The published variant computed independently of solveNpt: every event's row
+// [(t - t_first) f'^T, f'^T] with f' = R(t) f / |f| (P = tau I: the peers'
+// gyro-integrated model), each line's x the last right singular vector of its
+// stacked rows (SVD of the rows, not the eigenvectors of their normal
+// matrix), scaled to |m| = 1; x = [a; m] gives d = m x a / |m x a| and the
+// line's averaging row d x (a x d), the normal of the plane of d and v, of
+// length |a| (npt.hpp's u_z e2 - u_y e3 up to sign); v the last right
+// singular vector of the stacked averaging rows.
+Vec3 publishedNptBySvd(const WindowObservations& obs, const MotionModel& motion) {
+  double t_first = INFINITY;
+  for (const auto& c : obs.clusters)
+    for (double t : c.times) t_first = std::min(t_first, t);
+  std::vector<Vec3> rows;
+  for (const auto& c : obs.clusters) {
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(c.size()), 6);
+    for (size_t k = 0; k < c.size(); ++k) {
+      const Vec3 fp = motion.rotation(c.times[k]) * c.bearings[k].normalized();
+      A.row(static_cast<Eigen::Index>(k)) << (c.times[k] - t_first) * fp.transpose(), fp.transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+    Eigen::Matrix<double, 6, 1> x = svd.matrixV().col(5);
+    x /= x.tail<3>().norm();
+    const Vec3 a = x.head<3>(), m = x.tail<3>();
+    const Vec3 d = m.cross(a).normalized();
+    rows.push_back(d.cross(a.cross(d)));  // d x v_perp: orthogonal to d and to v
+  }
+  Eigen::MatrixXd H(static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) H.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(H, Eigen::ComputeFullV).matrixV().col(2);
+}
+
+NptOptions nptVariant(NptTimeOrigin origin, NptLineNormalisation normalisation) {
+  NptOptions o;
+  o.time_origin = origin;
+  o.line_normalisation = normalisation;
+  return o;
+}
+}  // namespace
+
+// The published variant (time from the window's first event, each line's x
+// scaled to a unit moment) equals an independent SVD implementation of it on
+// noisy data (5 lines x 200 events, V = 2 m/s, 1 px): 1e-9 rad allows for
+// solveNpt's normal matrix, which squares each line's conditioning; it is far
+// below the 0.3-10 deg the options move v by.
+TEST(Npt, PublishedVariantMatchesIndependentSvd) {
+  std::mt19937_64 rng(31);
+  const NptOptions published = nptVariant(NptTimeOrigin::FirstEvent, NptLineNormalisation::Moment);
+  for (int i = 0; i < 10; ++i) {
+    const PeerSceneTrial tr = generatePeerScene(peerScene(2.0, 1.0), rng);
+    ASSERT_TRUE(tr.ok);
+    const SolverResult r = solveNpt(tr.observations, tr.given_motion, published);
+    ASSERT_TRUE(r.ok()) << r.message;
+    const Vec3 ref = publishedNptBySvd(tr.observations, tr.given_motion);
+    EXPECT_LT(angleBetweenSignAgnostic(r.v, ref), 1e-9) << "trial " << i;
+  }
+}
+
+// Noise-free, every time origin and normalisation gives the exact direction
+// (the incidence holds for any origin; scaling a line's row does not move the
+// common nullspace); with noise they differ (the options do act).
+TEST(Npt, OptionsAgreeOnNoiseFreeDataAndDifferWithNoise) {
+  std::mt19937_64 rng(32);
+  const std::vector<NptOptions> variants{
+      nptVariant(NptTimeOrigin::Centre, NptLineNormalisation::Vector),
+      nptVariant(NptTimeOrigin::Centre, NptLineNormalisation::Moment),
+      nptVariant(NptTimeOrigin::FirstEvent, NptLineNormalisation::Vector),
+      nptVariant(NptTimeOrigin::FirstEvent, NptLineNormalisation::Moment)};
+  for (int i = 0; i < 8; ++i) {
+    const double speed = i % 2 ? 5.0 : 1.0;
+    const PeerSceneTrial clean = generatePeerScene(peerScene(speed, 0.0), rng);
+    ASSERT_TRUE(clean.ok);
+    std::vector<Vec3> v;
+    for (const NptOptions& o : variants) {
+      const SolverResult r = solveNpt(clean.observations, clean.true_motion, o);
+      ASSERT_TRUE(r.ok()) << r.message;
+      // 1e-8 rad: the noise-free test's bound at 5 x 200 events (1e-9 deg measured).
+      EXPECT_LT(angleBetweenSignAgnostic(r.v, clean.true_direction), 1e-8) << "trial " << i;
+      v.push_back(r.v);
+    }
+    const PeerSceneTrial noisy = generatePeerScene(peerScene(speed, 1.0), rng);
+    ASSERT_TRUE(noisy.ok);
+    const Vec3 base = solveNpt(noisy.observations, noisy.given_motion, variants[0]).v;
+    for (size_t j = 1; j < variants.size(); ++j)
+      EXPECT_GT(angleBetweenSignAgnostic(solveNpt(noisy.observations, noisy.given_motion, variants[j]).v, base),
+                1e-6)
+          << "trial " << i << " variant " << j;
+  }
+}
+
+// The two origins, for one line alone or a window: centre = the midpoint of the
+// first and last event times, first_event = the earliest.
+TEST(Npt, TimeOriginOfAWindow) {
+  WindowObservations obs;
+  obs.clusters.resize(2);
+  obs.clusters[0].times = {0.3, 0.1, 0.7};
+  obs.clusters[1].times = {NAN, 0.2, 0.9};
+  EXPECT_DOUBLE_EQ(nptTimeOrigin(obs, NptTimeOrigin::FirstEvent), 0.1);
+  EXPECT_DOUBLE_EQ(nptTimeOrigin(obs, NptTimeOrigin::Centre), 0.5);
+  EXPECT_EQ(nptTimeOrigin(WindowObservations{}, NptTimeOrigin::Centre), 0.0);
+}
+
+// The options are read by name; a wrong name is a one-line error naming the key.
+TEST(Npt, OptionsFromYaml) {
+  NptOptions o;
+  readYaml("time_origin: first_event\nline_normalisation: moment\n", "npt.yaml",
+           [&](FieldVisitor& v) { describe(v, o); });
+  EXPECT_EQ(o.time_origin, NptTimeOrigin::FirstEvent);
+  EXPECT_EQ(o.line_normalisation, NptLineNormalisation::Moment);
+  try {
+    readYaml("time_origin: middle\n", "npt.yaml", [&](FieldVisitor& v) { describe(v, o); });
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "npt.yaml:1: key 'time_origin': expected one of centre, first_event, got 'middle'");
   }
 }
 

@@ -2,8 +2,10 @@
 #include <benchmark/benchmark.h>
 
 #include "celc/sim/line_scene.hpp"
+#include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
 #include "solver/ce3lc.hpp"
+#include "solver/celc_linear.hpp"
 #include "solver/constraint_rows.hpp"
 #include "solver/irls_kernel.hpp"
 #include "solver/robust_nullspace.hpp"
@@ -73,6 +75,47 @@ static void BM_CelcLinearMethod1000Events(benchmark::State& state) {
     benchmark::DoNotOptimize(solveCelcLinear(tr.observations, tr.given_motion, {}));
 }
 BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
+
+// The CELC linear method as the dispatcher (solveMethods) runs it, the issue-14
+// target: the clusters' frames, the rows, the IRLS and the sign test; the
+// window checks, shared by all methods, are measured apart
+// (BM_WindowChecks1000Events). arg = events per line, 5 lines.
+// Paper's scene: constant twist, |w| T = 1 rad, 2 px noise.
+static void BM_CelcLinear(benchmark::State& state) {
+  const auto tr = scene(static_cast<int>(state.range(0)));
+  const LinearOptions opt;
+  int ok = 0, iterations = 0;
+  for (auto _ : state) {
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
+    ok = r.ok();
+    iterations = r.iterations;
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["ok"] = ok;
+  state.counters["irls_iterations"] = iterations;
+}
+BENCHMARK(BM_CelcLinear)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+// The same on the peers' scene (gyro-integrated rotation, V = 2 m/s, 1 px noise).
+static void BM_CelcLinearPeers(benchmark::State& state) {
+  PeerSceneOptions o;
+  o.events_per_line = static_cast<int>(state.range(0));
+  std::mt19937_64 rng(42);
+  const auto tr = generatePeerScene(o, rng);
+  const LinearOptions opt;
+  int ok = 0, iterations = 0;
+  for (auto _ : state) {
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
+    ok = r.ok();
+    iterations = r.iterations;
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["ok"] = ok;
+  state.counters["irls_iterations"] = iterations;
+}
+BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 // CE3LC itself (5 clusters, 15 rows) with its cluster frames; the window
 // checks are measured apart.

@@ -35,13 +35,31 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
   size_t capacity = 0;
   for (size_t q : quota) capacity += q;
   PackedRows rows(capacity, 2);
+  // Per cluster: the sampled finite events; under a constant twist within
+  // the series' range their rows are formed across events (appendTwistRows),
+  // else (and when a row is not finite) one by one.
+  std::vector<double> t, fx, fy, fz;
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
-    const ClusterFrame& frame = frames[usable[ci]];
+    const ClusterRowTerms terms(frames[usable[ci]], motion);
+    const TwistRowConstants* twist = terms.twist();
+    t.clear(), fx.clear(), fy.clear(), fz.clear();
+    bool in_series_range = twist != nullptr;
     for (size_t k : sampleIndices(cl.size(), quota[ci], row_seed + ci)) {
       if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
-      const ConstraintRow row = celcRow(frame, motion, cl.times[k], cl.bearings[k]);
-      if (row.a.allFinite() && row.N.allFinite()) rows.append(row.a, row.N);
+      t.push_back(cl.times[k]);
+      fx.push_back(cl.bearings[k].x()), fy.push_back(cl.bearings[k].y()), fz.push_back(cl.bearings[k].z());
+      if (twist) {
+        const double tau = cl.times[k] - twist->t_ref;
+        in_series_range = in_series_range && twist->w2 * tau * tau < kTwistSeriesLimit;
+      }
+    }
+    if (in_series_range && rows.appendTwistRows(*twist, t.data(), fx.data(), fy.data(), fz.data(), t.size()))
+      continue;
+    Vec3 a, n0, n1;
+    for (size_t k = 0; k < t.size(); ++k) {
+      terms.row(t[k], Vec3(fx[k], fy[k], fz[k]), a, n0, n1);
+      if (a.allFinite() && n0.allFinite() && n1.allFinite()) rows.append(a, n0, n1);
     }
   }
   rows.seal();

@@ -24,6 +24,70 @@ struct ConstraintRow {
 /// normalised units (celc_residual.hpp's d / focal).
 ConstraintRow celcRow(const ClusterFrame& frame, const MotionModel& motion, double t, const Vec3& f);
 
+/// What an event's CELC row and its cheirality vote need, from its pose
+/// (R_k, P_k): with g_i = R_k^T m_i (the lines' normals in the camera at t_k),
+/// u = (P_e - P_k)^T m3 and s = (P_s - P_k)^T m1 (so B_ref = m1 u^T - m3 s^T),
+///   a = B_ref^T R_k f = (g1.f) u - (g3.f) s,   N_r = g1_r u - g3_r s  (r = 0, 1),
+/// and the transferred line in the camera at t_k is R_k^T B_ref v = g1 (u.v) - g3 (s.v).
+struct EventLineTerms {
+  Vec3 g1, g3, u, s;
+};
+
+/// A cluster's event-independent terms of its CELC rows under a constant
+/// twist w about t_ref (reference frame): m1, m3, u0 = P_e^T m3, s0 = P_s^T m1,
+/// w x m_i, w x (w x m_i) and w2 = |w|^2. With tau = t - t_ref, phi = w tau and
+/// the SO(3) coefficients A = sin|phi| / |phi|, B = (1 - cos|phi|) / |phi|^2,
+/// C = (|phi| - sin|phi|) / |phi|^3 (R = I + A W + B W^2,
+/// P = tau (I + B W + C W^2), W = [phi]_x):
+///   g_i = R^T m_i = m_i - A tau (w x m_i) + B tau^2 w x (w x m_i),
+///   P^T m = tau m - B tau^2 (w x m) + C tau^3 w x (w x m).
+struct TwistRowConstants {
+  double t_ref = 0.0, w2 = 0.0;
+  Vec3 m1, m3, u0, s0, wm1, wm3, wwm1, wwm3;
+};
+
+/// B and C by their Taylor series in x = |phi|^2 <= kTwistSeriesLimit, to the
+/// x^10 term (truncation below 1e-19 relative; no cancellation, unlike the
+/// closed form of C at small angles); A = 1 - x C. Inline: the row kernel
+/// evaluates it across events.
+constexpr double kTwistSeriesLimit = 2.25;  // |phi| <= 1.5 rad
+inline void twistSeriesCoefficients(double x, double& A, double& B, double& C) {
+  // 1 / (2k + 2)! and 1 / (2k + 3)!, k = 0..10.
+  constexpr double kB[11] = {1.0 / 2, 1.0 / 24, 1.0 / 720, 1.0 / 40320, 1.0 / 3628800,
+                             1.0 / 479001600, 1.0 / 87178291200.0, 1.0 / 20922789888000.0,
+                             1.0 / 6402373705728000.0, 1.0 / 2432902008176640000.0,
+                             1.0 / 1124000727777607680000.0};
+  constexpr double kC[11] = {1.0 / 6, 1.0 / 120, 1.0 / 5040, 1.0 / 362880, 1.0 / 39916800,
+                             1.0 / 6227020800.0, 1.0 / 1307674368000.0, 1.0 / 355687428096000.0,
+                             1.0 / 121645100408832000.0, 1.0 / 51090942171709440000.0,
+                             1.0 / 25852016738884976640000.0};
+  B = kB[10], C = kC[10];
+  for (int k = 9; k >= 0; --k) B = kB[k] - x * B, C = kC[k] - x * C;
+  A = 1.0 - x * C;
+}
+
+/// The EventLineTerms of one cluster's events without 3x3 products: the
+/// cluster's constants are formed once (TwistRowConstants for a constant
+/// twist; other motion models take R_k and P_k from the model). row() equals
+/// celcRow up to rounding under a constant twist, and is celcRow otherwise
+/// (the pose costs most there). Keeps references to frame and motion.
+class ClusterRowTerms {
+ public:
+  ClusterRowTerms(const ClusterFrame& frame, const MotionModel& motion);
+  EventLineTerms at(double t) const;
+  /// The CELC row of bearing f at time t: a, and N's two nonzero rows.
+  void row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) const;
+  /// The constant twist's constants; null for other motion models.
+  const TwistRowConstants* twist() const { return twist_ ? &k_ : nullptr; }
+  const ClusterFrame& frame() const { return *frame_; }
+
+ private:
+  const ClusterFrame* frame_;
+  const MotionModel* motion_;
+  bool twist_;
+  TwistRowConstants k_;
+};
+
 /// B_ref at time t (reference frame): l_ref(t) = B_ref v.
 Mat3 transferMatrix(const ClusterFrame& frame, const MotionModel& motion, double t);
 /// The same from P(t) (when the pose at t is at hand).

@@ -113,6 +113,47 @@ CELC_ISA_CLONES void squaredResiduals3(const double* c, size_t m, size_t s, cons
   squaredResiduals<3>(c, m, s, v, r2_degenerate, r2);
 }
 
+// The CELC rows of m events under a constant twist (constants q: t_ref, w2,
+// then m1 m3 u0 s0 wm1 wm3 wwm1 wwm3, 3 each), into columns c (stride s) from
+// row 0: ClusterRowTerms::at and ::row, one event per lane.
+CELC_ISA_CLONES void twistRows(const double* q, const double* t, const double* fx, const double* fy,
+                               const double* fz, size_t m, double* c, size_t s) {
+  const double t_ref = q[0], w2 = q[1];
+  const double* m1 = q + 2; const double* m3 = q + 5; const double* u0 = q + 8; const double* s0 = q + 11;
+  const double* wm1 = q + 14; const double* wm3 = q + 17; const double* wwm1 = q + 20; const double* wwm3 = q + 23;
+#pragma omp simd
+  for (size_t i = 0; i < m; ++i) {
+    const double tau = t[i] - t_ref, tau2 = tau * tau, x = w2 * tau2;
+    double A, B, C;
+    twistSeriesCoefficients(x, A, B, C);
+    const double ra = A * tau, rb = B * tau2, pc = C * tau2 * tau;
+    double g1[3], g3[3], u[3], sv[3];
+    for (int j = 0; j < 3; ++j) {
+      g1[j] = m1[j] - ra * wm1[j] + rb * wwm1[j];
+      g3[j] = m3[j] - ra * wm3[j] + rb * wwm3[j];
+      u[j] = u0[j] - (tau * m3[j] - rb * wm3[j] + pc * wwm3[j]);
+      sv[j] = s0[j] - (tau * m1[j] - rb * wm1[j] + pc * wwm1[j]);
+    }
+    const double al = g1[0] * fx[i] + g1[1] * fy[i] + g1[2] * fz[i];
+    const double be = g3[0] * fx[i] + g3[1] * fy[i] + g3[2] * fz[i];
+    for (int j = 0; j < 3; ++j) {
+      c[static_cast<size_t>(j) * s + i] = al * u[j] - be * sv[j];
+      c[static_cast<size_t>(3 + j) * s + i] = g1[0] * u[j] - g3[0] * sv[j];
+      c[static_cast<size_t>(6 + j) * s + i] = g1[1] * u[j] - g3[1] * sv[j];
+    }
+  }
+}
+
+// 0 when the m rows of the first `columns` columns (stride s) are all
+// finite, else NaN (x * 0 is NaN exactly for an infinite or NaN x).
+CELC_ISA_CLONES double zeroUnlessNotFinite(const double* c, size_t columns, size_t m, size_t s) {
+  double sum = 0.0;
+  for (size_t j = 0; j < columns; ++j)
+#pragma omp simd reduction(+ : sum)
+    for (size_t i = 0; i < m; ++i) sum += c[j * s + i] * 0.0;
+  return sum;
+}
+
 // The lanes' partial sums added in a fixed order.
 PackedSums laneTotals(const LaneSums& acc) {
   PackedSums out{};
@@ -154,6 +195,32 @@ bool PackedRows::append(const Vec3& a, const Mat3& N) {
   for (int r = 0; r < normal_rows_; ++r)
     for (int k = 0; k < 3; ++k) c[static_cast<size_t>(3 + 3 * r + k) * stride_] = N(r, k);
   ++n_;
+  return true;
+}
+
+bool PackedRows::append(const Vec3& a, const Vec3& n0, const Vec3& n1) {
+  if (n_ >= capacity_) return false;
+  double* c = data_.get() + n_;
+  const size_t s = stride_;
+  c[0] = a.x(), c[s] = a.y(), c[2 * s] = a.z();
+  c[3 * s] = n0.x(), c[4 * s] = n0.y(), c[5 * s] = n0.z();
+  c[6 * s] = n1.x(), c[7 * s] = n1.y(), c[8 * s] = n1.z();
+  if (normal_rows_ == 3) c[9 * s] = c[10 * s] = c[11 * s] = 0.0;
+  ++n_;
+  return true;
+}
+
+bool PackedRows::appendTwistRows(const TwistRowConstants& k, const double* t, const double* fx,
+                                 const double* fy, const double* fz, size_t m) {
+  if (normal_rows_ != 2 || m > capacity_ - n_) return false;
+  double q[26] = {k.t_ref, k.w2};
+  const Vec3* vectors[8] = {&k.m1, &k.m3, &k.u0, &k.s0, &k.wm1, &k.wm3, &k.wwm1, &k.wwm3};
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 3; ++i) q[2 + 3 * j + i] = (*vectors[j])(i);
+  double* c = data_.get() + n_;
+  twistRows(q, t, fx, fy, fz, m, c, stride_);
+  if (!std::isfinite(zeroUnlessNotFinite(c, 9, m, stride_))) return false;
+  n_ += m;
   return true;
 }
 

@@ -34,6 +34,16 @@ class PackedRows {
   /// Appends a row (beyond capacity: ignored, and false). With
   /// normalRows() = 2, N's third row is not stored: it must be zero.
   bool append(const Vec3& a, const Mat3& N);
+  /// Appends a row whose N has the rows n0, n1 and a zero third row.
+  bool append(const Vec3& a, const Vec3& n0, const Vec3& n1);
+  /// Appends the CELC rows of m events of one cluster under a constant twist
+  /// (ClusterRowTerms::row with the series coefficients), computed across
+  /// the events in lanes: times t [s], bearings (fx, fy, fz) in the camera at
+  /// t. Needs normalRows() = 2, room for m rows, and
+  /// k.w2 (t - k.t_ref)^2 < kTwistSeriesLimit for every event. False (and
+  /// nothing appended) when a row is not finite.
+  bool appendTwistRows(const TwistRowConstants& k, const double* t, const double* fx,
+                       const double* fy, const double* fz, size_t m);
   /// Pads, forms the plain sums and the scale sample: once, after the last
   /// append and before any pass.
   void seal();

@@ -2,11 +2,20 @@
 #include "celc/solver/npt.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
 namespace celc {
+
+std::string toString(NptTimeOrigin origin) {
+  return origin == NptTimeOrigin::Centre ? "centre" : "first_event";
+}
+
+std::string toString(NptLineNormalisation normalisation) {
+  return normalisation == NptLineNormalisation::Vector ? "vector" : "moment";
+}
 
 std::string NptOptions::validate() const {
   std::ostringstream e;
@@ -26,11 +35,37 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 // s(t) with c(t) = s(t) v: trace(P(t)) / 3 (exactly tau for P = tau I).
 double displacementScale(const Mat3& P) { return P.trace() / 3.0; }
 
+// The first and last finite times of a list.
+void extendRange(const std::vector<double>& times, double& first, double& last) {
+  for (double t : times)
+    if (std::isfinite(t)) first = std::min(first, t), last = std::max(last, t);
+}
+
+double originOf(double first, double last, NptTimeOrigin origin) {
+  if (!(first <= last)) return 0.0;  // no finite time
+  return origin == NptTimeOrigin::Centre ? 0.5 * (first + last) : first;
+}
+
 }  // namespace
+
+double nptTimeOrigin(const WindowObservations& obs, NptTimeOrigin origin) {
+  double first = INFINITY, last = -INFINITY;
+  for (const auto& c : obs.clusters) extendRange(c.times, first, last);
+  return originOf(first, last, origin);
+}
 
 NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector<Vec3>& bearings,
                              const MotionModel& motion, const NptOptions& opt) {
+  double first = INFINITY, last = -INFINITY;
+  extendRange(times, first, last);
+  return solveNptLine(times, bearings, motion, opt, originOf(first, last, opt.time_origin));
+}
+
+NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector<Vec3>& bearings,
+                             const MotionModel& motion, const NptOptions& opt, double t0) {
   NptLineSolution out;
+  // The camera centre relative to the one at t0: (s(t) - s(t0)) v.
+  const double s0 = displacementScale(motion.positionMatrix(t0));
   // Normal matrix of the rows [s f'^T, f'^T]: its eigenvectors are the right
   // singular vectors of the stacked rows (eigenvalues = squared singular values).
   Mat6 G = Mat6::Zero();
@@ -42,7 +77,7 @@ NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector
     motion.pose(times[k], R, P);
     const Vec3 fp = R * bearings[k].normalized();
     Vec6 row;
-    row << displacementScale(P) * fp, fp;
+    row << (displacementScale(P) - s0) * fp, fp;
     if (!row.allFinite()) continue;
     G.noalias() += row * row.transpose();
     ++out.events;
@@ -63,10 +98,11 @@ NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector
   if (!(m.norm() > 1e-14) || !(a.norm() > 1e-9 * m.norm()) ||
       !(mxa.norm() > 1e-6 * m.norm() * a.norm()))
     return out;
+  if (opt.line_normalisation == NptLineNormalisation::Moment) out.x /= m.norm();
   const Vec3 d = mxa.normalized();
   out.direction = d;
-  out.partial_velocity = a.cross(d);
-  const Vec3 e2 = -m.normalized();
+  out.partial_velocity = out.x.head<3>().cross(d);
+  const Vec3 e2 = -m.normalized();  // the same for either scaling
   const Vec3 e3 = d.cross(e2);
   const double uy = out.partial_velocity.dot(e2), uz = out.partial_velocity.dot(e3);
   out.averaging_row = uz * e2 - uy * e3;
@@ -95,8 +131,9 @@ SolverResult solveNpt(const WindowObservations& obs, const MotionModel& motion,
   }
   Mat3 H = Mat3::Zero();  // sum of row row^T of the averaging stage
   int lines = 0;
+  const double t0 = nptTimeOrigin(obs, opt.time_origin);
   for (const auto& c : obs.clusters) {
-    const NptLineSolution line = solveNptLine(c.times, c.bearings, motion, opt);
+    const NptLineSolution line = solveNptLine(c.times, c.bearings, motion, opt, t0);
     r.rows_used += line.events;
     if (!line.ok) continue;
     H += line.averaging_row * line.averaging_row.transpose();

@@ -7,20 +7,21 @@
 namespace celc {
 
 std::string LinearOptions::validate() const {
-  std::ostringstream e;
-  if (max_rows < 0) e << "max_rows must be >= 0; ";
-  if (max_iterations < 1) e << "max_iterations must be >= 1; ";
-  if (!(huber_k > 0.0)) e << "huber_k must be > 0; ";
-  if (!(tolerance > 0.0)) e << "tolerance must be > 0; ";
+  // Plain appends: every linear solve validates its options.
+  std::string e;
+  if (max_rows < 0) e += "max_rows must be >= 0; ";
+  if (max_iterations < 1) e += "max_iterations must be >= 1; ";
+  if (!(huber_k > 0.0)) e += "huber_k must be > 0; ";
+  if (!(tolerance > 0.0)) e += "tolerance must be > 0; ";
   if (grid_directions < 0 || grid_starts < 0 || grid_rows < 1)
-    e << "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";
-  if (min_clusters < 1) e << "min_clusters must be >= 1; ";
-  if (min_cluster_events < 2) e << "min_cluster_events must be >= 2; ";
-  if (!(max_nullspace_sigma_deg > 0.0)) e << "max_nullspace_sigma_deg must be > 0; ";
-  if (!(min_parallax_ratio >= 1.0)) e << "min_parallax_ratio must be >= 1; ";
-  if (!(min_parallax_px >= 0.0)) e << "min_parallax_px must be >= 0; ";
-  if (!(min_window_parallax >= 0.0)) e << "min_window_parallax must be >= 0; ";
-  return e.str();
+    e += "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";
+  if (min_clusters < 1) e += "min_clusters must be >= 1; ";
+  if (min_cluster_events < 2) e += "min_cluster_events must be >= 2; ";
+  if (!(max_nullspace_sigma_deg > 0.0)) e += "max_nullspace_sigma_deg must be > 0; ";
+  if (!(min_parallax_ratio >= 1.0)) e += "min_parallax_ratio must be >= 1; ";
+  if (!(min_parallax_px >= 0.0)) e += "min_parallax_px must be >= 0; ";
+  if (!(min_window_parallax >= 0.0)) e += "min_window_parallax must be >= 0; ";
+  return e;
 }
 
 std::string RefineOptions::validate() const {

@@ -46,6 +46,10 @@ void describe(FieldVisitor& v, NptOptions& o) {
           o.min_line_sigma_ratio);
   v.field({"max_sigma_ratio", "-", "averaging: sigma_min / sigma_second above this -> degenerate"},
           o.max_sigma_ratio);
+  v.enumeration({"time_origin", "", "time of the rows from the window's centre or first event (published)"},
+                o.time_origin, {NptTimeOrigin::Centre, NptTimeOrigin::FirstEvent});
+  v.enumeration({"line_normalisation", "", "a line's solution scaled to unit vector or unit moment (published)"},
+                o.line_normalisation, {NptLineNormalisation::Vector, NptLineNormalisation::Moment});
 }
 
 void describe(FieldVisitor& v, MlOptions& o) {

@@ -2,6 +2,7 @@
 #include "sign_test.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <vector>
 
@@ -15,24 +16,39 @@ namespace {
 // the majority is decided and resume when the exact event balance is needed.
 struct SignVotes {
   const ClusterObservation* cl = nullptr;
-  const ClusterFrame* fr = nullptr;
-  Vec3 ps, pe;     // P(t_s) v, P(t_e) v
+  ClusterRowTerms terms;
   size_t stride = 1, next = 0;
   long pos = 0, neg = 0;
 
+  SignVotes(const ClusterObservation& c, const ClusterFrame& frame, const MotionModel& motion)
+      : cl(&c), terms(frame, motion) {}
+  // lambda of the event (t, f); NaN when it sees neither plane. Under a
+  // constant twist from the cluster's terms, else from the pose as the row
+  // of celcRow (bit-identical to the former test there).
+  double depth(double t, const Vec3& f, const MotionModel& motion, const Vec3& v) const {
+    double a1, a3, d1, d3;  // m_i.f' and m_i.(p_i - p_k)
+    if (terms.twist()) {
+      const EventLineTerms e = terms.at(t);
+      a1 = e.g1.dot(f), a3 = e.g3.dot(f), d1 = e.s.dot(v), d3 = e.u.dot(v);
+    } else {
+      const ClusterFrame& fr = terms.frame();
+      Mat3 Rk, Pk;
+      motion.pose(t, Rk, Pk);
+      const Vec3 fp = Rk * f, pk = Pk * v;
+      a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
+      d1 = fr.m1.dot(fr.Ps * v - pk), d3 = fr.m3.dot(fr.Pe * v - pk);
+    }
+    const double den = a1 * a1 + a3 * a3;
+    if (!(den > 1e-24)) return NAN;
+    return (a1 * d1 + a3 * d3) / den;
+  }
   size_t remaining() const { return next < cl->size() ? (cl->size() - 1 - next) / stride + 1 : 0; }
   // Counts votes until the majority cannot change (or all are counted).
   void count(const MotionModel& motion, const Vec3& v, bool all) {
     for (; next < cl->size(); next += stride) {
       if (!all && static_cast<size_t>(std::abs(pos - neg)) > remaining()) return;
-      Mat3 Rk, Pk;
-      motion.pose(cl->times[next], Rk, Pk);
-      const Vec3 fp = Rk * cl->bearings[next];
-      const Vec3 pk = Pk * v;
-      const double a1 = fr->m1.dot(fp), a3 = fr->m3.dot(fp);
-      const double den = a1 * a1 + a3 * a3;
-      if (!(den > 1e-24)) continue;
-      const double lambda = (a1 * fr->m1.dot(ps - pk) + a3 * fr->m3.dot(pe - pk)) / den;
+      const double lambda = depth(cl->times[next], cl->bearings[next], motion, v);
+      if (std::isnan(lambda)) continue;
       if (lambda > 0) ++pos;
       else if (lambda < 0) ++neg;
     }
@@ -44,21 +60,18 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
                          const WindowFrames& frames) {
   // Depth of event k along its ray from the camera at t_k, where the ray meets
   // the planes of l1 and l3 (least squares over both planes):
-  //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v.
+  //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v,
+  // that is (g1.f (s.v) + g3.f (u.v)) / ((g1.f)^2 + (g3.f)^2) in EventLineTerms.
   // lambda is odd in v, so exactly one sign puts the line in front (lambda > 0).
   // Each cluster votes by the majority of kSignVotesPerCluster of its events; a
   // cluster's count stops once its majority is decided, and is completed only
   // when the clusters tie and the event balance decides.
   std::vector<SignVotes> clusters;
+  clusters.reserve(frames.clusters().size());
   for (int c : frames.clusters()) {
-    SignVotes s;
-    s.cl = &obs.clusters[c];
-    s.fr = &frames[c];
-    s.ps = s.fr->Ps * v;
-    s.pe = s.fr->Pe * v;
+    SignVotes& s = clusters.emplace_back(obs.clusters[c], frames[c], motion);
     s.stride = std::max<size_t>(1, s.cl->size() / kSignVotesPerCluster);
     s.count(motion, v, false);
-    clusters.push_back(s);
   }
   int votes = 0, voters = 0;
   for (const auto& s : clusters) {

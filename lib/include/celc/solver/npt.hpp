@@ -8,7 +8,8 @@
 /// Known rotation, constant linear velocity v in the reference frame. An event
 /// at time t with unit bearing f (camera frame at t), rotated into the
 /// reference frame, f' = R(t) f, was seen from the camera centre c = tau v
-/// (tau = t - t_ref). The ray (f', c x f') meets the 3D line with Plücker
+/// (tau = t - t0, relative to the centre at the time origin t0:
+/// NptOptions::time_origin). The ray (f', c x f') meets the 3D line with Plücker
 /// coordinates (d, m) (unit direction d, moment m = X x d) iff
 ///   d . (c x f') + m . f' = 0   <=>   tau f'^T (d x v) + f'^T m = 0,
 /// linear and homogeneous in x = [d x v; m] (6 unknowns): one row
@@ -22,7 +23,8 @@
 /// stacked rows. The sign of v is not observable by this solver.
 ///
 /// General motion models: the incidence holds with c = P(t) v. It is exactly
-/// the form above when P(t) = s(t) I; the solver uses s(t) = trace(P(t)) / 3.
+/// the form above when P(t) = s(t) I, with tau = s(t) - s(t0); the solver uses
+/// s(t) = trace(P(t)) / 3.
 /// GyroIntegrated (velocity constant in the reference frame): P = tau I, exact.
 /// ConstantTwist: P = tau J_l(w tau) = tau (I + [w tau]_x / 2 + O(|w tau|^2));
 /// trace/3 keeps the symmetric part (error O(|w tau|^2)) and drops the skew
@@ -42,7 +44,8 @@ namespace celc {
 /// Per-line stage: x = [d x v; m] up to scale and sign, and what follows from it.
 struct NptLineSolution {
   bool ok = false;
-  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();  ///< unit norm
+  /// Unit norm, or unit moment (|m| = 1) with NptLineNormalisation::Moment.
+  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
   Vec3 direction = Vec3::Zero();        ///< d, unit (sign arbitrary)
   Vec3 partial_velocity = Vec3::Zero(); ///< v_perp = a x d (line's scale, sign arbitrary)
   Vec3 averaging_row = Vec3::Zero();    ///< u_z e2 - u_y e3
@@ -51,11 +54,22 @@ struct NptLineSolution {
 };
 
 /// Solves one line's 6x6 system from its events (times [s], bearings (x, y, 1)
-/// or any positive multiple, camera frame at each time).
+/// or any positive multiple, camera frame at each time), time measured from
+/// t0 [s]: rows [(s(t) - s(t0)) f'^T, f'^T], m the moment about the camera
+/// centre at t0. Noise-free, every t0 gives the same d and partial velocity
+/// direction; with noise the unit-norm least-squares solution depends on t0.
+NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector<Vec3>& bearings,
+                             const MotionModel& motion, const NptOptions& options, double t0);
+/// The same with t0 from options.time_origin over this line's own events.
 NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector<Vec3>& bearings,
                              const MotionModel& motion, const NptOptions& options);
 
-/// The whole solver over a window's clusters (their l1/l2/l3 are not used).
+/// t0 of a window: the midpoint of its first and last finite event times
+/// (Centre) or the first (FirstEvent) [s]; 0 when it has no finite time.
+double nptTimeOrigin(const WindowObservations& obs, NptTimeOrigin origin);
+
+/// The whole solver over a window's clusters (their l1/l2/l3 are not used),
+/// every line's time from nptTimeOrigin(obs, options.time_origin).
 /// The returned v is unit, sign arbitrary (resolve with resolveSign);
 /// sigma_min / sigma_second are those of the averaging stage.
 SolverResult solveNpt(const WindowObservations& obs, const MotionModel& motion,

@@ -68,7 +68,25 @@ struct RefineOptions {
   std::string validate() const;
 };
 
+/// npt's time origin t0: each event's row is [(s(t) - s(t0)) f'^T, f'^T]
+/// (npt.hpp), so the per-line unknown m is the line's moment about the
+/// camera centre at t0.
+enum class NptTimeOrigin {
+  Centre,      ///< the midpoint of the window's first and last event times
+  FirstEvent,  ///< the window's first event (the published code's)
+};
+/// How a line's solution x = [d x v; m] is scaled before its averaging row is
+/// formed; the row's length, hence its weight in the averaging, is |d x v|
+/// after scaling.
+enum class NptLineNormalisation {
+  Vector,  ///< |x| = 1: weight |d x v| / sqrt(|d x v|^2 + |m|^2)
+  Moment,  ///< |m| = 1 (the published code's): weight |d x v| / |m|
+};
+std::string toString(NptTimeOrigin origin);                ///< "centre" | "first_event"
+std::string toString(NptLineNormalisation normalisation);  ///< "vector" | "moment"
+
 /// Options of the N-point linear solver `npt` (Gao et al., CVPR 2024; see npt.hpp).
+/// The published variant: time_origin FirstEvent, line_normalisation Moment.
 struct NptOptions {
   int min_line_events = 5;   ///< a line needs this many events (>= 5: 6 homogeneous unknowns)
   int min_lines = 2;         ///< fewer lines with a partial velocity -> degenerate
@@ -77,6 +95,8 @@ struct NptOptions {
   double min_line_sigma_ratio = 1e-10;
   /// The averaging stage: sigma_min / sigma_second above this -> degenerate.
   double max_sigma_ratio = 0.999;
+  NptTimeOrigin time_origin = NptTimeOrigin::Centre;
+  NptLineNormalisation line_normalisation = NptLineNormalisation::Vector;
   std::string validate() const;  ///< empty when valid
 };
 
