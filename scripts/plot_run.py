@@ -5,9 +5,11 @@ usage: plot_run.py OUTDIR [OUTDIR ...]
        plot_run.py --table OUT.png [--max-sigma DEG] --run LABEL CSV [CSV ...] [--run ...]
 
 Per OUTDIR it writes
-  OUTDIR/velocity.png  the estimated unit direction's x, y, z components over
-                       the window mid-time [s], one colour per method (ok
-                       windows only), the ground truth in black, and a band of
+  OUTDIR/velocity.png  one column per method, rows the x, y, z components of
+                       the estimated unit direction against the window
+                       mid-time [s] after the first window's start (ok windows
+                       as points and lines, the others as x on the lower
+                       edge), the ground truth dashed black, and a band of
                        +-sin(sigma_deg) around each component (clipped to
                        [-1, 1]) where windows.csv has sigma_deg;
   OUTDIR/error.png     phi [deg] per window and method (log axis), the median
@@ -15,7 +17,9 @@ Per OUTDIR it writes
                        no error.png, and an old one is removed).
 With --table it writes OUT.png: several runs side by side, per run a box plot
 of phi [deg] per method (top) and the share of ok windows per method (bottom).
-Each --run is one run (its CSVs merge: shards). Needs python3-matplotlib.
+Each --run is one run (its CSVs merge: shards). --max-sigma DEG keeps only ok
+windows with sigma_deg <= DEG. Needs python3-matplotlib; errors are one line
+on stderr and exit status 1.
 """
 import argparse
 import csv
@@ -48,8 +52,8 @@ def read_rows(paths):
         with open(path, newline="") as f:
             for r in csv.DictReader(f):
                 key = (r.get("window"), r.get("method"))
-                if None in key or key in seen:
-                    continue
+                if None in key or key in seen or not key[0].isdigit():
+                    continue  # a torn last line of an interrupted run, or a repeat
                 seen.add(key)
                 rows.append(r)
     rows.sort(key=lambda r: (int(r["window"]), r["method"]))
@@ -73,6 +77,15 @@ def is_ok(r):
 def phi_deg(r):
     p = num(r.get("phi"))
     return max(math.degrees(p), PHI_FLOOR_DEG) if math.isfinite(p) else float("nan")
+
+
+def log_axis_deg(plt, ax):
+    """A log y axis [deg] labelled at 1, 2, 5 times powers of ten."""
+    import matplotlib.ticker as ticker
+    ax.set_yscale("log")
+    ax.yaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda y, _: "%g" % y))
+    ax.yaxis.set_minor_formatter(ticker.NullFormatter())
 
 
 def save(fig, path):
@@ -123,7 +136,6 @@ def plot_velocity(plt, outdir, name, rows):
     ncol = len(methods)
     fig, axes = plt.subplots(3, ncol, figsize=(min(20.0, 2.0 + 3.6 * ncol), 7.6), sharex=True,
                              sharey=True, squeeze=False)
-    any_sigma = False
     for j, m in enumerate(methods):
         color, label = style(m)
         by_w = {int(r["window"]): r for r in rows if r["method"] == m}
@@ -132,6 +144,15 @@ def plot_velocity(plt, outdir, name, rows):
         title = "%s\nok %d of %d windows" % (label, len(ok), len(order))
         if sig:
             title += ", median sigma %.3g deg" % statistics.median(sig)
+        failed = {}
+        for w in order:
+            if w not in ok:
+                st = by_w[w].get("status") if w in by_w else "no row"
+                failed[st] = failed.get(st, 0) + 1
+        if failed:
+            top = sorted(failed.items(), key=lambda kv: -kv[1])[:2]
+            title += "\nnot ok: " + ", ".join("%s %d" % kv for kv in top) + (", ..." if len(failed) > 2 else "")
+        bad_t = [t for w, t in zip(order, times) if w not in ok]
         axes[0][j].set_title(title, fontsize=9, color=color)
         for k, key in enumerate(("vx", "vy", "vz")):
             ax = axes[k][j]
@@ -141,12 +162,13 @@ def plot_velocity(plt, outdir, name, rows):
             band = [sigma_band(y, num(by_w[w].get("sigma_deg")) if w in by_w else float("nan"))
                     for w, y in zip(order, ys)]
             if any(not math.isnan(lo) for lo, _ in band):
-                any_sigma = True
                 ax.fill_between(times, [lo for lo, _ in band], [hi for _, hi in band], color=color,
                                 alpha=0.22, lw=0, zorder=2)
             if with_gt:
                 g = [wins[w][1][k] if wins[w][1] is not None else float("nan") for w in order]
                 ax.plot(times, g, color="k", lw=1.4, ls="--", zorder=5)
+            if bad_t:  # the windows that are not ok, on the lower edge
+                ax.plot(bad_t, [-1.04] * len(bad_t), "x", color="0.45", ms=ms, zorder=3, clip_on=False)
             ax.axhline(0.0, color="0.6", lw=0.6, zorder=0)
             ax.grid(alpha=0.3)
             if j == 0:
@@ -154,10 +176,14 @@ def plot_velocity(plt, outdir, name, rows):
         axes[-1][j].set_xlabel(time_label(rows) if ncol < 3 else "window mid-time [s] after t0")
         axes[-1][j].xaxis.set_major_locator(plt.MaxNLocator(4))
     axes[0][0].set_ylim(-1.08, 1.08)
+    pad = 0.02 * (times[-1] - times[0]) if len(times) > 1 else 0.01
+    axes[0][0].set_xlim(times[0] - pad, times[-1] + pad)
     handles = [plt.Line2D([], [], color="0.3", marker="o", ms=4, lw=1.0),
+               plt.Line2D([], [], color="0.45", marker="x", ms=4, lw=0),
                plt.Rectangle((0, 0), 1, 1, color="0.3", alpha=0.22)]
-    labels = ["estimate (ok windows; a gap: not ok)",
-              "+-sin(sigma_deg) per component, clipped to [-1, 1]" if any_sigma else "no sigma_deg in windows.csv"]
+    labels = ["estimate (ok windows)", "window not ok",
+              "+-sin(sigma_deg) per component, clipped to [-1, 1]" if "sigma_deg" in rows[0]
+              else "no sigma_deg (windows.csv of the first format)"]
     if with_gt:
         handles.append(plt.Line2D([], [], color="k", lw=1.4, ls="--"))
         labels.append("ground truth")
@@ -187,10 +213,10 @@ def plot_error(plt, outdir, name, rows):
         ys = [phi_deg(by_w[w]) if w in by_w else float("nan") for w in order]
         good = sorted(y for y in ys if math.isfinite(y))
         text = "median %.3g deg, %d windows" % (statistics.median(good), len(good)) if good else "no ok window"
-        ax.plot(times, ys, color=color, lw=1.0, marker="o", ms=ms, label="%s: %s" % (label, text))
+        ax.plot(times, ys, color=color, lw=0.8 if len(order) > 60 else 1.0, marker="o", ms=ms,
+                label="%s: %s" % (label, text))
     ax.axhline(90.0, color="0.4", lw=0.9, ls=":", label="90 deg: a random direction's median")
-    ax.set_yscale("log")
-    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda y, _: "%g" % y))
+    log_axis_deg(plt, ax)
     ax.set_xlabel(time_label(rows))
     ax.set_ylabel("phi, angle to ground truth [deg]")
     ax.grid(alpha=0.3, which="both")
@@ -203,8 +229,13 @@ def plot_error(plt, outdir, name, rows):
     return True
 
 
+def plain(text):
+    """TEXT shown as it is: matplotlib reads $...$ as mathematics."""
+    return text.replace("$", r"\$")
+
+
 def run_name(outdir):
-    return os.path.basename(os.path.normpath(os.path.abspath(outdir)))
+    return plain(os.path.basename(os.path.normpath(os.path.abspath(outdir))))
 
 
 def plot_outdir(plt, outdir):
@@ -228,7 +259,7 @@ def plot_table(plt, out, runs, max_sigma):
                 if r.get("status") == "ok" and not num(r.get("sigma_deg")) <= max_sigma:
                     r["status"] = "sigma_above_max"
                     r["phi"] = ""
-        data.append((label, rows))
+        data.append((plain(label), rows))
     ms = methods_of([r for _, rows in data for r in rows])
     n = len(data)
     width = 0.8 / max(1, len(ms))
@@ -264,27 +295,30 @@ def plot_table(plt, out, runs, max_sigma):
         if not any(math.isfinite(phi_deg(r)) for r in rows if is_ok(r)):
             ax.text(k, 0.5, "no ground truth", transform=ax.get_xaxis_transform(), ha="center",
                     va="center", fontsize=8, color="0.35", rotation=90 if n > 6 else 0)
+    ax.axhline(90.0, color="0.4", lw=0.9, ls=":")
     for k in range(1, n):
         for a in (ax, bx):
             a.axvline(k - 0.5, color="0.75", lw=0.8)
-    ax.set_yscale("log")
-    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda y, _: "%g" % y))
+    log_axis_deg(plt, ax)
     ax.set_ylabel("phi, angle to ground truth [deg]")
     ax.grid(alpha=0.3, which="both", axis="y")
     ax.set_xlim(-0.5, n - 0.5)
     handles = [plt.Rectangle((0, 0), 1, 1, color=style(m)[0], alpha=0.75) for m in ms]
     ax.legend(handles, [style(m)[1] for m in ms], loc="upper left", bbox_to_anchor=(1.005, 1.0),
               fontsize=8)
-    title = "celc table: phi per window (box: quartiles, whiskers 1.5 IQR, line: median, dots: windows)"
+    title = ("celc table: phi per window and method\n(box: quartiles, whiskers 1.5 IQR, line: median, "
+             "dots: windows; dotted: 90 deg)")
     if max_sigma is not None:
-        title += "; ok windows with sigma_deg <= %g deg" % max_sigma
+        title += "\nok windows with sigma_deg <= %g deg only" % max_sigma
     ax.set_title(title, fontsize=10)
     bx.set_ylim(0, 1.05)
-    bx.set_ylabel("share of windows ok")
+    bx.set_ylabel("share of windows ok" if max_sigma is None else "share ok, sigma <= %g deg" % max_sigma)
     bx.grid(alpha=0.3, axis="y")
     bx.set_xticks(range(n))
     rotate = n > 4 or max(len(label) for label, _ in data) > 18
-    bx.set_xticklabels([label for label, _ in data], rotation=30 if rotate else 0,
+    counts = [len({r["window"] for r in rows}) for _, rows in data]
+    bx.set_xticklabels(["%s\n%d windows" % (label, c) for (label, _), c in zip(data, counts)],
+                       rotation=30 if rotate else 0,
                        ha="right" if rotate else "center", fontsize=9)
     fig.tight_layout()
     save(fig, out)

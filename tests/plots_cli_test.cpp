@@ -167,11 +167,13 @@ TEST(Plots, TablePlotsRunsSideBySide) {
   const fs::path odd = d / "old 'v1'";
   writeOldCsv(odd, true);
   writeOldCsv(d / "nogt", false);
-  r = runCelc("table " + q(d / "sample") + " --label 'no gt'=" + q(d / "nogt") + " \"" + odd.string() +
-                  "\" --plot " + q(d / "t.png"),
+  r = runCelc("table " + q(d / "sample") + " \"" + odd.string() + "\" --label 'no gt'=" + q(d / "nogt") +
+                  " --plot " + q(d / "t.png"),
               d, true);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("| sample | eps"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| old 'v1' | eps"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| no gt | eps"), std::string::npos) << r.out;
   expectPng(d / "t.png");
   // With --max-sigma (the old files have no sigma_deg: none of their rows is kept).
   r = runCelc("table " + q(d / "sample") + " \"" + odd.string() + "\" --max-sigma 30 --plot " + q(d / "s.png"), d,
