@@ -147,7 +147,7 @@ def plot_velocity(plt, outdir, name, rows):
         failed = {}
         for w in order:
             if w not in ok:
-                st = by_w[w].get("status") if w in by_w else "no row"
+                st = (by_w[w].get("reason") or by_w[w].get("status")) if w in by_w else "no row"
                 failed[st] = failed.get(st, 0) + 1
         if failed:
             top = sorted(failed.items(), key=lambda kv: -kv[1])[:2]
