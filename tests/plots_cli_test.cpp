@@ -71,6 +71,14 @@ TEST(Plots, NoPlotsFlagAndEnvironmentWriteNone) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(d / "b" / "windows.csv"));
   EXPECT_FALSE(fs::exists(d / "b" / "velocity.png"));
+  // celc batch --no-plots: neither the runs' plots nor table.png.
+  std::ofstream(d / "batch.yaml") << "sequences:\n  - {label: a, path: '" << kSample << "', t_end: 0.12}\n";
+  r = runCelc("batch " + q(d / "batch.yaml") + " -o " + q(d / "out") + " -q --no-plots" + kFast, d, true);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(d / "out" / "a" / "windows.csv"));
+  EXPECT_TRUE(fs::exists(d / "out" / "table.md"));
+  EXPECT_FALSE(fs::exists(d / "out" / "a" / "velocity.png"));
+  EXPECT_FALSE(fs::exists(d / "out" / "table.png"));
   fs::remove_all(d);
 }
 
