@@ -11,7 +11,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # ~0.6 M events per simulated second: 5 s gives 3 windows of 1 M events.
 "$build/celc" synth "$root/config/scenes/davis346_chessboard.yaml" -o "$work/seq" --duration 5 -q
-"$build/celc" run "$work/seq" -o "$work/out" --window-events 1000000 --threads "$threads" -q > /dev/null
+"$build/celc" run "$work/seq" -o "$work/out" --window-events 1000000 --threads "$threads" --no-plots -q > /dev/null
 echo "celc run, 1,000,000-event windows, $threads threads:"
 grep -E "windows processed|time per stage" "$work/out/summary.md"
 grep -E "^\| (celc|celc_opt|celc_ml|ce3lc) " "$work/out/summary.md" | cut -d'|' -f2,3,4,8,9,12

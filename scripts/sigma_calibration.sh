@@ -19,7 +19,7 @@ for scene in config/scenes/sample_davis346_room.yaml config/scenes/e2e_davis346_
   name=$(basename "$scene" .yaml)
   [ -d "$OUT/$name/seq" ] || "$CELC" synth "$scene" -o "$OUT/$name/seq" -q
   for n in 30000 50000; do
-    "$CELC" run "$OUT/$name/seq" -o "$OUT/$name/run_$n" --window-events "$n" --force -q > /dev/null
+    "$CELC" run "$OUT/$name/seq" -o "$OUT/$name/run_$n" --window-events "$n" --force --no-plots -q > /dev/null
     awk -F, -v s="$name" -v n="$n" 'NR > 1 && $7 == "ok" && $15 != "" && $18 != "" {
         ok[$6]++; if ($15 <= 2 * $18 * 3.14159265 / 180) c[$6]++ }
       END { for (m in ok) printf "| %s | %s events | %s | %.2f | %d |\n", s, n, m, c[m] / ok[m], ok[m] }' \

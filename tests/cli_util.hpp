@@ -24,9 +24,12 @@ inline std::string readAll(const std::filesystem::path& p) {
 }
 
 /// Runs `celc ARGS`, capturing stdout and (through DIR/stderr.txt) stderr.
-inline CliRun runCelc(const std::string& args, const std::filesystem::path& dir) {
+/// Without `plots` the automatic plots (python3-matplotlib, seconds per run)
+/// are off (CELC_NO_PLOTS=1); tests of the plots pass plots = true.
+inline CliRun runCelc(const std::string& args, const std::filesystem::path& dir, bool plots = false) {
   const std::filesystem::path err = dir / "stderr.txt";
-  const std::string cmd = std::string(CELC_BINARY) + " " + args + " 2> '" + err.string() + "'";
+  const std::string cmd = std::string(plots ? "" : "CELC_NO_PLOTS=1 ") + CELC_BINARY + " " + args + " 2> '" +
+                          err.string() + "'";
   CliRun r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;

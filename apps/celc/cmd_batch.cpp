@@ -8,6 +8,7 @@
 #include "celc/eval/run_tables.hpp"
 #include "celc/io/labelled_events.hpp"
 #include "commands.hpp"
+#include "plots.hpp"
 #include "progress.hpp"
 #include "run_common.hpp"
 
@@ -60,12 +61,23 @@ void runBatch(const BatchArgs& a) {
     });
     progress.finish();
     if (!o.quiet) printSummary(jobs[i].title, outcome);
+    if (automaticPlots(o.no_plots)) plotRun(jobs[i].outdir);
     table.push_back({entries[i].label, outcome.summaries});
   }
   const fs::path out(a.outdir);
   writeFileAtomically((out / "table.md").string(), tableMarkdown(table));
   writeFileAtomically((out / "table.tex").string(), tableLatex(table));
   writeFileAtomically((out / "table.csv").string(), tableCsv(table));
+  if (automaticPlots(o.no_plots)) {
+    std::vector<std::string> args = {"--table", (out / "table.png").string()};
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      args.push_back("--run");
+      args.push_back(entries[i].label);
+      args.push_back((fs::path(jobs[i].outdir) / "windows.csv").string());
+    }
+    if (const std::string error = runPlotScript("plot_run.py", args); !error.empty())
+      spdlog::warn("no plot {}: {}", (out / "table.png").string(), error);
+  }
   std::cout << "\nTable (mean over windows with ground truth; " << (out / "table.{md,tex,csv}").string()
             << ")\n\n" << tableMarkdown(table) << std::flush;
 }
@@ -78,7 +90,9 @@ void registerBatch(CLI::App& app) {
       "batch",
       "Many sequences from BATCH.yaml (sequences: label, path, calib, groundtruth, imu, t_start, "
       "t_end, config overrides; see config/batch_example.yaml), each into OUTDIR/<label>/, then "
-      "the paper-layout tables OUTDIR/table.md, table.tex (booktabs) and table.csv.");
+      "the paper-layout tables OUTDIR/table.md, table.tex (booktabs) and table.csv; plots per "
+      "sequence (OUTDIR/<label>/velocity.png, error.png) and OUTDIR/table.png (phi per method and "
+      "sequence side by side) unless --no-plots.");
   cmd->add_option("batch", a->batch, "batch YAML file")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--outdir", a->outdir, "output folder")->capture_default_str();
   addRunOptions(cmd, a->o);

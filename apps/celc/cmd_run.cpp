@@ -6,6 +6,7 @@
 
 #include "celc/io/sequence_layout.hpp"
 #include "commands.hpp"
+#include "plots.hpp"
 #include "progress.hpp"
 #include "run_common.hpp"
 
@@ -40,6 +41,7 @@ void runRun(const RunArgs& a) {
   });
   progress.finish();
   printSummary(job.title + " (" + job.outdir + "/summary.md)", outcome);
+  if (automaticPlots(a.o.no_plots)) plotRun(job.outdir);
 }
 
 }  // namespace
@@ -54,7 +56,9 @@ void registerRun(CLI::App& app) {
           "(and --groundtruth), or a ROS bag / HDF5 file (camera and ground truth from the file unless "
           "--calib / --groundtruth say otherwise; topics found by type, or --topic-events/--topic-imu/--topic-pose). "
           "Writes OUTDIR/windows.csv (one row per window and method), "
-          "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary.");
+          "OUTDIR/summary.md and OUTDIR/config.yaml; prints the summary; then the plots "
+          "OUTDIR/velocity.png (direction per window and method, ground truth) and OUTDIR/error.png "
+          "(phi per window; with ground truth only) unless --no-plots.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");
   cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/calibration.md) or ") + sequence_file::kCalibText)

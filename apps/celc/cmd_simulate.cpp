@@ -12,6 +12,7 @@
 #include "celc/pipeline/peer_study.hpp"
 #include "celc/pipeline/simulation_study.hpp"
 #include "commands.hpp"
+#include "plots.hpp"
 #include "run_common.hpp"
 #include "progress.hpp"
 
@@ -32,19 +33,6 @@ struct SimulateArgs {
   bool force = false, no_plots = false, quiet = false, verbose = false;
   std::vector<std::string> sets;  ///< --set key.path=value
 };
-
-// Finds scripts/<name>: $CELC_SCRIPTS_DIR, the source tree, or next to the binary.
-std::string findPlotScript(const std::string& name = "plot_simulation.py") {
-  std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("CELC_SCRIPTS_DIR")) candidates.emplace_back(env);
-  candidates.emplace_back(CELC_SCRIPTS_DIR);
-  candidates.emplace_back(fs::path("scripts"));
-  for (const auto& dir : candidates) {
-    const fs::path p = dir / name;
-    if (fs::exists(p)) return p.string();
-  }
-  return {};
-}
 
 std::string fmtCell(double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : "-"; }
 
@@ -109,18 +97,10 @@ void runSigmaStudy(const SimulateArgs& a, const SimulateConfig& cfg, const fs::p
   std::cout << std::flush;
 }
 
-// Runs a plot script on OUTDIR with Debian's interpreter (or $CELC_PYTHON).
-void runPlotScript(const std::string& name, const fs::path& out) {
-  const std::string script = findPlotScript(name);
-  if (script.empty()) {
-    spdlog::warn("plot script scripts/{} not found: no plots (set CELC_SCRIPTS_DIR)", name);
-    return;
-  }
-  std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  if (const char* env = std::getenv("CELC_PYTHON")) python = env;
-  const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
-  if (std::system(cmd.c_str()) != 0)
-    spdlog::warn("plotting failed (needs python3-matplotlib): {}", cmd);
+// Runs a plot script on OUTDIR; a failure is a warning.
+void plotSimulation(const std::string& name, const fs::path& out) {
+  if (const std::string error = runPlotScript(name, {out.string()}); !error.empty())
+    spdlog::warn("no plots of {}: {}", out.string(), error);
   else
     spdlog::info("plots written to {}/*.png", out.string());
 }
@@ -173,7 +153,7 @@ void runPeers(const SimulateArgs& a, const SimulateConfig& cfg) {
     std::cout << " |\n";
   }
   std::cout << std::flush;
-  if (!a.no_plots) runPlotScript("plot_peers.py", out);
+  if (automaticPlots(a.no_plots)) plotSimulation("plot_peers.py", out);
 }
 
 void runSimulate(const SimulateArgs& a) {
@@ -230,8 +210,8 @@ void runSimulate(const SimulateArgs& a) {
   }
   std::cout << std::flush;
 
-  if (a.no_plots || sweeps.size() < 2) return;
-  runPlotScript("plot_simulation.py", out);
+  if (!automaticPlots(a.no_plots) || sweeps.size() < 2) return;
+  plotSimulation("plot_simulation.py", out);
 }
 
 }  // namespace

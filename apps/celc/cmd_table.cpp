@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <fmt/format.h>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/run_output.hpp"
 #include "commands.hpp"
+#include "plots.hpp"
 
 namespace fs = std::filesystem;
 
@@ -22,6 +24,7 @@ struct TableArgs {
   std::vector<std::string> results;
   std::vector<std::string> labels;  ///< NAME=PATH
   std::string output;
+  std::string plot;  ///< --plot FILE.png (empty: none)
   double max_sigma_deg = -1.0;  ///< < 0: every ok row
   bool quiet = false, allow_incomplete = false;
 };
@@ -184,6 +187,22 @@ void runTable(const TableArgs& a) {
     for (const auto& n : kept_notes) std::cout << n << "\n";
   }
   std::cout << std::flush;
+  if (!a.plot.empty()) {
+    // The same rows as the table: per group its label and its CSVs (shards merge).
+    std::vector<std::string> args = {"--table", a.plot};
+    if (a.max_sigma_deg >= 0.0) {
+      args.push_back("--max-sigma");
+      args.push_back(fmt::format("{}", a.max_sigma_deg));
+    }
+    for (const auto& g : groups) {
+      args.push_back("--run");
+      args.push_back(g.label);
+      for (const auto& s : g.sources) args.push_back(s.csv.string());
+    }
+    if (const std::string error = runPlotScript("plot_run.py", args); !error.empty())
+      throw std::runtime_error("--plot " + a.plot + ": " + error);
+    spdlog::info("wrote {}", a.plot);
+  }
 }
 
 }  // namespace
@@ -203,6 +222,9 @@ void registerTable(CLI::App& app) {
                   "NAME=PATH: the results in PATH as the row NAME (repeatable; the same NAME twice "
                   "merges, e.g. shards)");
   cmd->add_option("-o,--output", a->output, "write PREFIX.md, PREFIX.tex, PREFIX.csv");
+  cmd->add_option("--plot", a->plot,
+                  "FILE.png: the runs side by side, per run a box plot of phi [deg] per method and the "
+                  "share of ok windows (scripts/plot_run.py, python3-matplotlib)");
   cmd->add_option("--max-sigma", a->max_sigma_deg,
                   "DEG: only the windows a user would keep, ok rows with sigma_deg <= DEG [deg] "
                   "(rows without sigma_deg, from older files, are left out)")

@@ -43,6 +43,8 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
   cmd->add_flag("--resume", o.resume,
                 "continue a run after its last finished window; refused when OUTDIR/config.yaml differs "
                 "from this configuration");
+  cmd->add_flag("--no-plots", o.no_plots,
+                "skip the plots OUTDIR/velocity.png and error.png (scripts/plot_run.py, python3-matplotlib)");
   cmd->add_flag("-q,--quiet", o.quiet, "only warnings and errors on stderr");
   cmd->add_flag("-v,--verbose", o.verbose, "debug logging");
 }

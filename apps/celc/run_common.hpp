@@ -19,6 +19,7 @@ struct RunOverrides {
   std::string methods, omega, motion_model;
   int threads = 0;  ///< 0 = all cores; checked by checkThreads
   bool force = false, resume = false, quiet = false, verbose = false;
+  bool no_plots = false;  ///< --no-plots: no velocity.png / error.png
   std::string shard;
   /// --topic-events / --topic-imu / --topic-pose (ROS bags; empty: not given).
   std::string topic_events, topic_imu, topic_pose;

@@ -15,6 +15,14 @@
 namespace fs = std::filesystem;
 
 namespace celc {
+namespace {
+
+// What is made from the finished rows: summary.md and the plots of `celc run`.
+void removeResultFiles(const std::string& dir) {
+  for (const char* f : {"summary.md", "velocity.png", "error.png"}) fs::remove(fs::path(dir) / f);
+}
+
+}  // namespace
 
 std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
   std::vector<std::string> lines;
@@ -153,12 +161,12 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& c
     }
     in.close();
     writeMarker("celc run resumed " + nowText() + "; not complete (interrupted, or stopped on an error)");
-    fs::remove(fs::path(dir) / "summary.md");
+    removeResultFiles(dir);
     writeFileAtomically(csv_path_, content);
     csv_.open(csv_path_, std::ios::app);
   } else {
-    // The old summary goes first: it never stands beside new rows.
-    fs::remove(fs::path(dir) / "summary.md");
+    // The old summary and plots go first: they never stand beside new rows.
+    removeResultFiles(dir);
     writeMarker("celc run started " + nowText() + "; not complete (interrupted, or stopped on an error)");
     csv_.open(csv_path_, std::ios::trunc);
     csv_ << windowsCsvHeader() << "\n";
