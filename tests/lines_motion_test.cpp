@@ -114,6 +114,32 @@ TEST(LinesMotion, SparseClustersKeepEveryLineAndEveryMethodAnswers) {
   }
 }
 
+// A cluster whose lines could not be fitted stays in the window for npt
+// (which needs no fitted lines) and is skipped by the line methods: npt gives
+// the answer it gives with the lines, the line methods the answer without
+// the cluster.
+TEST(LinesMotion, ClusterWithoutLinesServesNptOnly) {
+  PeerSceneOptions o;
+  std::mt19937_64 rng(17);
+  const PeerSceneTrial tr = generatePeerScene(o, rng);
+  ASSERT_TRUE(tr.ok) << tr.message;
+  ASSERT_EQ(tr.lines_fitted, 5);
+  WindowObservations failed = tr.observations, removed = tr.observations;
+  failed.clusters[0].has_lines = false;
+  removed.clusters.erase(removed.clusters.begin());
+  const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::Npt};
+  const auto all = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions{});
+  const auto with_failed = solveMethods(failed, tr.given_motion, methods, SolverOptions{});
+  const auto without = solveMethods(removed, tr.given_motion, methods, SolverOptions{});
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_TRUE(with_failed[k].ok() && without[k].ok()) << toString(methods[k]);
+    EXPECT_LT(angleBetween(with_failed[k].v, without[k].v), 1e-9) << toString(methods[k]);
+  }
+  ASSERT_TRUE(with_failed[2].ok() && all[2].ok());
+  EXPECT_LT(angleBetween(with_failed[2].v, all[2].v), 1e-12);
+  EXPECT_GT(angleBetweenSignAgnostic(without[2].v, all[2].v), 1e-6);  // the cluster counts for npt
+}
+
 // The table of docs/lines.md (opt-in, prints medians; not a check):
 //   CELC_LINES_STUDY=1 build/celc_tests --gtest_filter=LinesMotion.Study
 TEST(LinesMotion, Study) {

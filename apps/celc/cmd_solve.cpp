@@ -120,9 +120,11 @@ void runSolve(const SolveArgs& a) {
   for (std::size_t k = 0; k < clusters.clusters.size(); ++k)
     if (std::find(report.used_ids.begin(), report.used_ids.end(), clusters.clusters[k].id) ==
         report.used_ids.end())
-      spdlog::warn("cluster {}: skipped (fewer than {} events, or its start and end lines could not be fitted)",
+      spdlog::warn("cluster {}: not used by the line methods (fewer than {} events, or its start and end "
+                   "lines could not be fitted; npt uses it when it has the events)",
                    clusters.clusters[k].id, cfg.observations.min_events);
-  spdlog::info("solve: {} events, {} clusters with lines", events.size(), obs.clusters.size());
+  spdlog::info("solve: {} events, {} clusters with lines, {} without (npt only)", events.size(),
+               report.n_used, obs.clusters.size() - static_cast<std::size_t>(report.n_used));
   const auto& methods = cfg.methods;
   const auto results = solveMethods(obs, motion, methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
   std::cout << "method,status,vx,vy,vz,runtime_us\n";

@@ -53,7 +53,10 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     }
     const ClusterLines lines = fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion);
     if (!lines.ok()) {
+      // Kept for the methods that need no lines (npt).
       ++rep.n_line_fit_failed;
+      obs.has_lines = false;
+      out.clusters.push_back(std::move(obs));
       continue;
     }
     obs.l1 = lines.l1.line;
@@ -64,7 +67,7 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     rep.lines.push_back(lines);
     out.clusters.push_back(std::move(obs));
   }
-  rep.n_used = static_cast<int>(out.clusters.size());
+  rep.n_used = static_cast<int>(rep.used_ids.size());
   if (report) *report = rep;
   return out;
 }

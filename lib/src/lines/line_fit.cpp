@@ -203,6 +203,7 @@ ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector
 bool attachFittedLines(ClusterObservation& cluster, double focal_px, const LineFitOptions& options,
                        const MotionModel* motion) {
   const ClusterLines lines = fitClusterLines(cluster.times, cluster.bearings, focal_px, options, motion);
+  cluster.has_lines = lines.ok();
   if (!lines.ok()) return false;
   cluster.l1 = lines.l1.line;
   cluster.l3 = lines.l3.line;

@@ -186,7 +186,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   ObservationReport report;
   const WindowObservations obs =
       toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
-  rec.n_clusters = static_cast<int>(obs.clusters.size());
+  rec.n_clusters = report.n_used;  // with lines; npt also gets the others
   rec.times.lines = secondsSince(start);
 
   start = Clock::now();

@@ -44,7 +44,8 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   // No screening when the subset would hold every event anyway (refining the
   // winner again would repeat its work).
   size_t events = 0;
-  for (const auto& c : obs.clusters) events += c.size();
+  for (const auto& c : obs.clusters)
+    if (c.has_lines) events += c.size();
   const int full = options.refine.max_events;
   const bool screen = options.ml.grid_starts > 0 && options.ml.screen_events > 0 &&
                       (full == 0 || full > options.ml.screen_events) &&

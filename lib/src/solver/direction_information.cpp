@@ -54,7 +54,7 @@ DirectionInformation directionInformation(const WindowObservations& obs, const M
   const Vec3 v = direction.normalized();
   const Mat32 Bv = tangentBasis(v);
   for (const auto& c : obs.clusters) {
-    if (!(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
+    if (!c.has_lines || !(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
     if (!(c.l1.normal.norm() > 0.0) || !(c.l3.normal.norm() > 0.0)) continue;
     const ClusterFrame fr = makeClusterFrame(c, motion);
     const Vec3 m1 = fr.m1.normalized(), m3 = fr.m3.normalized();

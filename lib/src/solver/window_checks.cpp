@@ -19,6 +19,7 @@ std::vector<int> usableClusters(const WindowObservations& obs, int min_events) {
   for (size_t c = 0; c < obs.clusters.size(); ++c) {
     const auto& cl = obs.clusters[c];
     if (static_cast<int>(cl.size()) < min_events || cl.bearings.size() != cl.times.size()) continue;
+    if (!cl.has_lines) continue;
     if (!cl.l1.normal.allFinite() || !cl.l3.normal.allFinite()) continue;
     if (!(cl.l1.normal.norm() > 0.0) || !(cl.l3.normal.norm() > 0.0)) continue;
     if (!(cl.l3.t > cl.l1.t)) continue;

@@ -30,15 +30,18 @@ void describe(FieldVisitor& v, ObservationOptions& options);
 /// What happened to each cluster.
 struct ObservationReport {
   int n_clusters = 0;         ///< clusters in the ClusterResult
-  int n_used = 0;             ///< clusters turned into observations
+  int n_used = 0;             ///< clusters turned into observations with lines
   int n_too_few_events = 0;   ///< skipped: fewer than min_events usable events
-  int n_line_fit_failed = 0;  ///< skipped: l1 or l3 not Ok (too few events, poor fit, l3 not after l1)
+  /// l1 or l3 not Ok (too few events, poor fit, l3 not after l1): kept with
+  /// has_lines = false (npt uses them; the line methods skip them)
+  int n_line_fit_failed = 0;
   std::vector<int> used_ids;         ///< ClusterResult ids of the clusters used, in output order
   std::vector<ClusterLines> lines;   ///< fitted lines of every used cluster (quality, timestamps)
 };
 
 /// Builds the solver input of a window. Clusters keep their ClusterResult id in
-/// ClusterObservation::id. Events whose bearing is not finite are left out.
+/// ClusterObservation::id; a cluster whose lines could not be fitted is kept
+/// with has_lines = false. Events whose bearing is not finite are left out.
 /// `focal_px` converts normalised distances to pixels (fit thresholds are in px)
 /// and is stored in WindowObservations::focal_px. `motion` gives the rotation
 /// the line fit removes (line_fit.hpp; nullptr: no rotation). Never throws on data.

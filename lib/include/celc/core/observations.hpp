@@ -26,6 +26,9 @@ struct ClusterObservation {
   TimedLine l3;                 ///< line at the cluster's end t_e
   TimedLine l2;                 ///< middle line at t_m (CE3LC)
   bool has_l2 = false;
+  /// l1 and l3 were fitted. False: the events alone (a line fit failed):
+  /// npt, which needs no fitted lines, uses them; the line methods skip them.
+  bool has_lines = true;
   int id = -1;                  ///< caller's label (cluster id)
   size_t size() const { return times.size(); }
 };

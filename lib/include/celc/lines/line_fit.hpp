@@ -105,8 +105,8 @@ ClusterLines fitClusterLines(const std::vector<double>& times, const std::vector
                              double focal_px, const LineFitOptions& options,
                              const MotionModel* motion = nullptr);
 
-/// Fits the lines of a cluster and stores them in it (l1, l2, l3, has_l2).
-/// Returns false when l1 or l3 could not be fitted.
+/// Fits the lines of a cluster and stores them in it (l1, l2, l3, has_l2,
+/// has_lines). Returns false (has_lines false) when l1 or l3 could not be fitted.
 bool attachFittedLines(ClusterObservation& cluster, double focal_px, const LineFitOptions& options,
                        const MotionModel* motion = nullptr);
 
