@@ -119,6 +119,20 @@ TEST(CliTrust, CalibrationOfAnotherSensorSizeIsRefused) {
   fs::remove_all(d);
 }
 
+// Clusters whose lines cannot be fitted are counted in the summary and their
+// reasons logged with --verbose (issue 12's bad-input rule).
+TEST(CliTrust, ClustersWithoutLinesAreCountedAndExplained) {
+  const fs::path d = test::freshTempDir("trust_lines");
+  const auto r = runCelc("run '" + kSample + "' -o " + q(d / "o") +
+                             " --window-events 50000 --set windows.t_end=0.12 --set lines.min_length_px=150 -v",
+                         d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lines not fitted (l1 poor_fit"), std::string::npos) << r.err;
+  EXPECT_NE(readAll(d / "o" / "summary.md").find("clusters whose start / end lines could not be fitted: used by npt only"),
+            std::string::npos);
+  fs::remove_all(d);
+}
+
 TEST(CliTrust, RecordingWithoutImuNeedsOmega) {
   const fs::path d = test::freshTempDir("trust_imu");
   fs::create_directories(d / "seq");

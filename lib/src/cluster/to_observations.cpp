@@ -55,6 +55,8 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     if (!lines.ok()) {
       // Kept for the methods that need no lines (npt).
       ++rep.n_line_fit_failed;
+      rep.failed_ids.push_back(obs.id);
+      rep.failed_lines.push_back(lines);
       obs.has_lines = false;
       out.clusters.push_back(std::move(obs));
       continue;

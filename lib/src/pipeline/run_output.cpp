@@ -295,6 +295,10 @@ void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
   }
   if (s.reader_warnings > 0)
     out.notes.push_back(std::to_string(s.reader_warnings) + " reader warnings (see celc info)");
+  if (s.clusters_line_fit_failed > 0)
+    out.notes.push_back(std::to_string(s.clusters_line_fit_failed) +
+                        " clusters whose start / end lines could not be fitted: used by npt only "
+                        "(reasons with --verbose)");
   const WindowTail& tail = s.tail;
   if (tail.events > 0) {
     std::ostringstream n;

@@ -1,5 +1,7 @@
 #include "celc/pipeline/sequence_runner.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -187,6 +189,14 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   const WindowObservations obs =
       toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
   rec.n_clusters = report.n_used;  // with lines; npt also gets the others
+  rec.n_line_fit_failed = report.n_line_fit_failed;
+  for (std::size_t k = 0; k < report.failed_ids.size(); ++k) {
+    const ClusterLines& l = report.failed_lines[k];
+    spdlog::debug("window {}: cluster {}: lines not fitted (l1 {}, {} events, {:.2f} px, {:.1f} px long; l3 {}, "
+                  "{} events, {:.2f} px, {:.1f} px long); npt only",
+                  index, report.failed_ids[k], toString(l.l1.status), l.l1.n_events, l.l1.rms_px,
+                  l.l1.length_px, toString(l.l3.status), l.l3.n_events, l.l3.rms_px, l.l3.length_px);
+  }
   rec.times.lines = secondsSince(start);
 
   start = Clock::now();
@@ -274,6 +284,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         stats.stage_seconds.lines += rec.times.lines;
         stats.stage_seconds.solve += rec.times.solve;
         stats.stage_seconds.groundtruth += rec.times.groundtruth;
+        stats.clusters_line_fit_failed += static_cast<std::uint64_t>(rec.n_line_fit_failed);
         sink(rec);
         if (progress) progress(stats.windows_processed, stats.events_processed);
       });

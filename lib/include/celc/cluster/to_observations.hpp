@@ -37,6 +37,8 @@ struct ObservationReport {
   int n_line_fit_failed = 0;
   std::vector<int> used_ids;         ///< ClusterResult ids of the clusters used, in output order
   std::vector<ClusterLines> lines;   ///< fitted lines of every used cluster (quality, timestamps)
+  std::vector<int> failed_ids;              ///< ClusterResult ids of the clusters whose lines failed
+  std::vector<ClusterLines> failed_lines;   ///< their fits (statuses say why)
 };
 
 /// Builds the solver input of a window. Clusters keep their ClusterResult id in

@@ -42,7 +42,8 @@ struct WindowRecord {
   std::uint64_t index = 0;
   double t0 = 0.0, t1 = 0.0;   ///< [s]
   std::size_t n_events = 0;
-  int n_clusters = 0;          ///< clusters handed to the solvers
+  int n_clusters = 0;          ///< clusters handed to the solvers with lines
+  int n_line_fit_failed = 0;   ///< clusters whose l1 / l3 could not be fitted (npt still uses them)
   /// Empty when the window reached the solvers; else why no method ran
   /// (`no_gyro`, `not_covered`, `gyro_gap`, `too_few_clusters`, `no_clusters`, ...).
   std::string window_status;
@@ -71,6 +72,7 @@ struct RunStats {
   double seconds_total = 0.0, seconds_reading = 0.0;
   StageTimes stage_seconds;  ///< summed over windows
   std::uint64_t reader_warnings = 0;
+  std::uint64_t clusters_line_fit_failed = 0;  ///< summed WindowRecord::n_line_fit_failed
   WindowTail tail;           ///< the last, partial window: processed or not, and its events
 };
 
