@@ -29,6 +29,12 @@ inline const std::string& ioFixtureDir() {
 }
 inline std::string fixture(const std::string& name) { return ioFixtureDir() + "/" + name; }
 inline std::string fixtureSequence() { return ioFixtureDir() + "/seq"; }
+/// The fixture sequence's events as its text reader gives them (the reference
+/// every other format must reproduce).
+inline std::vector<Event> fixtureTextEvents() {
+  auto r = openEventSource(fixtureSequence());
+  return readAllEvents(*r);
+}
 
 #define CELC_REQUIRE_IO_FIXTURES() \
   ASSERT_FALSE(::celc::test::ioFixtureDir().empty()) << "tests/fixtures/make_fixtures.sh failed: see " CELC_FIXTURE_DIR ".log"

@@ -17,18 +17,11 @@ using celc::test::fixture;
 using celc::test::fixtureSequence;
 using celc::test::ioErrorOf;
 
-namespace {
-std::vector<Event> textEvents() {
-  auto r = openEventSource(fixtureSequence());
-  return readAllEvents(*r);
-}
-}  // namespace
-
 TEST(IoHdf5, DsecLayoutReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
   auto r = openEventSource(fixture("seq_dsec.h5"));
   EXPECT_EQ(r->format(), Format::Hdf5);
-  celc::test::expectSameEvents(readAllEvents(*r), textEvents());
+  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
   EXPECT_EQ(r->warnings().total(), 0u);
   EXPECT_TRUE(r->readImu().empty());
   EXPECT_TRUE(r->readPoses().empty());
@@ -38,13 +31,13 @@ TEST(IoHdf5, BloscCompressedDsecReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
   if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
   auto r = openEventSource(fixture("seq_blosc.h5"));
-  celc::test::expectSameEvents(readAllEvents(*r), textEvents());
+  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
 }
 
 TEST(IoHdf5, MvsecLayoutEventsImuPoses) {
   CELC_REQUIRE_IO_FIXTURES();
   auto r = openEventSource(fixture("seq_mvsec.h5"));
-  celc::test::expectSameEvents(readAllEvents(*r), textEvents());
+  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
   const auto imu = r->readImu(), imu_text = readImuText(fixtureSequence() + "/imu.txt");
   ASSERT_EQ(imu.size(), imu_text.size());
   for (std::size_t i = 0; i < imu.size(); ++i) {
@@ -66,7 +59,7 @@ TEST(IoHdf5, MvsecLayoutEventsImuPoses) {
 // ms_to_idx lands on the first event of the millisecond.
 TEST(IoHdf5, BatchesAndSeek) {
   CELC_REQUIRE_IO_FIXTURES();
-  const auto text = textEvents();
+  const auto text = celc::test::fixtureTextEvents();
   for (std::size_t batch : {1u, 999u, 65536u, 100000u}) {
     auto r = openEventSource(fixture("seq_dsec.h5"));
     std::vector<Event> all, b;

@@ -20,10 +20,6 @@ using celc::test::fixtureSequence;
 using celc::test::ioErrorOf;
 
 namespace {
-std::vector<Event> textEvents() {
-  auto r = openEventSource(fixtureSequence());
-  return readAllEvents(*r);
-}
 bool hasNote(const EventReader& r, const std::string& part) {
   for (const auto& n : r.notes())
     if (n.find(part) != std::string::npos) return true;
@@ -33,7 +29,7 @@ bool hasNote(const EventReader& r, const std::string& part) {
 
 TEST(IoRosbag, EveryCompressionReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
-  const auto text = textEvents();
+  const auto text = celc::test::fixtureTextEvents();
   ASSERT_GT(text.size(), 10000u);
   const auto imu_text = readImuText(fixtureSequence() + "/imu.txt");
   const auto poses_text = readPosesText(fixtureSequence() + "/groundtruth.txt");
@@ -70,7 +66,7 @@ TEST(IoRosbag, EveryCompressionReadsAsTheText) {
 // Batches of every size give the same stream (a batch may end inside a message).
 TEST(IoRosbag, BatchesSplitMessagesAnywhere) {
   CELC_REQUIRE_IO_FIXTURES();
-  const auto text = textEvents();
+  const auto text = celc::test::fixtureTextEvents();
   for (std::size_t batch : {1u, 7u, 1499u, 1500u, 4096u}) {
     auto r = openEventSource(fixture("seq_lz4.bag"));
     std::vector<Event> all, b;
@@ -118,7 +114,7 @@ TEST(IoRosbag, TopicsFoundByTypeOrNamed) {
   o.topic_imu = "/dvs/imu";
   o.topic_pose = "/optitrack/pose";
   auto r = openEventSource(fixture("seq_none.bag"), o);
-  EXPECT_EQ(readAllEvents(*r).size(), textEvents().size());
+  EXPECT_EQ(readAllEvents(*r).size(), celc::test::fixtureTextEvents().size());
   o.topic_events = "/nowhere";
   std::string m = ioErrorOf([&] { openEventSource(fixture("seq_none.bag"), o); });
   EXPECT_NE(m.find("seq_none.bag: no topic /nowhere (input.topic_events)"), std::string::npos) << m;

@@ -81,19 +81,24 @@ BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
 // window checks, shared by all methods, are measured apart
 // (BM_WindowChecks1000Events). arg = events per line, 5 lines.
 // Paper's scene: constant twist, |w| T = 1 rad, 2 px noise.
-static void BM_CelcLinear(benchmark::State& state) {
-  const auto tr = scene(static_cast<int>(state.range(0)));
+// The CELC linear method as the dispatcher runs it (frames, rows, IRLS, sign).
+static void timeCelcLinear(benchmark::State& state, const WindowObservations& obs, const MotionModel& motion) {
   const LinearOptions opt;
   int ok = 0, iterations = 0;
   for (auto _ : state) {
-    const detail::WindowFrames frames(tr.observations, tr.given_motion);
-    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
+    const detail::WindowFrames frames(obs, motion);
+    const auto r = detail::solveCelcLinear(obs, motion, opt, frames, false, opt.seed);
     ok = r.ok();
     iterations = r.iterations;
     benchmark::DoNotOptimize(r);
   }
   state.counters["ok"] = ok;
   state.counters["irls_iterations"] = iterations;
+}
+
+static void BM_CelcLinear(benchmark::State& state) {
+  const auto tr = scene(static_cast<int>(state.range(0)));
+  timeCelcLinear(state, tr.observations, tr.given_motion);
 }
 BENCHMARK(BM_CelcLinear)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
@@ -103,17 +108,7 @@ static void BM_CelcLinearPeers(benchmark::State& state) {
   o.events_per_line = static_cast<int>(state.range(0));
   std::mt19937_64 rng(42);
   const auto tr = generatePeerScene(o, rng);
-  const LinearOptions opt;
-  int ok = 0, iterations = 0;
-  for (auto _ : state) {
-    const detail::WindowFrames frames(tr.observations, tr.given_motion);
-    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
-    ok = r.ok();
-    iterations = r.iterations;
-    benchmark::DoNotOptimize(r);
-  }
-  state.counters["ok"] = ok;
-  state.counters["irls_iterations"] = iterations;
+  timeCelcLinear(state, tr.observations, tr.given_motion);
 }
 BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
