@@ -107,7 +107,19 @@ TEST(MotionModel, GyroIntegratedWithConstantRateMatchesConstantTwist) {
     EXPECT_LT((gyro.rotation(t) - twist.rotation(t)).norm(), 1e-12) << t;
   }
   EXPECT_LT((gyro.meanOmega(0.1, 0.9) - w).norm(), 1e-10);
-  EXPECT_LT((gyro.positionMatrix(0.75) - 0.5 * Mat3::Identity()).norm(), 1e-15);
+  // Body-frame velocity (the default): P(t) = integral of R = J_l(w tau) tau, the twist's.
+  for (double t : {0.0, 0.123, 0.25, 0.777, 1.0, 1.2}) {
+    Mat3 R, P;
+    gyro.pose(t, R, P);
+    EXPECT_LT((P - twist.positionMatrix(t)).norm(), 1e-12) << t;
+    EXPECT_LT((gyro.positionMatrix(t) - P).norm(), 1e-15) << t;
+    EXPECT_LT((R - gyro.rotation(t)).norm(), 1e-15) << t;
+  }
+  // Reference-frame velocity (the peers' protocol): P(t) = tau I.
+  const auto reference = MotionModel::gyroIntegrated(times, rates, 0.25, VelocityFrame::Reference);
+  EXPECT_LT((reference.positionMatrix(0.75) - 0.5 * Mat3::Identity()).norm(), 1e-15);
+  EXPECT_LT((reference.rotation(0.777) - twist.rotation(0.777)).norm(), 1e-12);
+  EXPECT_EQ(reference.withOmegaOffset(Vec3::Zero()).velocityFrame(), VelocityFrame::Reference);
 }
 
 TEST(MotionModel, GyroIntegratedFollowsVaryingRate) {
@@ -124,6 +136,21 @@ TEST(MotionModel, GyroIntegratedFollowsVaryingRate) {
   for (double t : {0.13, 0.5, 0.99}) {
     const Mat3 expected = so3::exp(axis * (a * t + 0.5 * b * t * t));
     EXPECT_LT((gyro.rotation(t) - expected).norm(), 1e-12) << t;
+  }
+  // P(t) = integral of R(s) ds from t_ref = 0, by Simpson's rule on a fine grid
+  // of the exact rotation (error ~1e-12 at 2000 steps).
+  for (double t : {0.13, 0.5, 0.99}) {
+    const int n = 2000;
+    Mat3 integral = Mat3::Zero();
+    for (int k = 0; k <= n; ++k) {
+      const double s = t * k / n, weight = (k == 0 || k == n) ? 1.0 : (k % 2 ? 4.0 : 2.0);
+      integral += weight * so3::exp(axis * (a * s + 0.5 * b * s * s));
+    }
+    integral *= t / (3.0 * n);
+    // Inside a step the model turns at the mean rate of the step's start and t,
+    // off the true angle by at most b dt^2 / 8 = 1.5e-4 rad (dt = 20 ms); the
+    // integral of R is then off by at most that times t (|R - R'| <= sqrt(2) angle).
+    EXPECT_LT((gyro.positionMatrix(t) - integral).norm(), 1.5e-4 * std::sqrt(2.0) * t) << t;
   }
 }
 

@@ -27,7 +27,8 @@ MotionModel MotionModel::constantTwist(const Vec3& omega, double t_ref) {
 }
 
 MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
-                                        const std::vector<Vec3>& rates, double t_ref) {
+                                        const std::vector<Vec3>& rates, double t_ref,
+                                        VelocityFrame frame) {
   if (times.empty() || times.size() != rates.size())
     throw std::invalid_argument("gyroIntegrated: need equally many (>= 1) times and rates");
   for (size_t i = 1; i < times.size(); ++i)
@@ -35,40 +36,70 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
       throw std::invalid_argument("gyroIntegrated: sample times must increase");
   MotionModel m;
   m.kind_ = MotionModelKind::GyroIntegrated;
+  m.frame_ = frame;
   m.t_ref_ = t_ref;
   m.times_ = times;
   m.rates_ = rates;
-  // R_0_ti from the first sample, trapezoidal (mean-rate) steps.
+  // R_0_ti and Q_i = integral of R_0_s ds over [t_0, t_i], from the first
+  // sample: each step turns at its mean rate w, so its rotation is exp(w dt)
+  // and its integral R_0_ti J_l(w dt) dt.
   m.rotations_.resize(times.size());
+  m.positions_.resize(times.size());
   m.rotations_[0] = Mat3::Identity();
+  m.positions_[0] = Mat3::Zero();
   for (size_t i = 1; i < times.size(); ++i) {
     const double dt = times[i] - times[i - 1];
-    m.rotations_[i] = m.rotations_[i - 1] * so3::exp(0.5 * (rates[i - 1] + rates[i]) * dt);
+    Mat3 step_R, step_J;
+    so3::expAndLeftJacobian(0.5 * (rates[i - 1] + rates[i]) * dt, step_R, step_J);
+    m.positions_[i] = m.positions_[i - 1] + m.rotations_[i - 1] * step_J * dt;
+    m.rotations_[i] = m.rotations_[i - 1] * step_R;
   }
-  // Re-anchor so that R(t_ref) = I.
-  const Mat3 R0_ref = m.rotation(t_ref);
-  for (auto& R : m.rotations_) R = R0_ref.transpose() * R;
+  // Re-anchor so that R(t_ref) = I and P(t_ref) = 0.
+  Mat3 R0_ref, Q_ref;
+  m.samplePose(t_ref, R0_ref, Q_ref);
+  for (size_t i = 0; i < times.size(); ++i) {
+    m.rotations_[i] = R0_ref.transpose() * m.rotations_[i];
+    m.positions_[i] = R0_ref.transpose() * (m.positions_[i] - Q_ref);
+  }
   return m;
+}
+
+void MotionModel::samplePose(double t, Mat3& R, Mat3& P) const {
+  // The step [t_i, t] holding t turns at the mean of the rates at its ends
+  // (clamped at the ends of the samples, holding the end rate).
+  size_t i = 0;
+  Vec3 rate;
+  if (times_.size() == 1 || t <= times_.front()) {
+    rate = rates_.front();
+  } else if (t >= times_.back()) {
+    i = times_.size() - 1;
+    rate = rates_.back();
+  } else {
+    i = static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin()) - 1;
+    const double s = (t - times_[i]) / (times_[i + 1] - times_[i]);
+    rate = 0.5 * (rates_[i] + (1.0 - s) * rates_[i] + s * rates_[i + 1]);
+  }
+  const double dt = t - times_[i];
+  Mat3 step_R, step_J;
+  so3::expAndLeftJacobian(rate * dt, step_R, step_J);
+  P = positions_[i] + rotations_[i] * step_J * dt;
+  R = rotations_[i] * step_R;
 }
 
 Mat3 MotionModel::rotation(double t) const {
   if (kind_ == MotionModelKind::ConstantTwist) return so3::exp(omega_ * (t - t_ref_));
-  // Interval [t_i, t_i+1] holding t (clamped at the ends, holding the end rate).
-  if (times_.size() == 1 || t <= times_.front())
-    return rotations_.front() * so3::exp(rates_.front() * (t - times_.front()));
-  if (t >= times_.back()) return rotations_.back() * so3::exp(rates_.back() * (t - times_.back()));
-  const size_t i = static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) -
-                                       times_.begin()) - 1;
-  const double dt = t - times_[i];
-  const double s = dt / (times_[i + 1] - times_[i]);
-  const Vec3 rate_t = (1.0 - s) * rates_[i] + s * rates_[i + 1];
-  return rotations_[i] * so3::exp(0.5 * (rates_[i] + rate_t) * dt);
+  Mat3 R, P;
+  samplePose(t, R, P);
+  return R;
 }
 
 Mat3 MotionModel::positionMatrix(double t) const {
   const double tau = t - t_ref_;
   if (kind_ == MotionModelKind::ConstantTwist) return so3::leftJacobian(omega_ * tau) * tau;
-  return Mat3::Identity() * tau;
+  if (frame_ == VelocityFrame::Reference) return Mat3::Identity() * tau;
+  Mat3 R, P;
+  samplePose(t, R, P);
+  return P;
 }
 
 void MotionModel::pose(double t, Mat3& R, Mat3& P) const {
@@ -78,8 +109,8 @@ void MotionModel::pose(double t, Mat3& R, Mat3& P) const {
     P *= tau;
     return;
   }
-  R = rotation(t);
-  P = Mat3::Identity() * tau;
+  samplePose(t, R, P);
+  if (frame_ == VelocityFrame::Reference) P = Mat3::Identity() * tau;
 }
 
 Vec3 MotionModel::meanOmega(double t0, double t1) const {
@@ -91,7 +122,7 @@ MotionModel MotionModel::withOmegaOffset(const Vec3& delta) const {
   if (kind_ == MotionModelKind::ConstantTwist) return constantTwist(omega_ + delta, t_ref_);
   std::vector<Vec3> rates = rates_;
   for (auto& r : rates) r += delta;
-  return gyroIntegrated(times_, rates, t_ref_);
+  return gyroIntegrated(times_, rates, t_ref_, frame_);
 }
 
 }  // namespace celc

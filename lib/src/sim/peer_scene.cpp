@@ -70,7 +70,8 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
     trial.true_direction = randomUnit(rng);
     v = trial.true_direction * o.speed;
     trial.true_motion =
-        MotionModel::gyroIntegrated({t0, t1}, {trial.true_omega, trial.true_omega}, o.t_ref);
+        MotionModel::gyroIntegrated({t0, t1}, {trial.true_omega, trial.true_omega}, o.t_ref,
+                                    VelocityFrame::Reference);
     R0 = trial.true_motion.rotation(t0);
     R1 = trial.true_motion.rotation(t1);
     p0 = trial.true_motion.positionMatrix(t0) * v;

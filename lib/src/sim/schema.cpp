@@ -7,7 +7,7 @@ void describe(FieldVisitor& v, LineSceneOptions& o) {
   v.field({"n_lines", "", "3D segments (clusters)"}, o.n_lines);
   v.field({"events_per_line", "events", "events sampled per segment"}, o.events_per_line);
   v.field({"duration", "s", "window length; t_s = 0, t_e = duration"}, o.duration);
-  v.field({"velocity", "m/s", "v (body frame; reference frame with gyro_integrated)"}, o.velocity);
+  v.field({"velocity", "m/s", "v (body frame)"}, o.velocity);
   v.field({"omega", "rad/s", "angular velocity, camera frame"}, o.omega);
   v.field({"event_noise_px", "px", "std of event pixel noise"}, o.event_noise_px);
   v.field({"line_noise_px", "px", "std of line endpoint noise"}, o.line_noise_px);

@@ -14,7 +14,8 @@ namespace celc::detail {
 bool nptStartApplies(const WindowObservations& obs, const MotionModel& motion,
                      const MlOptions& options) {
   if (!options.second_start) return false;
-  if (motion.kind() == MotionModelKind::GyroIntegrated) return true;
+  if (motion.kind() == MotionModelKind::GyroIntegrated && motion.velocityFrame() == VelocityFrame::Reference)
+    return true;
   double tau = 0.0;
   for (const auto& c : obs.clusters)
     for (double t : c.times)

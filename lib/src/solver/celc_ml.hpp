@@ -9,7 +9,8 @@
 namespace celc::detail {
 
 /// Whether npt's estimate may start celc_ml: npt's motion model (P(t) = tau I)
-/// holds, exactly for GyroIntegrated, for a constant twist while
+/// holds, exactly for GyroIntegrated in the reference frame, for a body-frame
+/// model while
 /// |w| max|tau| / 2 <= options.second_start_max_twist; and options.second_start.
 bool nptStartApplies(const WindowObservations& obs, const MotionModel& motion,
                      const MlOptions& options);

@@ -11,8 +11,13 @@
 ///      R(t) = exp(w^ tau),  P(t) = J_l(w tau) tau,  tau = t - t_ref.
 ///    v is the body-frame velocity, the same at every time of the window.
 ///  - GyroIntegrated: R(t) integrated from a sampled angular-velocity signal
-///    (linear interpolation between samples), velocity constant in the
-///    reference frame: P(t) = tau I. v is the velocity in the reference camera frame.
+///    (linear interpolation between samples), with the velocity constant
+///      - in the body frame (VelocityFrame::Body, the pipeline's): P(t) =
+///        integral of R(s) ds over [t_ref, t]; v is the body-frame velocity, and
+///        with a constant rate this is the constant twist;
+///      - or in the reference frame (VelocityFrame::Reference, the newer
+///        papers' protocol, docs/peers.md): P(t) = tau I; v is the velocity in
+///        the reference camera frame.
 /// Both keep every CELC constraint linear in v.
 #include <vector>
 
@@ -21,6 +26,8 @@
 namespace celc {
 
 enum class MotionModelKind { ConstantTwist, GyroIntegrated };
+/// GyroIntegrated: the frame in which the linear velocity is constant.
+enum class VelocityFrame { Body, Reference };
 
 /// Parses "constant_twist" / "gyro_integrated"; throws std::invalid_argument otherwise.
 MotionModelKind parseMotionModelKind(const std::string& name);
@@ -34,9 +41,12 @@ class MotionModel {
   /// frame), integrated with the trapezoidal rule. Needs at least one sample;
   /// outside the sampled range the nearest end rate is held.
   static MotionModel gyroIntegrated(const std::vector<double>& times,
-                                    const std::vector<Vec3>& rates, double t_ref);
+                                    const std::vector<Vec3>& rates, double t_ref,
+                                    VelocityFrame frame = VelocityFrame::Body);
 
   MotionModelKind kind() const { return kind_; }
+  /// Body for ConstantTwist; GyroIntegrated: as built.
+  VelocityFrame velocityFrame() const { return frame_; }
   double referenceTime() const { return t_ref_; }
   /// Mean angular velocity over [t0, t1] [rad/s]: the constant rate, or log(R(t0)^T R(t1)) / (t1 - t0).
   Vec3 meanOmega(double t0, double t1) const;
@@ -54,12 +64,17 @@ class MotionModel {
 
  private:
   MotionModelKind kind_ = MotionModelKind::ConstantTwist;
+  VelocityFrame frame_ = VelocityFrame::Body;
   double t_ref_ = 0.0;
   Vec3 omega_ = Vec3::Zero();
   // GyroIntegrated: samples and R_ref_ti at each sample time.
   std::vector<double> times_;
   std::vector<Vec3> rates_;
   std::vector<Mat3> rotations_;
+  std::vector<Mat3> positions_;  ///< P at each sample time
+  /// GyroIntegrated: R(t) and P(t) from the samples (rotations_ / positions_
+  /// anchored at t_ref, or from the first sample while they are being built).
+  void samplePose(double t, Mat3& R, Mat3& P) const;
 };
 
 }  // namespace celc

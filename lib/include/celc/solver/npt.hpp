@@ -25,8 +25,9 @@
 /// General motion models: the incidence holds with c = P(t) v. It is exactly
 /// the form above when P(t) = s(t) I, with tau = s(t) - s(t0); the solver uses
 /// s(t) = trace(P(t)) / 3.
-/// GyroIntegrated (velocity constant in the reference frame): P = tau I, exact.
-/// ConstantTwist: P = tau J_l(w tau) = tau (I + [w tau]_x / 2 + O(|w tau|^2));
+/// GyroIntegrated with VelocityFrame::Reference: P = tau I, exact.
+/// ConstantTwist (and GyroIntegrated with a body-frame velocity, the same to
+/// first order): P = tau J_l(w tau) = tau (I + [w tau]_x / 2 + O(|w tau|^2));
 /// trace/3 keeps the symmetric part (error O(|w tau|^2)) and drops the skew
 /// part, a relative error of up to |w| |tau| / 2 on the camera displacement
 /// (1.9% at 15 deg/s and |tau| = 0.25 s): the solver's own model, documented.

@@ -106,7 +106,8 @@ struct MlOptions {
   /// more than second_start_deg away from it, and keep the lower robust cost;
   /// also run from npt alone when celc fails. A remedy for the local minima of
   /// the joint problem (docs/peers.md). Only where npt's motion model holds:
-  /// GyroIntegrated (P = tau I, exact), or a constant twist turning little,
+  /// GyroIntegrated in the reference frame (P = tau I, exact), or a body-frame
+  /// model (constant twist, gyro-integrated) turning little,
   /// |w| max|tau| / 2 <= second_start_max_twist (npt's relative error on the
   /// displacement).
   bool second_start = true;
