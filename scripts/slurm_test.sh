@@ -250,12 +250,12 @@ sequences:
   - label: room
     path: $root/data/sample_seq
     config:
-      windows: {events: 20000}
+      windows: {policy: events, events: 20000}
   - label: room_gyro
     path: $root/data/sample_seq
     t_end: 0.2
     config:
-      windows: {events: 20000}
+      windows: {policy: events, events: 20000}
       motion: {model: gyro_integrated}
 EOF
 export CELC_NO_PLOTS=1

@@ -60,6 +60,7 @@ TEST(CliTrust, WindowSizesMustBePositiveAndFinite) {
   expectOneLineError(runCelc(run + "--window-events 100 --window-seconds 0.1", d), {"--window-events", "not both"});
   // The same through the configuration: the key is named.
   expectOneLineError(runCelc(run + "--set windows.seconds=-0.1", d), {"windows.seconds", "> 0"});
+  expectOneLineError(runCelc(run + "--set windows.seconds=0.1", d), {"windows.policy", "parallax"});
   expectOneLineError(runCelc(run + "--set windows.overlap=1", d), {"windows.overlap", "[0, 1)"});
   expectOneLineError(runCelc(run + "--set windows.overlap=-0.5", d), {"windows.overlap"});
   EXPECT_FALSE(fs::exists(d / "o"));
@@ -86,7 +87,7 @@ TEST(CliTrust, WindowRateIsBounded) {
   // By duration: known before reading.
   expectOneLineError(runCelc(run + "--window-seconds 1e-9", d),
                      {"--window-seconds 1e-9", "windows per second", "windows.max_windows_per_second = 10000"});
-  std::ofstream(d / "tiny.yaml") << "windows: {events: 0, seconds: 1.0e-6}\n";
+  std::ofstream(d / "tiny.yaml") << "windows: {policy: seconds, events: 0, seconds: 1.0e-6}\n";
   expectOneLineError(runCelc("run '" + kSample + "' -c " + q(d / "tiny.yaml") + " -o " + q(d / "o") + kFast, d),
                      {"tiny.yaml", "windows.seconds", "max_windows_per_second"});
   // By count: from the event rate, before the first window is processed.

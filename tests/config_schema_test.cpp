@@ -256,7 +256,7 @@ TEST(ConfigSchema, SetAssignments) {
 TEST(ConfigSchema, HelpComesFromTheSchema) {
   RunConfig c;
   const std::string help = fieldHelp([&](FieldVisitor& v) { describe(v, c); }, "windows.seconds");
-  EXPECT_EQ(help, "window length (0 = windows by events) [s] (YAML windows.seconds, default 0.0)");
+  EXPECT_EQ(help, "window length (policy seconds; 0 otherwise) [s] (YAML windows.seconds, default 0.0)");
 }
 
 TEST(ConfigSchema, BatchFile) {
@@ -268,6 +268,7 @@ TEST(ConfigSchema, BatchFile) {
   auto base = [&](const std::string& p) {
     seen_base = p;
     RunConfig c;
+    c.window_policy = WindowPolicy::Events;
     c.windows.events_per_window = 1234;
     return c;
   };
@@ -284,8 +285,9 @@ TEST(ConfigSchema, BatchFile) {
   EXPECT_EQ(spec.entries[1].config.windows.events_per_window, 50u);
   write("sequences:\n  - {path: a}\n  - {path: b, config: {windows: {evnts: 5}}}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
-            ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: events, seconds, overlap, "
-            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second)");
+            ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: policy, events, seconds, overlap, "
+            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second, parallax_px, "
+            "min_seconds, max_seconds, step_seconds, probe_events)");
   write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: key 'sequences[1].label': duplicate label 'x'");

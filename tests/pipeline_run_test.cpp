@@ -41,7 +41,7 @@ TEST(RunConfig, ShippedFileEqualsDefaults) {
 
 TEST(RunConfig, EffectiveConfigRoundTripsAndErrorsNameTheKey) {
   RunConfig c;
-  applyRunConfig("windows: {events: 1234}\ncluster: {smoothness_deg: 12}\nmethods: [celc]\n", "a.yaml", c);
+  applyRunConfig("windows: {policy: events, events: 1234}\ncluster: {smoothness_deg: 12}\nmethods: [celc]\n", "a.yaml", c);
   EXPECT_EQ(c.windows.events_per_window, 1234u);
   EXPECT_EQ(c.cluster.smoothness_deg, 12.0);
   RunConfig back;

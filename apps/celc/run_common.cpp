@@ -20,9 +20,9 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
   RunConfig defaults;
   const Describe schema = [&](FieldVisitor& v) { describe(v, defaults); };
   cmd->add_option("--window-events", o.window_events,
-                  "windows by event count: " + fieldHelp(schema, "windows.events"));
+                  "windows of a fixed event count (windows.policy events): " + fieldHelp(schema, "windows.events"));
   cmd->add_option("--window-seconds", o.window_seconds,
-                  "windows by duration: " + fieldHelp(schema, "windows.seconds"));
+                  "windows of a fixed duration (windows.policy seconds): " + fieldHelp(schema, "windows.seconds"));
   cmd->add_option("--methods", o.methods,
                   "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "methods"));
   cmd->add_option("--omega", o.omega,
@@ -97,6 +97,7 @@ RunConfig buildRunConfig(const RunOverrides& o) {
     throw std::runtime_error("--window-events, --window-seconds: give one of them, not both");
   RunConfig c = o.config.empty() ? RunConfig{} : loadRunConfig(o.config);
   if (!o.window_events.empty()) {
+    c.window_policy = WindowPolicy::Events;
     c.windows.events_per_window = parseWindowEvents(o.window_events);
     c.windows.seconds_per_window = 0.0;
   }
@@ -107,6 +108,7 @@ RunConfig buildRunConfig(const RunOverrides& o) {
       throw std::runtime_error(fmt::format(
           "--window-seconds {}: {:.3g} windows per second of data, more than windows.max_windows_per_second = {:g}",
           o.window_seconds, per_second, c.windows.max_windows_per_second));
+    c.window_policy = WindowPolicy::Seconds;
     c.windows.seconds_per_window = s;
     c.windows.events_per_window = 0;
   }

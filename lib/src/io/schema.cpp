@@ -32,8 +32,8 @@ void describe(FieldVisitor& v, ReaderOptions& o) {
 }
 
 void describe(FieldVisitor& v, WindowOptions& o) {
-  v.field({"events", "events", "events per window (0 = windows by seconds)"}, o.events_per_window);
-  v.field({"seconds", "s", "window length (0 = windows by events)"}, o.seconds_per_window);
+  v.field({"events", "events", "events per window (policy events; 0 otherwise)"}, o.events_per_window);
+  v.field({"seconds", "s", "window length (policy seconds; 0 otherwise)"}, o.seconds_per_window);
   v.field({"overlap", "-", "share of a window overlapping the next, in [0, 1)"}, o.overlap);
   v.field({"t_start", "s", "first time used"}, o.t_start);
   v.field({"t_end", "s", "end of the time used (exclusive)"}, o.t_end);

@@ -1,6 +1,7 @@
 #include "celc/pipeline/run_config.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "celc/core/yaml.hpp"
 
@@ -23,8 +24,32 @@ std::string inSection(const std::string& section, const std::string& problems) {
 }
 }  // namespace
 
+std::string RunConfig::windowsValidate() const {
+  if (window_policy == WindowPolicy::Events && windows.events_per_window == 0)
+    return "events: windows.policy events needs events > 0; ";
+  if (window_policy == WindowPolicy::Seconds && !(windows.seconds_per_window > 0.0))
+    return "seconds: windows.policy seconds needs seconds > 0; ";
+  if (window_policy != WindowPolicy::Parallax) {
+    if (window_policy == WindowPolicy::Events && windows.seconds_per_window != 0.0)
+      return "seconds: set with windows.policy events (use one of them); ";
+    if (window_policy == WindowPolicy::Seconds && windows.events_per_window != 0)
+      return "events: set with windows.policy seconds (use one of them); ";
+    return windows.validate();
+  }
+  // Parallax: events and seconds belong to the other policies and must not
+  // be set by mistake; the window's own checks run on a window of max_seconds.
+  if (!std::isfinite(windows.seconds_per_window) || windows.seconds_per_window < 0.0) return windows.validate();
+  if (windows.events_per_window != 0 || windows.seconds_per_window != 0.0)
+    return "policy: events / seconds are set but the policy is parallax (set windows.policy: events or seconds); ";
+  WindowOptions w = windows;
+  w.seconds_per_window = parallax.max_seconds > 0.0 && std::isfinite(parallax.max_seconds) ? parallax.max_seconds : 1.0;
+  std::string e = w.validate();
+  if (e.empty() && windows.overlap != 0.0) e += "overlap: the parallax policy's windows do not overlap (set 0); ";
+  return e + parallax.validate();
+}
+
 std::string RunConfig::validate() const {
-  std::string e = reader.validate() + inSection("windows", windows.validate()) + gyro.validate() +
+  std::string e = reader.validate() + inSection("windows", windowsValidate()) + gyro.validate() +
                   cluster.validate() + observations.validate() + solver.validate() + groundtruth.validate();
   if (methods.empty()) e += "methods: at least one; ";
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
@@ -43,8 +68,13 @@ void describeClustering(FieldVisitor& v, ClusterOptions& cluster, LineFitOptions
 
 void describe(FieldVisitor& v, RunConfig& c) {
   v.section({"input", "", "reading the recording"}, [&](FieldVisitor& s) { describe(s, c.reader); });
-  v.section({"windows", "", "cutting the stream into windows (events or seconds, not both)"},
-            [&](FieldVisitor& s) { describe(s, c.windows); });
+  v.section({"windows", "", "cutting the stream into windows (pipeline/window_policy.hpp)"}, [&](FieldVisitor& s) {
+    s.enumeration({"policy", "",
+                   "parallax: grow each window until its lines show parallax_px; events / seconds: fixed windows"},
+                  c.window_policy, {WindowPolicy::Parallax, WindowPolicy::Events, WindowPolicy::Seconds});
+    describe(s, c.windows);
+    describe(s, c.parallax);
+  });
   v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) {
     s.enumeration({"model", "", "constant_twist (paper) or gyro_integrated"}, c.motion,
                   {MotionModelKind::ConstantTwist, MotionModelKind::GyroIntegrated});

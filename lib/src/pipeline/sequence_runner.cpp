@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -34,6 +36,54 @@ struct SequenceRunner::Impl {
   GyroTrack gyro;
   std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
+
+  /// Unit-plane bearing (x, y, 1) of a pixel: the undistortion table at whole
+  /// pixels, the camera model elsewhere.
+  Vec3 bearing(const Vec2& p) const {
+    Vec3 b;
+    const double rx = std::round(p.x()), ry = std::round(p.y());
+    if (rx == p.x() && ry == p.y() && lut->bearing(static_cast<int>(rx), static_cast<int>(ry), b)) return b;
+    return calib.camera.bearing(p);  // sub-pixel or outside the table
+  }
+  /// The window's motion model, or false with the reason (no_gyro, a gyro window status).
+  bool motionFor(double t0, double t1, MotionModel& motion, Vec3& omega, std::string& status) const {
+    motion = MotionModel::constantTwist(config.fixed_omega, t0);
+    omega = config.fixed_omega;
+    if (config.omega_source != OmegaSource::Gyro) return true;
+    if (gyro.empty()) {
+      status = "no_gyro";
+      return false;
+    }
+    const GyroWindow gw = gyro.window(t0, t1);
+    if (!gw.ok()) {
+      status = toString(gw.status);
+      return false;
+    }
+    motion = config.motion == MotionModelKind::GyroIntegrated ? gw.motionModel(t0)
+                                                              : MotionModel::constantTwist(gw.mean_omega, t0);
+    omega = gw.mean_omega;
+    return true;
+  }
+  /// D of a growing parallax window (window_policy.hpp) [px], measured on at
+  /// most parallax.probe_events of its events (every k-th); NaN when it cannot
+  /// be measured (no motion model, clustering failed, too few lines).
+  double probeTranslation(double t0, double t1, const std::vector<Event>& events) const {
+    MotionModel motion = MotionModel::constantTwist(Vec3::Zero(), t0);
+    Vec3 omega;
+    std::string status;
+    if (!motionFor(t0, t1, motion, omega, status)) return NAN;
+    const std::size_t keep_every = std::max<std::size_t>(
+        1, (events.size() + config.parallax.probe_events - 1) / config.parallax.probe_events);
+    std::vector<Event> probe;
+    probe.reserve(events.size() / keep_every + 1);
+    for (std::size_t i = 0; i < events.size(); i += keep_every) probe.push_back(events[i]);
+    const ClusterResult clusters = clusterEvents(probe, config.cluster);
+    if (clusters.status != ClusterStatus::Ok) return NAN;
+    const WindowObservations obs = toObservations(
+        probe, clusters, [&](const Vec2& p) { return bearing(p); }, calib.camera.focal(), config.observations,
+        &motion, nullptr);
+    return lineTranslationPx(obs, motion, t0, t1);
+  }
 };
 
 SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
@@ -119,7 +169,7 @@ std::vector<std::string> SequenceRunner::describe() const {
 }
 
 WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, double t1,
-                                           const std::vector<Event>& events) const {
+                                           const std::vector<Event>& events, double translation_px) const {
   const Impl& m = *impl_;
   const RunConfig& cfg = m.config;
   WindowRecord rec;
@@ -148,22 +198,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // The angular velocity for the window.
   MotionModel motion = MotionModel::constantTwist(cfg.fixed_omega, t0);
-  if (cfg.omega_source == OmegaSource::Gyro) {
-    if (m.gyro.empty()) {
-      rec.window_status = "no_gyro";
-      return rec;
-    }
-    const GyroWindow gw = m.gyro.window(t0, t1);
-    if (!gw.ok()) {
-      rec.window_status = toString(gw.status);
-      return rec;
-    }
-    motion = cfg.motion == MotionModelKind::GyroIntegrated ? gw.motionModel(t0)
-                                                           : MotionModel::constantTwist(gw.mean_omega, t0);
-    rec.omega = gw.mean_omega;
-  } else {
-    rec.omega = cfg.fixed_omega;
-  }
+  if (!m.motionFor(t0, t1, motion, rec.omega, rec.window_status)) return rec;
   rec.has_omega = true;
 
   // Clustering in pixel space-time.
@@ -177,14 +212,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // Undistorted bearings and boundary lines per cluster.
   start = Clock::now();
-  const UndistortLut& lut = *m.lut;
   const CameraModel& cam = m.calib.camera;
-  auto bearing = [&](const Vec2& p) {
-    Vec3 b;
-    const double rx = std::round(p.x()), ry = std::round(p.y());
-    if (rx == p.x() && ry == p.y() && lut.bearing(static_cast<int>(rx), static_cast<int>(ry), b)) return b;
-    return cam.bearing(p);  // sub-pixel or outside the table
-  };
+  auto bearing = [&](const Vec2& p) { return m.bearing(p); };
   ObservationReport report;
   const WindowObservations obs =
       toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
@@ -199,6 +228,18 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   }
   rec.times.lines = secondsSince(start);
 
+  // The parallax policy grew the window to windows.max_seconds and its lines
+  // still show too little translation: no method is asked for a direction.
+  if (std::isfinite(translation_px) && translation_px < cfg.parallax.target_px) {
+    for (MethodRow& row : rec.rows) {
+      row.result.status = SolveStatus::Degenerate;
+      row.result.degeneracy = Degeneracy::NoParallax;
+      row.result.message = fmt::format("the lines moved {:.1f} px in {:.3f} s, less than windows.parallax_px = {:g}",
+                                       translation_px, t1 - t0, cfg.parallax.target_px);
+    }
+    spdlog::debug("window {}: {}", index, rec.rows.front().result.message);
+    return rec;
+  }
   start = Clock::now();
   const SampleSeeds seeds{cfg.seed + index, cfg.seed + index};  // windows draw different subsets
   const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds);
@@ -225,9 +266,25 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
     std::uint64_t index = 0;
     double t0 = 0.0, t1 = 0.0;
     std::vector<Event> events;
+    double translation_px = NAN;  ///< the parallax policy's D (NaN: other policies)
   };
-  WindowSource source(*m.reader, m.config.windows);
+  const RunConfig& cfg = m.config;
+  const bool parallax = cfg.window_policy == WindowPolicy::Parallax;
+  // The parallax policy reads steps of step_seconds and joins them into windows.
+  WindowOptions source_options = cfg.windows;
+  if (parallax) {
+    source_options.events_per_window = 0;
+    source_options.seconds_per_window = cfg.parallax.step_seconds;
+    source_options.overlap = 0.0;
+    source_options.keep_partial = true;  // the last step, whatever it holds; judged below
+  }
+  WindowSource source(*m.reader, source_options);
   EventWindow window;
+  ParallaxWindowJoiner joiner(source, cfg.parallax, cfg.windows.partial_min_share,
+                              [&](double t0, double t1, const std::vector<Event>& events) {
+                                return m.probeTranslation(t0, t1, events);
+                              });
+  auto nextWindow = [&](EventWindow& w) { return parallax ? joiner.next(w) : source.next(w); };
   // By count the number of windows per second of data depends on the event
   // rate: checked as windows arrive (by duration WindowOptions::validate did).
   double first_t0 = 0.0;
@@ -258,7 +315,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
       [&](Job& job) {  // the next wanted window, read on this thread
         for (;;) {
           const auto t_read = Clock::now();
-          const bool more = source.next(window);
+          const bool more = nextWindow(window);
           stats.seconds_reading += secondsSince(t_read);
           if (!more) return false;
           stats.windows_read++;
@@ -272,11 +329,12 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
           job.t0 = window.t0;
           job.t1 = window.t1;
           job.events = std::move(window.events);
+          job.translation_px = parallax ? joiner.translationPx() : NAN;
           window.events = {};
           return true;
         }
       },
-      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events); },
+      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events, job.translation_px); },
       [&](WindowRecord& rec) {  // in window order, on this thread
         stats.windows_processed++;
         stats.events_processed += rec.n_events;
@@ -289,7 +347,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         if (progress) progress(stats.windows_processed, stats.events_processed);
       });
   stats.reader_warnings = m.reader->warnings().total();
-  stats.tail = source.tail();
+  stats.tail = parallax ? joiner.tail() : source.tail();
   stats.seconds_total = secondsSince(start);
   return stats;
 }

@@ -13,6 +13,7 @@
 #include "celc/io/event_reader.hpp"
 #include "celc/io/imu_window.hpp"
 #include "celc/io/window_source.hpp"
+#include "celc/pipeline/window_policy.hpp"
 #include "celc/solver/solver.hpp"
 
 namespace celc {
@@ -26,15 +27,18 @@ std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
 struct RunConfig {
   ReaderOptions reader;
-  /// 30,000 events per window (the paper's choice); the last, partial window
-  /// is processed when it holds at least half a window (else the summary says
-  /// how many events it held).
+  /// How windows are cut (pipeline/window_policy.hpp): by default each grows
+  /// until its lines show parallax_px of translation (parallax). The events
+  /// and seconds policies use `windows` (events_per_window or
+  /// seconds_per_window; the paper's choice is 30,000 events); with them the
+  /// last, partial window is processed when it holds at least half a window.
+  WindowPolicy window_policy = WindowPolicy::Parallax;
   WindowOptions windows = [] {
     WindowOptions w;
-    w.events_per_window = 30000;
     w.partial_min_share = 0.5;
     return w;
   }();
+  ParallaxWindowOptions parallax;
   MotionModelKind motion = MotionModelKind::ConstantTwist;
   OmegaSource omega_source = OmegaSource::Gyro;
   Vec3 fixed_omega = Vec3::Zero();  ///< [rad/s], camera frame, with OmegaSource::Fixed
@@ -60,6 +64,8 @@ struct RunConfig {
   GtVelocityOptions groundtruth;
   std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)
   std::string validate() const;
+  /// The `windows:` section's problems ("key: what; "), by policy.
+  std::string windowsValidate() const;
 };
 
 /// The schema of `celc run` / `celc batch` configurations (core/fields.hpp):

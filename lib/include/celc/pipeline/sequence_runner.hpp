@@ -5,6 +5,7 @@
 /// then the ground-truth velocity and the metrics where poses exist.
 /// Windows are read in order by the calling thread, processed by a pool of
 /// workers, and handed to the sink in window order.
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -100,8 +101,10 @@ class SequenceRunner {
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
   /// Processes one window's events (the per-window pipeline; thread-safe).
-  WindowRecord processWindow(std::uint64_t index, double t0, double t1,
-                             const std::vector<Event>& events) const;
+  /// translation_px: the parallax policy's D of the window (window_policy.hpp);
+  /// below windows.parallax_px every method is degenerate (no_parallax).
+  WindowRecord processWindow(std::uint64_t index, double t0, double t1, const std::vector<Event>& events,
+                             double translation_px = NAN) const;
 
  private:
   struct Impl;

@@ -1,0 +1,95 @@
+#pragma once
+/// \file window_policy.hpp
+/// How `celc run` chooses the length of its windows (`windows.policy`):
+///  - events: a fixed count of events (the paper's 30,000);
+///  - seconds: a fixed duration;
+///  - parallax (the default): each window grows in time until its boundary
+///    lines show enough translation, or a maximum duration is reached.
+/// The translation a window shows is measured on its clusters' lines: with
+/// the rotation removed (the motion model's R(t), from the gyroscope), l1 and
+/// l3 of a cluster differ only by what translation moved; the angle between
+/// their reference-frame normals m1 = R(t1) l1, m3 = R(t3) l3, times the focal
+/// length, is that motion in pixels, scaled here to the whole window:
+///   D = median over clusters with lines of f acos|m1 . m3| (t_end - t_start) / (t3 - t1)   [px].
+/// The accuracy of the line methods follows D (docs/results.md): a window is
+/// grown until D >= parallax_px.
+#include <cmath>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "celc/core/fields.hpp"
+#include "celc/core/observations.hpp"
+#include "celc/geometry/motion_model.hpp"
+#include "celc/io/window_source.hpp"
+
+namespace celc {
+
+enum class WindowPolicy { Parallax, Events, Seconds };
+std::string toString(WindowPolicy policy);  ///< "parallax" | "events" | "seconds"
+
+/// The parallax policy's options (keys of the `windows:` section).
+struct ParallaxWindowOptions {
+  double target_px = 25.0;     ///< grow until the lines' translation D reaches this [px]
+  double min_seconds = 0.05;   ///< first (shortest) window tried [s]
+  double max_seconds = 0.3;    ///< longest window [s]; a window that stops here may be degenerate (no_parallax)
+  /// Growth is in steps of this duration [s]: windows are whole numbers of steps.
+  double step_seconds = 0.025;
+  /// The measurement of D while a window grows clusters at most this many
+  /// events (every k-th event of the window); the window itself keeps all.
+  std::size_t probe_events = 30000;
+  std::string validate() const;  ///< "key: what; " per problem ("" = valid)
+};
+/// The parallax keys of the `windows:` section (core/fields.hpp).
+void describe(FieldVisitor& v, ParallaxWindowOptions& options);
+
+/// D of the window [t0, t1] (see the file comment) [px]; NaN when fewer than
+/// `min_clusters` clusters have lines.
+double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
+                         int min_clusters = 3);
+
+/// The next length to try [steps] after a window of `steps` steps showed D px:
+/// at least 1.5x and at most 3x longer, aiming at target_px with D linear in
+/// the length; `max_steps` caps it.
+int nextWindowSteps(int steps, double d_px, double target_px, int max_steps);
+
+/// The parallax policy's windows, joined from consecutive steps of a
+/// WindowSource cut by duration (step_seconds each, no overlap). A window
+/// starts as min_seconds; while the probe measures D < target_px it grows by
+/// nextWindowSteps, up to max_seconds (where D is measured once more). A gap the source skipped ends a window.
+/// The last window, cut by the end of the data, is emitted when its events
+/// span at least partial_min_share of min_seconds (else tail() reports it).
+/// Memory: at most max_seconds of events.
+class ParallaxWindowJoiner {
+ public:
+  /// D [px] of the window [t0, t1) holding `events` (NaN: not measurable).
+  using Probe = std::function<double(double t0, double t1, const std::vector<Event>& events)>;
+  ParallaxWindowJoiner(WindowSource& steps, const ParallaxWindowOptions& options, double partial_min_share,
+                       Probe probe);
+  /// The next window (indices 0, 1, ...); false when none remains.
+  bool next(EventWindow& window);
+  /// After next() returned false: the last, partial window, emitted or not.
+  const WindowTail& tail() const { return tail_; }
+  /// D [px] measured on the window next() returned last: >= target_px, or
+  /// less when it stopped at max_seconds; NaN when not measured (cut short by
+  /// the data or a gap) or not measurable.
+  double translationPx() const { return translation_px_; }
+
+ private:
+  /// Pulls steps until `wanted` contiguous ones are pending; returns how many are.
+  int contiguousSteps(int wanted);
+  void join(int steps, EventWindow& window) const;
+  WindowSource& source_;
+  ParallaxWindowOptions o_;
+  double partial_min_share_;
+  Probe probe_;
+  std::deque<EventWindow> pending_;
+  bool source_done_ = false;
+  std::uint64_t index_ = 0;
+  WindowTail tail_;
+  double translation_px_ = NAN;
+};
+
+}  // namespace celc

@@ -1,0 +1,143 @@
+#include "celc/pipeline/window_policy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+namespace celc {
+
+std::string toString(WindowPolicy policy) {
+  switch (policy) {
+    case WindowPolicy::Parallax: return "parallax";
+    case WindowPolicy::Events: return "events";
+    case WindowPolicy::Seconds: return "seconds";
+  }
+  return "?";
+}
+
+std::string ParallaxWindowOptions::validate() const {
+  std::ostringstream e;
+  e.precision(6);
+  if (!(target_px > 0.0) || !std::isfinite(target_px)) e << "parallax_px: must be finite and > 0; ";
+  if (!(step_seconds > 0.0) || !std::isfinite(step_seconds)) e << "step_seconds: must be finite and > 0; ";
+  if (!(min_seconds > 0.0) || !std::isfinite(min_seconds)) e << "min_seconds: must be finite and > 0; ";
+  if (!(max_seconds >= min_seconds) || !std::isfinite(max_seconds))
+    e << "max_seconds: must be finite and >= min_seconds (" << min_seconds << "); ";
+  else if (step_seconds > 0.0 && max_seconds / step_seconds > 10000.0)
+    e << "max_seconds: more than 10000 steps of step_seconds; ";
+  if (probe_events < 1000) e << "probe_events: must be >= 1000; ";
+  return e.str();
+}
+
+void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
+  v.field({"parallax_px", "px", "parallax policy: grow a window until its lines' translation reaches this"},
+          o.target_px);
+  v.field({"min_seconds", "s", "parallax policy: shortest window"}, o.min_seconds);
+  v.field({"max_seconds", "s", "parallax policy: longest window (reached without parallax: degenerate)"},
+          o.max_seconds);
+  v.field({"step_seconds", "s", "parallax policy: windows grow by whole steps of this"}, o.step_seconds);
+  v.field({"probe_events", "events", "parallax policy: events clustered to measure a growing window"},
+          o.probe_events);
+}
+
+double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
+                         int min_clusters) {
+  std::vector<double> d;
+  for (const ClusterObservation& c : obs.clusters) {
+    if (!c.has_lines || !(c.l3.t > c.l1.t)) continue;
+    const Vec3 m1 = (motion.rotation(c.l1.t) * c.l1.normal).normalized();
+    const Vec3 m3 = (motion.rotation(c.l3.t) * c.l3.normal).normalized();
+    const double angle = std::acos(std::min(1.0, std::abs(m1.dot(m3))));
+    const double px = obs.focal_px * angle * (t1 - t0) / (c.l3.t - c.l1.t);
+    if (std::isfinite(px)) d.push_back(px);
+  }
+  if (static_cast<int>(d.size()) < std::max(1, min_clusters)) return NAN;
+  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid;
+}
+
+int nextWindowSteps(int steps, double d_px, double target_px, int max_steps) {
+  double factor = 3.0;
+  if (std::isfinite(d_px) && d_px > 0.0) factor = std::clamp(target_px / d_px, 1.5, 3.0);
+  const int next = static_cast<int>(std::ceil(steps * factor - 1e-9));
+  return std::min(max_steps, std::max(steps + 1, next));
+}
+
+ParallaxWindowJoiner::ParallaxWindowJoiner(WindowSource& steps, const ParallaxWindowOptions& options,
+                                           double partial_min_share, Probe probe)
+    : source_(steps), o_(options), partial_min_share_(partial_min_share), probe_(std::move(probe)) {}
+
+int ParallaxWindowJoiner::contiguousSteps(int wanted) {
+  const double tolerance = 1e-6 * o_.step_seconds;
+  auto contiguous = [&] {
+    int n = pending_.empty() ? 0 : 1;
+    while (n < static_cast<int>(pending_.size()) &&
+           std::abs(pending_[static_cast<std::size_t>(n)].t0 - pending_[static_cast<std::size_t>(n - 1)].t1) <=
+               tolerance)
+      ++n;
+    return n;
+  };
+  int n = contiguous();
+  while (n < wanted && n == static_cast<int>(pending_.size()) && !source_done_) {
+    EventWindow step;
+    if (!source_.next(step)) {
+      source_done_ = true;
+      break;
+    }
+    pending_.push_back(std::move(step));
+    n = contiguous();
+  }
+  return n;
+}
+
+void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
+  window.events.clear();
+  std::size_t n = 0;
+  for (int i = 0; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
+  window.events.reserve(n);
+  for (int i = 0; i < steps; ++i) {
+    const auto& e = pending_[static_cast<std::size_t>(i)].events;
+    window.events.insert(window.events.end(), e.begin(), e.end());
+  }
+  window.t0 = pending_.front().t0;
+  window.t1 = pending_[static_cast<std::size_t>(steps - 1)].t1;
+}
+
+bool ParallaxWindowJoiner::next(EventWindow& window) {
+  const int min_steps = std::max(1, static_cast<int>(std::ceil(o_.min_seconds / o_.step_seconds - 1e-9)));
+  const int max_steps = std::max(min_steps, static_cast<int>(std::floor(o_.max_seconds / o_.step_seconds + 1e-9)));
+  int steps = min_steps;
+  translation_px_ = NAN;
+  for (;;) {
+    const int have = contiguousSteps(steps);
+    if (have == 0) return false;
+    if (have < steps) {  // the data or a gap ends the window: not measured
+      steps = have;
+      translation_px_ = NAN;
+      break;
+    }
+    join(steps, window);
+    translation_px_ = probe_(window.t0, window.t1, window.events);
+    if (translation_px_ >= o_.target_px || steps >= max_steps) break;
+    steps = nextWindowSteps(steps, translation_px_, o_.target_px, max_steps);
+  }
+  join(steps, window);
+  const bool at_end = source_done_ && static_cast<int>(pending_.size()) == steps;
+  if (at_end && steps < min_steps) {  // the end of the data cut the window short
+    std::size_t events = window.events.size();
+    const double span = events == 0 ? 0.0 : window.events.back().t - window.t0;
+    tail_ = {events, std::min(1.0, span / o_.min_seconds), false};
+    if (events == 0 || tail_.share < partial_min_share_) {
+      pending_.clear();
+      return false;
+    }
+    tail_.emitted = true;
+  }
+  pending_.erase(pending_.begin(), pending_.begin() + steps);
+  window.index = index_++;
+  return true;
+}
+
+}  // namespace celc

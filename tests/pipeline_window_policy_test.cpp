@@ -1,0 +1,159 @@
+// The parallax window policy: the lines' translation D, the growth rule, and
+// the joiner that grows windows from steps of a duration source.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "celc/geometry/so3.hpp"
+#include "celc/io/writers.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/pipeline/window_policy.hpp"
+#include "io_test_util.hpp"
+
+using namespace celc;
+using celc::test::TempDir;
+
+namespace {
+// A cluster whose reference-frame normals m1 (at t1) and m3 (at t3) are
+// `angle` apart, seen through `motion` (the camera-frame lines rotate).
+ClusterObservation clusterWithAngle(const MotionModel& motion, double t1, double t3, double angle, std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  const Vec3 m1 = Vec3(g(rng), g(rng), g(rng)).normalized();
+  const Vec3 axis = m1.cross(Vec3(g(rng), g(rng), g(rng))).normalized();
+  const Vec3 m3 = so3::exp(axis * angle) * m1;
+  ClusterObservation c;
+  c.l1.t = t1;
+  c.l3.t = t3;
+  c.l1.normal = motion.rotation(t1).transpose() * m1;
+  c.l3.normal = motion.rotation(t3).transpose() * -m3;  // the sign of a normal is free
+  return c;
+}
+}  // namespace
+
+// D = median over clusters of f * angle(m1, m3) * window / (t3 - t1), with the
+// rotation removed: a camera turning at 2 rad/s moves the camera-frame lines
+// by ~0.2 rad, which must not count.
+TEST(WindowPolicy, LineTranslationIsTheMedianRotationFreeMotionOverTheWindow) {
+  std::mt19937 rng(3);
+  const MotionModel motion = MotionModel::constantTwist(Vec3(0.5, -1.8, 0.6), 0.0);
+  WindowObservations obs;
+  obs.focal_px = 320.0;
+  // Angles 0.01 .. 0.05 rad over [0.02, 0.08] s of a 0.1 s window: D_k = 320 * a_k * 0.1 / 0.06.
+  for (double a : {0.05, 0.01, 0.03, 0.02, 0.04}) obs.clusters.push_back(clusterWithAngle(motion, 0.02, 0.08, a, rng));
+  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1), 320.0 * 0.03 * 0.1 / 0.06, 1e-9);
+  // Clusters without lines do not count; fewer than 3 with lines: NaN.
+  obs.clusters[0].has_lines = obs.clusters[1].has_lines = obs.clusters[2].has_lines = false;
+  EXPECT_TRUE(std::isnan(lineTranslationPx(obs, motion, 0.0, 0.1)));
+  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1, 2), 320.0 * 0.04 * 0.1 / 0.06, 1e-9);  // median of 2: upper
+}
+
+TEST(WindowPolicy, GrowthAimsAtTheTargetWithinOneAndAHalfToThreeTimes) {
+  EXPECT_EQ(nextWindowSteps(2, 10.0, 25.0, 12), 5);   // 2.5x
+  EXPECT_EQ(nextWindowSteps(2, 24.0, 25.0, 12), 3);   // at least 1.5x
+  EXPECT_EQ(nextWindowSteps(2, 1.0, 25.0, 12), 6);    // at most 3x
+  EXPECT_EQ(nextWindowSteps(2, NAN, 25.0, 12), 6);    // not measurable: 3x
+  EXPECT_EQ(nextWindowSteps(8, 5.0, 25.0, 12), 12);   // capped
+  EXPECT_EQ(nextWindowSteps(1, 24.9, 25.0, 12), 2);   // always grows
+}
+
+namespace {
+struct JoinedWindow {
+  double t0, t1;
+  std::size_t events;
+};
+// Windows of the joiner over a text file of events with a probe D = rate * duration.
+std::vector<JoinedWindow> joinAll(const std::string& file, const ParallaxWindowOptions& o, double rate_px_s,
+                                  std::vector<double>* probed = nullptr, WindowTail* tail = nullptr) {
+  auto reader = openEventSource(file);
+  WindowOptions steps;
+  steps.seconds_per_window = o.step_seconds;
+  steps.keep_partial = true;
+  steps.read_batch = 500;
+  WindowSource source(*reader, steps);
+  ParallaxWindowJoiner joiner(source, o, 0.5, [&](double t0, double t1, const std::vector<Event>& ev) {
+    if (probed) probed->push_back(t1 - t0);
+    EXPECT_FALSE(ev.empty());
+    return rate_px_s * (t1 - t0);
+  });
+  std::vector<JoinedWindow> out;
+  EventWindow w;
+  while (joiner.next(w)) {
+    EXPECT_EQ(w.index, out.size());
+    out.push_back({w.t0, w.t1, w.events.size()});
+  }
+  if (tail) *tail = joiner.tail();
+  return out;
+}
+}  // namespace
+
+TEST(WindowPolicy, JoinerGrowsEachWindowUntilTheTargetOrTheMaximum) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(60000, 240, 180, 5, 1.0);  // ~0.6 s at 10 us per event
+  writeEventsText(d.file("e.txt"), ev);
+  ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s, steps of 0.025 s
+  // 200 px/s: 0.05 s shows 10 px -> 0.125 s shows 25 px: windows of 5 steps after one probe.
+  std::vector<double> probed;
+  const auto w = joinAll(d.file("e.txt"), o, 200.0, &probed);
+  ASSERT_GE(w.size(), 3u);
+  EXPECT_NEAR(w[0].t1 - w[0].t0, 0.125, 1e-9);
+  EXPECT_NEAR(probed[0], 0.05, 1e-9);
+  EXPECT_NEAR(probed[1], 0.125, 1e-9);
+  // Contiguous, in order, every event in exactly one window but the dropped tail.
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < w.size(); ++k) {
+    if (k > 0) {
+      EXPECT_NEAR(w[k].t0, w[k - 1].t1, 1e-9);
+    }
+    total += w[k].events;
+  }
+  EXPECT_LE(total, ev.size());
+  EXPECT_GE(total, ev.size() - 2600);  // at most a quarter of min_seconds (0.5 share) dropped
+  // No parallax at all: every window is max_seconds long (the last cut by the data).
+  const auto flat = joinAll(d.file("e.txt"), o, 0.0);
+  EXPECT_NEAR(flat[0].t1 - flat[0].t0, 0.3, 1e-9);
+  // Much parallax: every window is min_seconds.
+  const auto fast = joinAll(d.file("e.txt"), o, 1e4);
+  EXPECT_NEAR(fast[0].t1 - fast[0].t0, 0.05, 1e-9);
+  EXPECT_NEAR(fast[3].t0, fast[0].t0 + 0.15, 1e-9);
+}
+
+TEST(WindowPolicy, JoinerReportsTheShortLastWindow) {
+  TempDir d;
+  auto ev = celc::test::randomEvents(10000, 240, 180, 9, 1.0);  // ~0.1 s
+  writeEventsText(d.file("e.txt"), ev);
+  ParallaxWindowOptions o;
+  o.min_seconds = o.max_seconds = 0.075;  // three steps: 0.075 s, then ~0.025 s left
+  WindowTail tail;
+  const auto w = joinAll(d.file("e.txt"), o, 0.0, nullptr, &tail);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_FALSE(tail.emitted);
+  EXPECT_GT(tail.events, 0u);
+  EXPECT_EQ(w[0].events + tail.events, ev.size());
+  EXPECT_LT(tail.share, 0.5);
+}
+
+// Options: the policy decides which keys apply; a key of another policy is an
+// error naming it, not silently ignored.
+TEST(WindowPolicy, PolicyKeysAreCheckedAgainstThePolicy) {
+  auto error = [](const std::string& yaml) {
+    RunConfig c;
+    try {
+      applyRunConfig(yaml, "test.yaml", c);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(RunConfig{}.window_policy, WindowPolicy::Parallax);
+  EXPECT_EQ(RunConfig{}.validate(), "");
+  EXPECT_EQ(error("windows: {policy: seconds, seconds: 0.1}"), "");
+  EXPECT_EQ(error("windows: {policy: events, events: 30000}"), "");
+  EXPECT_NE(error("windows: {policy: events}").find("windows.events"), std::string::npos);
+  EXPECT_NE(error("windows: {seconds: 0.1}").find("windows.policy"), std::string::npos);
+  EXPECT_NE(error("windows: {policy: seconds, seconds: 0.1, events: 5}").find("windows.events"), std::string::npos);
+  EXPECT_NE(error("windows: {policy: widest}").find("policy"), std::string::npos);
+  EXPECT_NE(error("windows: {min_seconds: 0.2, max_seconds: 0.1}").find("windows.max_seconds"), std::string::npos);
+  EXPECT_NE(error("windows: {overlap: 0.5}").find("windows.overlap"), std::string::npos);
+  EXPECT_NE(error("windows: {parallax_px: .nan}").find("windows.parallax_px"), std::string::npos);
+}
