@@ -8,6 +8,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <algorithm>
+#include <iterator>
+#include <sstream>
 #include <stdexcept>
 
 #include "celc/core/yaml.hpp"
@@ -158,16 +161,60 @@ std::vector<std::string> assignments(const pyb::handle& options) {
   return out;
 }
 
-void applyDict(const pyb::handle& options, const std::string& origin, const Describe& describe) {
-  for (const std::string& a : assignments(options)) {
-    try {
-      applyAssignment(a, describe);
-    } catch (const ConfigError& e) {
-      // "--set key=value: what" -> "ORIGIN: key=value: what".
-      std::string what = e.what();
-      if (what.rfind("--set ", 0) == 0) what = origin + ": " + what.substr(6);
-      throw ConfigError(what);
+namespace {
+
+// A YAML map built from dotted keys: one document for readYaml.
+struct YamlNode {
+  std::string value;  // a leaf's YAML flow value
+  std::vector<std::pair<std::string, YamlNode>> children;
+  void write(std::string& out, const std::string& indent) const {
+    for (const auto& [key, node] : children) {
+      if (node.children.empty()) out += indent + key + ": " + node.value + "\n";
+      else {
+        out += indent + key + ":\n";
+        node.write(out, indent + "  ");
+      }
     }
+  }
+};
+
+}  // namespace
+
+void applyDict(const pyb::handle& options, const std::string& origin, const Describe& describe) {
+  const std::vector<std::string> items = assignments(options);
+  if (items.empty()) return;
+  // One document for all of them (one parse: a dict of options costs
+  // microseconds, not one YAML read per key).
+  YamlNode root;
+  for (const std::string& a : items) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0) throw ConfigError(origin + ": '" + a + "': expected key.path=value");
+    YamlNode* node = &root;
+    std::stringstream path(a.substr(0, eq));
+    for (std::string part; std::getline(path, part, '.');) {
+      if (part.empty() || part.find_first_of(" :#[]{}'\"") != std::string::npos)
+        throw ConfigError(origin + ": '" + a.substr(0, eq) + "': expected names between the dots");
+      auto it = std::find_if(node->children.begin(), node->children.end(),
+                             [&](const auto& c) { return c.first == part; });
+      if (it == node->children.end()) {
+        node->children.emplace_back(part, YamlNode{});
+        it = std::prev(node->children.end());
+      }
+      node = &it->second;
+    }
+    if (!node->children.empty() || !node->value.empty())
+      throw ConfigError(origin + ": key '" + a.substr(0, eq) + "' given twice");
+    node->value = a.substr(eq + 1);
+  }
+  std::string yaml;
+  root.write(yaml, "");
+  try {
+    readYaml(yaml, origin, describe);
+  } catch (const ConfigError& e) {
+    // Lines of the generated document mean nothing to the caller.
+    const std::string what = e.what();
+    const std::string prefix = origin + ":" + std::to_string(e.line) + ": ";
+    throw ConfigError(what.rfind(prefix, 0) == 0 ? origin + ": " + what.substr(prefix.size()) : what);
   }
 }
 

@@ -2,7 +2,12 @@
 // library's readers and writers (io/event_reader.hpp, io/writers.hpp).
 #include <pybind11/stl.h>
 
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <cstddef>
 #include <cstring>
+#include <new>
 #include <limits>
 #include <optional>
 
@@ -20,58 +25,108 @@ ReaderOptions readerOptions(const pyb::handle& options, const std::string& origi
   return o;
 }
 
-// Every event with t0 <= t < t1 (file order), at most max_events of them.
-// Batches are kept as read and joined once into a vector of exactly the
-// right size, whose buffer numpy then takes over.
-std::vector<Event> readRange(const std::string& path, const ReaderOptions& options, double t0, double t1,
-                             std::size_t max_events) {
+// A growable array of events in its own anonymous mapping, handed to numpy
+// as it is. Growth is mremap (pages move, nothing is copied) and the mapping
+// asks for transparent huge pages: first-touch page faults, not copying,
+// dominate the cost of a large buffer on a virtual machine (2 ms per MB of
+// 4 KB pages measured here), and huge pages cut them 512-fold.
+class EventBuffer {
+ public:
+  EventBuffer() = default;
+  EventBuffer(const EventBuffer&) = delete;
+  EventBuffer& operator=(const EventBuffer&) = delete;
+  ~EventBuffer() { unmap(data_, bytes_); }
+
+  std::size_t size() const { return size_; }
+  void append(const Event* events, std::size_t n) {
+    if (n == 0) return;
+    if ((size_ + n) * sizeof(Event) > bytes_) grow((size_ + n) * sizeof(Event));
+    std::memcpy(static_cast<char*>(data_) + size_ * sizeof(Event), events, n * sizeof(Event));
+    size_ += n;
+  }
+  void push(const Event& e) { append(&e, 1); }
+
+  /// The events as a numpy array of EVENT_DTYPE owning the mapping.
+  pyb::array release() {
+    if (size_ == 0) return pyb::array(eventDtype(), {pyb::ssize_t(0)}, {static_cast<pyb::ssize_t>(sizeof(Event))});
+    // Shrink the mapping to the pages in use (the tail was never touched).
+    const std::size_t used = roundUp(size_ * sizeof(Event), kPage);
+    if (used < bytes_) {
+      ::munmap(static_cast<char*>(data_) + used, bytes_ - used);
+      bytes_ = used;
+    }
+    auto* owned = new Mapping{data_, bytes_};
+    data_ = nullptr;
+    bytes_ = 0;
+    const auto n = static_cast<pyb::ssize_t>(size_);
+    size_ = 0;
+    pyb::capsule owner(owned, [](void* p) {
+      auto* m = static_cast<Mapping*>(p);
+      unmap(m->data, m->bytes);
+      delete m;
+    });
+    return pyb::array(eventDtype(), {n}, {static_cast<pyb::ssize_t>(sizeof(Event))}, owned->data, owner);
+  }
+
+ private:
+  struct Mapping {
+    void* data;
+    std::size_t bytes;
+  };
+  static constexpr std::size_t kPage = 4096, kHuge = std::size_t(2) << 20;
+  static std::size_t roundUp(std::size_t x, std::size_t to) { return (x + to - 1) / to * to; }
+  static void unmap(void* p, std::size_t bytes) {
+    if (p) ::munmap(p, bytes);
+  }
+  void grow(std::size_t need) {
+    const std::size_t bytes = roundUp(std::max(need, std::max(2 * bytes_, kHuge)), kHuge);
+    void* p = data_ ? ::mremap(data_, bytes_, bytes, MREMAP_MAYMOVE)
+                    : ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    ::madvise(p, bytes, MADV_HUGEPAGE);  // advice only: without huge pages it still works
+    data_ = p;
+    bytes_ = bytes;
+  }
+  void* data_ = nullptr;
+  std::size_t bytes_ = 0;
+  std::size_t size_ = 0;
+};
+
+// Every event with t0 <= t < t1 (file order), at most max_events of them,
+// from a reused batch (cache-sized) into the buffer.
+void readRange(const std::string& path, const ReaderOptions& options, double t0, double t1,
+               std::size_t max_events, EventBuffer& out) {
   auto reader = openEventSource(path, options);
-  const bool from_start = t0 == -std::numeric_limits<double>::infinity();
-  if (!from_start) reader->seekTime(t0);
+  const bool everything = t0 == -std::numeric_limits<double>::infinity() &&
+                          t1 == std::numeric_limits<double>::infinity();
+  if (t0 != -std::numeric_limits<double>::infinity()) reader->seekTime(t0);
   // Events may come back in time by up to backwards_tolerance: read that far past t1.
   const double stop = t1 + options.backwards_tolerance;
-  std::vector<std::vector<Event>> batches;
-  std::size_t total = 0;
   std::vector<Event> batch;
-  bool done = false;
-  while (!done && total < max_events && reader->next(batch, std::size_t(1) << 20)) {
-    std::vector<Event> kept;
-    if (from_start && t1 == std::numeric_limits<double>::infinity() && batch.size() <= max_events - total) {
-      kept.swap(batch);
-    } else {
-      for (const Event& e : batch) {
-        if (e.t >= stop) {
-          done = true;
-          break;
-        }
-        if (e.t >= t0 && e.t < t1 && total + kept.size() < max_events) kept.push_back(e);
-      }
+  while (out.size() < max_events && reader->next(batch, std::size_t(1) << 16)) {
+    if (everything) {
+      out.append(batch.data(), std::min(batch.size(), max_events - out.size()));
+      continue;
     }
-    total += kept.size();
-    if (!kept.empty()) batches.push_back(std::move(kept));
+    for (const Event& e : batch) {
+      if (e.t >= stop || out.size() >= max_events) return;
+      if (e.t >= t0 && e.t < t1) out.push(e);
+    }
   }
-  if (batches.size() == 1) return std::move(batches.front());
-  std::vector<Event> all(total);
-  std::size_t at = 0;
-  for (const auto& b : batches) {
-    std::memcpy(all.data() + at, b.data(), b.size() * sizeof(Event));
-    at += b.size();
-  }
-  return all;
 }
 
 pyb::array readEvents(const pyb::object& path, std::optional<double> t0, std::optional<double> t1,
                       std::optional<std::size_t> max_events, const pyb::object& options) {
   const ReaderOptions o = readerOptions(options, "read_events(options)");
   const std::string p = existingPath(path);
-  std::vector<Event> events;
+  EventBuffer events;
   {
     pyb::gil_scoped_release nogil;
-    events = readRange(p, o, t0.value_or(-std::numeric_limits<double>::infinity()),
-                       t1.value_or(std::numeric_limits<double>::infinity()),
-                       max_events.value_or(std::numeric_limits<std::size_t>::max()));
+    readRange(p, o, t0.value_or(-std::numeric_limits<double>::infinity()),
+              t1.value_or(std::numeric_limits<double>::infinity()),
+              max_events.value_or(std::numeric_limits<std::size_t>::max()), events);
   }
-  return adoptVector(std::move(events), eventDtype());
+  return events.release();
 }
 
 pyb::array readImu(const pyb::object& path, const pyb::object& options) {

@@ -21,8 +21,17 @@ CameraModel cameraFrom(const pyb::handle& calib, bool normalized, double focal) 
     if (!normalized) throw pyb::value_error("solve: pixel events need calib= (a file or a dict), or normalized=True");
     cam.fx = cam.fy = focal;
   } else if (pyb::isinstance<pyb::dict>(calib)) {
+    // The last camera dict is remembered (calls under the GIL): a loop over
+    // windows with one camera parses it once.
+    static std::string last_key;
+    static CameraModel last_camera;
+    std::string key;
+    for (const std::string& a : assignments(calib)) key += a + "\n";
+    if (key == last_key && !key.empty()) return last_camera;
     applyDict(calib, "solve(calib)", [&](FieldVisitor& v) { describe(v, cam); });
     if (const std::string err = cam.validate(); !err.empty()) throw ConfigError("solve(calib): " + err);
+    last_key = key;
+    last_camera = cam;
   } else {
     cam = loadCalibration(existingPath(calib)).camera;
   }
@@ -86,21 +95,26 @@ pyb::dict solveImpl(const pyb::object& events, const pyb::object& labels, const 
     w = Vec3(o.data()[0], o.data()[1], o.data()[2]);
   }
   const GyroTrack track = gyro.is_none() ? GyroTrack{} : gyroTrack(gyro);
+  const bool has_gyro = !gyro.is_none();
   std::vector<SolverResult> results;
   {
-    const auto start = Clock::now();
     pyb::gil_scoped_release nogil;
-    const ClusterResult clusters = clustersFromLabels(ev, lb);
-    // Reference time: the first labelled event (as `celc solve`).
-    double t_ref = clusters.clusters.empty() ? 0.0 : clusters.clusters.front().t_begin;
-    for (const ClusterStats& c : clusters.clusters) t_ref = std::min(t_ref, c.t_begin);
-    const MotionModel motion = gyro.is_none() ? MotionModel::constantTwist(w, t_ref)
-                                              : MotionModel::gyroIntegrated(track.times, track.rates, t_ref);
-    const BearingFunction bearing = [&](const Vec2& p) {
-      return normalized ? Vec3(p.x(), p.y(), 1.0) : cam.bearing(p);
-    };
-    const WindowObservations obs = toObservations(ev, clusters, bearing, cam.focal(), cfg.observations, &motion);
-    results = solveMethods(obs, motion, cfg.methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
+    // What a C++ caller runs (timed, temporaries' destruction included).
+    const auto start = Clock::now();
+    {
+      const ClusterResult clusters = clustersFromLabels(ev, lb);
+      // Reference time: the first labelled event (as `celc solve`).
+      double t_ref = clusters.clusters.empty() ? 0.0 : clusters.clusters.front().t_begin;
+      for (const ClusterStats& c : clusters.clusters) t_ref = std::min(t_ref, c.t_begin);
+      const MotionModel motion = has_gyro ? MotionModel::gyroIntegrated(track.times, track.rates, t_ref)
+                                          : MotionModel::constantTwist(w, t_ref);
+      const BearingFunction bearing = [&](const Vec2& p) {
+        return normalized ? Vec3(p.x(), p.y(), 1.0) : cam.bearing(p);
+      };
+      const WindowObservations obs =
+          toObservations(ev, clusters, bearing, cam.focal(), cfg.observations, &motion);
+      results = solveMethods(obs, motion, cfg.methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
+    }
     if (cpp_seconds) *cpp_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   }
   pyb::dict out;

@@ -114,3 +114,18 @@ def test_errors(tmp_path):
     missing = tmp_path / "missing_calib.yaml"
     with pytest.raises(FileNotFoundError, match="missing_calib.yaml"):
         celc.solve(ev, lab, calib=missing)
+
+
+def test_camera_dict_is_read_each_time_it_changes():
+    """solve() remembers the last camera dict (parsed once for a loop over
+    windows); another dict must be read anew."""
+    w = celc.simulate_window(seed=2, event_noise_px=1.0)
+    args = (w["events"], w["labels"])
+    a = celc.solve(*args, omega=w["omega"], calib=w["camera"], methods="celc")["celc"]["v"]
+    other = dict(w["camera"], fx=200.0, fy=200.0)
+    b = celc.solve(*args, omega=w["omega"], calib=other, methods="celc")["celc"]["v"]
+    c = celc.solve(*args, omega=w["omega"], calib=w["camera"], methods="celc")["celc"]["v"]
+    assert phi(a, b) > 1e-3  # another focal length: other bearings, another direction
+    np.testing.assert_array_equal(a, c)
+    with pytest.raises(ValueError, match="focal"):
+        celc.solve(*args, calib=dict(w["camera"], fx=-1.0))
