@@ -3,12 +3,11 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <algorithm>
 #include <iterator>
 #include <sstream>
 #include <stdexcept>

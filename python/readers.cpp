@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstring>
-#include <new>
 #include <limits>
+#include <new>
 #include <optional>
 
 #include "celc/io/event_reader.hpp"
@@ -28,8 +28,8 @@ ReaderOptions readerOptions(const pyb::handle& options, const std::string& origi
 // A growable array of events in its own anonymous mapping, handed to numpy
 // as it is. Growth is mremap (pages move, nothing is copied) and the mapping
 // asks for transparent huge pages: first-touch page faults, not copying,
-// dominate the cost of a large buffer on a virtual machine (2 ms per MB of
-// 4 KB pages measured here), and huge pages cut them 512-fold.
+// dominate the cost of a large buffer on a virtual machine, and huge pages
+// cut their number 512-fold (docs/python.md, "Memory").
 class EventBuffer {
  public:
   EventBuffer() = default;
