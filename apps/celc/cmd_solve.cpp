@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <sstream>
 
 #include "celc/cluster/to_observations.hpp"
@@ -84,29 +83,19 @@ void runSolve(const SolveArgs& a) {
   if (!a.calib.empty()) cam = loadCalibration(a.calib).camera;
   else cam.fx = cam.fy = a.focal;
 
-  // The labels as a clustering result (cluster ids in order of first
-  // appearance), so that the pipeline's toObservations builds the input.
+  // The labels as a clustering result, so that the pipeline's toObservations
+  // builds the input; the motion's reference time is the first labelled event.
   std::vector<Event> events;
-  ClusterResult clusters;
-  clusters.status = ClusterStatus::Ok;
-  std::map<int, int> index_of;
-  double t_min = 1e300;
+  std::vector<int> labels;
+  events.reserve(labelled.size());
+  labels.reserve(labelled.size());
   for (const auto& e : labelled) {
     events.push_back(Event{e.t, static_cast<float>(e.x), static_cast<float>(e.y), true});
-    int label = -1;
-    if (e.cluster >= 0) {
-      auto [it, added] = index_of.emplace(e.cluster, static_cast<int>(clusters.clusters.size()));
-      if (added) {
-        ClusterStats stats;
-        stats.id = e.cluster;
-        clusters.clusters.push_back(stats);
-      }
-      label = it->second;
-      t_min = std::min(t_min, e.t);
-    }
-    clusters.labels.push_back(label);
+    labels.push_back(e.cluster < 0 ? -1 : e.cluster);
   }
-  if (clusters.clusters.empty()) t_min = 0.0;
+  const ClusterResult clusters = clustersFromLabels(events, labels);
+  double t_min = clusters.clusters.empty() ? 0.0 : clusters.clusters.front().t_begin;
+  for (const ClusterStats& c : clusters.clusters) t_min = std::min(t_min, c.t_begin);
   const MotionModel motion = a.gyro.empty()
                                  ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_min)
                                  : loadGyro(a.gyro, t_min);

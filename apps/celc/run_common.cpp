@@ -142,13 +142,6 @@ OutputMode outputMode(const RunOverrides& o) {
   return o.resume ? OutputMode::Resume : (o.force ? OutputMode::Force : OutputMode::Create);
 }
 
-void defaultContainerInputs(RunInputs& inputs, const ReaderOptions& reader) {
-  if (!isContainerFile(inputs.events)) return;
-  if (inputs.calib.empty() && detectFormat(inputs.events) == Format::RosBag) inputs.calib = inputs.events;
-  if (inputs.groundtruth.empty() && !openEventSource(inputs.events, reader)->readPoses().empty())
-    inputs.groundtruth = inputs.events;
-}
-
 void printSummary(const std::string& title, const SequenceOutcome& out) {
   auto f = [](double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : std::string("-"); };
   std::cout << "\n" << title << "\n\n"

@@ -38,10 +38,6 @@ OutputMode outputMode(const RunOverrides& o);
 constexpr int kMaxThreads = 1024;
 /// --threads outside [0, kMaxThreads] is an error naming the option.
 void checkThreads(int threads);
-/// A ROS bag or HDF5 file as the events input: the calibration (a bag's
-/// sensor_msgs/CameraInfo) and the ground truth (its poses) come from the file
-/// when `inputs` does not name them.
-void defaultContainerInputs(RunInputs& inputs, const ReaderOptions& reader);
 /// Prints the per-method summary table to stdout.
 void printSummary(const std::string& title, const SequenceOutcome& outcome);
 

@@ -168,13 +168,25 @@ void describe(FieldVisitor& v, SynthConfig& c) {
   v.section({"groundtruth", "", "the pose file"}, [&](FieldVisitor& s) { describeGroundTruth(s, c.groundtruth); });
 }
 
-SynthConfig loadSynthConfig(const std::string& path) {
+namespace {
+// The defaults (the davis346 camera), then the document `read` applies, validated.
+template <class Read>
+SynthConfig synthConfig(const std::string& origin, Read&& read) {
   SynthConfig c;
-  c.source = path;
+  c.source = origin;
   c.camera = cameraPreset(c.camera_preset);
-  readYamlFile(path, [&](FieldVisitor& v) { describe(v, c); });
-  if (const std::string err = c.validate(); !err.empty()) throw ConfigError(path + ": " + err);
+  read([&](FieldVisitor& v) { describe(v, c); });
+  if (const std::string err = c.validate(); !err.empty()) throw ConfigError(origin + ": " + err);
   return c;
+}
+}  // namespace
+
+SynthConfig loadSynthConfig(const std::string& path) {
+  return synthConfig(path, [&](const Describe& d) { readYamlFile(path, d); });
+}
+
+SynthConfig parseSynthConfig(const std::string& yaml, const std::string& origin) {
+  return synthConfig(origin, [&](const Describe& d) { readYaml(yaml, origin, d); });
 }
 
 }  // namespace celc

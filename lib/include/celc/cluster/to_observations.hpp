@@ -41,6 +41,14 @@ struct ObservationReport {
   std::vector<ClusterLines> failed_lines;   ///< their fits (statuses say why)
 };
 
+/// Events already labelled by cluster (`celc solve`, the Python module) as a
+/// clustering result: clusters numbered in order of first appearance, each
+/// ClusterStats::id the given label, size / t_begin / t_end [s] / on (the
+/// polarity of its first event) filled in; a negative label = unassigned (-1).
+/// Status Ok, NoClusters when no event is labelled. Throws
+/// std::invalid_argument when the sizes differ.
+ClusterResult clustersFromLabels(const std::vector<Event>& events, const std::vector<int>& labels);
+
 /// Builds the solver input of a window. Clusters keep their ClusterResult id in
 /// ClusterObservation::id; a cluster whose lines could not be fitted is kept
 /// with has_lines = false. Events whose bearing is not finite are left out.

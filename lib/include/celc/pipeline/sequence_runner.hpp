@@ -26,6 +26,12 @@ struct RunInputs {
   std::string imu;          ///< IMU text file (optional; aedat files carry their own)
 };
 
+/// A ROS bag or HDF5 file as the events input: the calibration (a bag's
+/// sensor_msgs/CameraInfo) and the ground truth (its poses) come from the file
+/// when `inputs` does not name them (`celc run`, `celc batch`, the Python
+/// module). Other inputs are left as they are. Throws IoError naming the file.
+void defaultContainerInputs(RunInputs& inputs, const ReaderOptions& reader);
+
 /// One method's outcome in one window.
 struct MethodRow {
   Method method = Method::Celc;

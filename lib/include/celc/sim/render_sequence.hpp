@@ -103,5 +103,7 @@ void describe(FieldVisitor& v, SynthConfig& config);
 /// Reads SCENE.yaml. Unknown keys, keys that do not apply and wrong types
 /// throw ConfigError with "FILE:LINE: key 'a.b': ..." messages.
 SynthConfig loadSynthConfig(const std::string& path);
+/// The same from YAML text; `origin` names it in errors.
+SynthConfig parseSynthConfig(const std::string& yaml, const std::string& origin);
 
 }  // namespace celc

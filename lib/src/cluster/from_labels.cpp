@@ -1,0 +1,47 @@
+// Labelled events as a clustering result (to_observations.hpp).
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "celc/cluster/to_observations.hpp"
+
+namespace celc {
+
+ClusterResult clustersFromLabels(const std::vector<Event>& events, const std::vector<int>& labels) {
+  if (labels.size() != events.size())
+    throw std::invalid_argument("clustersFromLabels: " + std::to_string(labels.size()) + " labels for " +
+                                std::to_string(events.size()) + " events");
+  ClusterResult out;
+  out.n_events = static_cast<int>(events.size());
+  out.labels.reserve(events.size());
+  std::map<int, int> index_of;  // label -> index into out.clusters
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const Event& e = events[i];
+    if (labels[i] < 0) {
+      out.labels.push_back(-1);
+      continue;
+    }
+    auto [it, added] = index_of.emplace(labels[i], static_cast<int>(out.clusters.size()));
+    if (added) {
+      ClusterStats stats;
+      stats.id = labels[i];
+      stats.on = e.on;
+      stats.t_begin = stats.t_end = e.t;
+      out.clusters.push_back(stats);
+    }
+    ClusterStats& c = out.clusters[static_cast<std::size_t>(it->second)];
+    ++c.size;
+    c.t_begin = std::min(c.t_begin, e.t);
+    c.t_end = std::max(c.t_end, e.t);
+    out.labels.push_back(it->second);
+    ++out.n_clustered;
+  }
+  out.status = out.clusters.empty() ? ClusterStatus::NoClusters : ClusterStatus::Ok;
+  if (!events.empty()) out.t0 = std::min_element(events.begin(), events.end(), [](const Event& a, const Event& b) {
+                                  return a.t < b.t;
+                                })->t;
+  return out;
+}
+
+}  // namespace celc
