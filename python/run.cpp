@@ -80,11 +80,13 @@ pyb::dict run(const pyb::object& path, const pyb::object& config, const pyb::obj
     throw pyb::value_error("run: threads=" + std::to_string(threads) + ": expected 0 (all cores) to " +
                            std::to_string(kMaxThreads));
   if (window_events && window_seconds) throw pyb::value_error("run: give window_events or window_seconds, not both");
-  if (window_events) {
+  if (window_events) {  // as --window-events: the events policy
+    c.window_policy = WindowPolicy::Events;
     c.windows.events_per_window = *window_events;
     c.windows.seconds_per_window = 0.0;
   }
-  if (window_seconds) {
+  if (window_seconds) {  // as --window-seconds: the seconds policy
+    c.window_policy = WindowPolicy::Seconds;
     c.windows.seconds_per_window = *window_seconds;
     c.windows.events_per_window = 0;
   }

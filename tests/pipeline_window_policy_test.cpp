@@ -156,4 +156,13 @@ TEST(WindowPolicy, PolicyKeysAreCheckedAgainstThePolicy) {
   EXPECT_NE(error("windows: {min_seconds: 0.2, max_seconds: 0.1}").find("windows.max_seconds"), std::string::npos);
   EXPECT_NE(error("windows: {overlap: 0.5}").find("windows.overlap"), std::string::npos);
   EXPECT_NE(error("windows: {parallax_px: .nan}").find("windows.parallax_px"), std::string::npos);
+  // --set: keys that belong together are validated together, in any order.
+  RunConfig c;
+  applyRunSettings({"windows.seconds=0.1", "windows.policy=seconds"}, c);
+  EXPECT_EQ(c.window_policy, WindowPolicy::Seconds);
+  EXPECT_EQ(c.windows.seconds_per_window, 0.1);
+  RunConfig d;
+  EXPECT_THROW(applyRunSettings({"windows.seconds=0.1"}, d), std::exception);
+  EXPECT_EQ(d.window_policy, WindowPolicy::Parallax);  // unchanged after an error
+  EXPECT_EQ(d.windows.seconds_per_window, 0.0);
 }

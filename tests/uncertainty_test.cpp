@@ -106,6 +106,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   rec.n_clusters = 4;
   rec.has_omega = true;
   rec.omega = Vec3(0.1, -0.2, 0.3);
+  rec.translation_px = 12.5;
   MethodRow ok;
   ok.method = Method::Celc;
   ok.result.status = SolveStatus::Ok;
@@ -135,6 +136,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   EXPECT_EQ(rows[0].n_lines, 4);
   EXPECT_TRUE(rows[0].has_omega);
   EXPECT_NEAR(rows[0].omega.y(), -0.2, 1e-9);
+  EXPECT_DOUBLE_EQ(rows[0].translation_px, 12.5);
   EXPECT_EQ(rows[1].status, "degenerate");
   EXPECT_EQ(rows[1].reason, "no_parallax");
   EXPECT_TRUE(std::isnan(rows[1].sigma_deg));
@@ -148,7 +150,18 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(old_rows.size(), 1u);
   EXPECT_TRUE(std::isnan(old_rows[0].sigma_deg));
   EXPECT_EQ(old_rows[0].n_lines, -1);
-  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,");
+  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,,");
+  // The second format (23 columns, before translation_px): read, padded by one.
+  const std::string v2 = old + ",,2.5,3.25,4,0.1,-0.2,0.3";
+  {
+    std::ofstream f(path);
+    f << windowsCsvHeaderV2() << "\n" << v2 << "\n";
+  }
+  const auto v2_rows = readWindowsCsv(path, false);
+  ASSERT_EQ(v2_rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(v2_rows[0].sigma_deg, 2.5);
+  EXPECT_TRUE(std::isnan(v2_rows[0].translation_px));
+  EXPECT_EQ(padWindowsCsvLine(v2), v2 + ",");
   // Summaries: NaN sigma is never kept.
   const auto s = summarize(old_rows, 5.0);
   EXPECT_EQ(s[0].ok, 1);

@@ -50,7 +50,7 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
 }
 
 void applySets(const std::vector<std::string>& sets, RunConfig& c) {
-  for (const std::string& s : sets) applyRunSetting(s, c);
+  applyRunSettings(sets, c);
 }
 
 namespace {

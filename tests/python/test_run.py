@@ -49,8 +49,8 @@ def test_run_matches_cli(synth_seq, tmp_path):
 
 
 def test_run_config_dict_and_set(synth_seq):
-    a = celc.run(synth_seq, config={"windows": {"seconds": 0.1, "events": 0}}, methods="celc", threads=1)
-    b = celc.run(synth_seq, set={"windows.seconds": 0.1, "windows.events": 0, "methods": ["celc"]})
+    a = celc.run(synth_seq, config={"windows": {"policy": "seconds", "seconds": 0.1}}, methods="celc", threads=1)
+    b = celc.run(synth_seq, set={"windows.seconds": 0.1, "windows.policy": "seconds", "methods": ["celc"]})
     np.testing.assert_array_equal(a["vx"], b["vx"])
     np.testing.assert_array_equal(a["status"], b["status"])
 

@@ -18,13 +18,15 @@ std::string windowsCsvHeaderV1() {
   return "window,t_start,t_end,n_events,n_clusters,method,status,vx,vy,vz,gt_vx,gt_vy,gt_vz,eps,phi,runtime_ms";
 }
 
-std::string windowsCsvHeader() { return windowsCsvHeaderV1() + ",reason,sigma_deg,parallax,n_lines,wx,wy,wz"; }
+std::string windowsCsvHeaderV2() { return windowsCsvHeaderV1() + ",reason,sigma_deg,parallax,n_lines,wx,wy,wz"; }
+std::string windowsCsvHeader() { return windowsCsvHeaderV2() + ",translation_px"; }
 
 std::string padWindowsCsvLine(const std::string& line) {
   std::string l = line;
   if (!l.empty() && l.back() == '\r') l.pop_back();
-  if (l.empty() || std::count(l.begin(), l.end(), ',') != 15) return line;
-  return l + ",,,,,,,";
+  const auto commas = std::count(l.begin(), l.end(), ',');
+  if (l.empty() || (commas != 15 && commas != 22)) return line;
+  return l + (commas == 15 ? ",,,,,,,," : ",");
 }
 
 namespace {
@@ -67,7 +69,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     if (!l.empty() && l.back() == '\r') l.pop_back();
     const std::string where = path + ":" + std::to_string(no);
     if (no == 1) {
-      if (l != windowsCsvHeader() && l != windowsCsvHeaderV1())
+      if (l != windowsCsvHeader() && l != windowsCsvHeaderV2() && l != windowsCsvHeaderV1())
         throw std::runtime_error(where + ": not a celc windows.csv header");
       continue;
     }
@@ -75,8 +77,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     const bool last = i + 1 == lines.size();
     const auto f = splitList(l, ',');
     try {
-      if (f.size() != 16 && f.size() != 23)
-        throw std::runtime_error(where + ": expected 16 or 23 columns, got " + std::to_string(f.size()));
+      if (f.size() != 16 && f.size() != 23 && f.size() != 24)
+        throw std::runtime_error(where + ": expected 16, 23 or 24 columns, got " + std::to_string(f.size()));
       WindowsCsvRow r;
       r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
       r.t_start = toDouble(f[1], where, "t_start");
@@ -97,7 +99,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         r.phi = toDouble(f[14], where, "phi");
       }
       if (!f[15].empty()) r.runtime_ms = toDouble(f[15], where, "runtime_ms");
-      if (f.size() == 23) {
+      if (f.size() >= 23) {
         r.reason = f[16];
         if (!f[17].empty()) r.sigma_deg = toDouble(f[17], where, "sigma_deg");
         if (!f[18].empty()) r.parallax = toDouble(f[18], where, "parallax");
@@ -106,6 +108,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         if (r.has_omega)
           r.omega = Vec3(toDouble(f[20], where, "wx"), toDouble(f[21], where, "wy"), toDouble(f[22], where, "wz"));
       }
+      if (f.size() == 24 && !f[23].empty()) r.translation_px = toDouble(f[23], where, "translation_px");
       rows.push_back(r);
     } catch (const std::runtime_error&) {
       if (last && !complete_last && tolerate_truncated_tail) break;  // interrupted write

@@ -115,6 +115,18 @@ RunConfig loadRunConfig(const std::string& path) {
   return c;
 }
 
+void applyRunSettings(const std::vector<std::string>& assignments, RunConfig& c) {
+  if (assignments.empty()) return;
+  RunConfig next = c;
+  std::string origin;
+  for (const std::string& a : assignments) {
+    applyAssignment(a, [&](FieldVisitor& v) { describe(v, next); });
+    origin += (origin.empty() ? "--set " : " --set ") + a;
+  }
+  validated(next, origin);
+  c = next;
+}
+
 void applyRunSetting(const std::string& assignment, RunConfig& c) {
   RunConfig next = c;
   applyAssignment(assignment, [&](FieldVisitor& v) { describe(v, next); });

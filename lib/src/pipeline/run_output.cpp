@@ -42,7 +42,7 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     if (row.has_metrics) o << row.eps << "," << row.phi;
     else o << ",";
     o << "," << std::setprecision(3) << row.result.time_us * 1e-3;
-    // Quality columns: reason,sigma_deg,parallax,n_lines,wx,wy,wz.
+    // Quality columns: reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px.
     const SolverResult& r = row.result;
     std::string reason;
     if (!rec.window_status.empty()) reason = rec.window_status;
@@ -59,6 +59,8 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     o << std::setprecision(6) << std::fixed;
     if (rec.has_omega) o << "," << rec.omega.x() << "," << rec.omega.y() << "," << rec.omega.z();
     else o << ",,,";
+    o << ",";
+    if (std::isfinite(rec.translation_px)) o << std::setprecision(2) << rec.translation_px;
     lines.push_back(o.str());
   }
   return lines;

@@ -227,6 +227,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                   l.l1.length_px, toString(l.l3.status), l.l3.n_events, l.l3.rms_px, l.l3.length_px);
   }
   rec.times.lines = secondsSince(start);
+  rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
 
   // The parallax policy grew the window to windows.max_seconds and its lines
   // still show too little translation: no method is asked for a direction.

@@ -14,12 +14,15 @@
 namespace celc {
 
 /// The header of windows.csv: the 16 columns of the first format, then the
-/// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz (README, docs/runs.md).
+/// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px
+/// (README, docs/runs.md).
 std::string windowsCsvHeader();
+/// The header of files written before translation_px (still read).
+std::string windowsCsvHeaderV2();
 /// The header of files written before the quality columns (still read).
 std::string windowsCsvHeaderV1();
-/// A row of the first format (16 columns) padded with empty quality columns;
-/// other lines are returned as they are.
+/// A row of an earlier format (16 or 23 columns) padded with empty quality
+/// columns; other lines are returned as they are.
 std::string padWindowsCsvLine(const std::string& line);
 
 struct WindowsCsvRow {
@@ -38,6 +41,8 @@ struct WindowsCsvRow {
   int n_lines = -1;             ///< usable clusters; -1: none
   bool has_omega = false;
   Vec3 omega = Vec3::Zero();    ///< angular velocity used [rad/s], camera frame
+  /// The lines' translation D over the window [px] (pipeline/window_policy.hpp); NaN: none.
+  double translation_px = NAN;
 };
 
 /// Reads a windows.csv; throws std::runtime_error("FILE:LINE: ...") on a wrong

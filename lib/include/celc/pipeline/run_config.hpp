@@ -83,6 +83,9 @@ void applyRunConfig(const std::string& yaml, const std::string& origin, RunConfi
 RunConfig loadRunConfig(const std::string& path);
 /// Applies `key.path=value` (a YAML value) onto `config`, then validates.
 void applyRunSetting(const std::string& assignment, RunConfig& config);
+/// Applies every assignment, then validates once (keys that only make sense
+/// together, e.g. windows.policy and windows.seconds, may come in any order).
+void applyRunSettings(const std::vector<std::string>& assignments, RunConfig& config);
 /// The effective configuration as YAML (every key, with its unit and doc).
 std::string toYaml(const RunConfig& config);
 

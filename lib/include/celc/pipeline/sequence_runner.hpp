@@ -51,6 +51,8 @@ struct WindowRecord {
   std::size_t n_events = 0;
   int n_clusters = 0;          ///< clusters handed to the solvers with lines
   int n_line_fit_failed = 0;   ///< clusters whose l1 / l3 could not be fitted (npt still uses them)
+  /// The lines' translation D over the window [px] (pipeline/window_policy.hpp); NaN: not measured.
+  double translation_px = NAN;
   /// Empty when the window reached the solvers; else why no method ran
   /// (`no_gyro`, `not_covered`, `gyro_gap`, `too_few_clusters`, `no_clusters`, ...).
   std::string window_status;
