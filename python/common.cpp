@@ -207,14 +207,7 @@ void applyDict(const pyb::handle& options, const std::string& origin, const Desc
   }
   std::string yaml;
   root.write(yaml, "");
-  try {
-    readYaml(yaml, origin, describe);
-  } catch (const ConfigError& e) {
-    // Lines of the generated document mean nothing to the caller.
-    const std::string what = e.what();
-    const std::string prefix = origin + ":" + std::to_string(e.line) + ": ";
-    throw ConfigError(what.rfind(prefix, 0) == 0 ? origin + ": " + what.substr(prefix.size()) : what);
-  }
+  readGeneratedYaml(yaml, origin, describe);
 }
 
 std::string pathString(const pyb::handle& path) {

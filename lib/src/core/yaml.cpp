@@ -511,8 +511,12 @@ void applyAssignment(const std::string& assignment, const Describe& describe) {
     yaml += indent + parts[i] + ":" + (i + 1 == parts.size() ? " " + assignment.substr(eq + 1) + "\n" : "\n");
     indent += "  ";
   }
+  readGeneratedYaml(yaml, origin, describe);
+}
+
+void readGeneratedYaml(const std::string& text, const std::string& origin, const Describe& describe) {
   try {
-    readYaml(yaml, origin, describe);
+    readYaml(text, origin, describe);
   } catch (const ConfigError& e) {
     // Lines of the generated document mean nothing to the user.
     const std::string what = e.what();

@@ -16,6 +16,9 @@ namespace celc {
 /// twice in one map, values of the wrong type or out of the type's range,
 /// NaN, lists of the wrong length, names outside a choice.
 void readYaml(const std::string& text, const std::string& origin, const Describe& describe);
+/// readYaml of a document the program generated (from `--set` assignments, a
+/// Python dict): errors name the origin and the key, not the generated lines.
+void readGeneratedYaml(const std::string& text, const std::string& origin, const Describe& describe);
 /// The same from a file (ConfigError when it cannot be opened).
 void readYamlFile(const std::string& path, const Describe& describe);
 
