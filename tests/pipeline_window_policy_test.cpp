@@ -15,37 +15,51 @@ using namespace celc;
 using celc::test::TempDir;
 
 namespace {
-// A cluster whose reference-frame normals m1 (at t1) and m3 (at t3) are
-// `angle` apart, seen through `motion` (the camera-frame lines rotate).
-ClusterObservation clusterWithAngle(const MotionModel& motion, double t1, double t3, double angle, std::mt19937& rng) {
-  std::normal_distribution<double> g;
-  const Vec3 m1 = Vec3(g(rng), g(rng), g(rng)).normalized();
-  const Vec3 axis = m1.cross(Vec3(g(rng), g(rng), g(rng))).normalized();
-  const Vec3 m3 = so3::exp(axis * angle) * m1;
-  ClusterObservation c;
-  c.l1.t = t1;
-  c.l3.t = t3;
-  c.l1.normal = motion.rotation(t1).transpose() * m1;
-  c.l3.normal = motion.rotation(t3).transpose() * -m3;  // the sign of a normal is free
-  return c;
+// A cluster whose reference-frame lines m1 (at t1) and m3 (at t3) are `moved`
+// apart (normalised units) at its centroid c, seen through `motion`: the
+// camera-frame lines and events turn with the camera.
+ClusterObservation clusterMoved(const MotionModel& motion, double t1, double t3, double moved, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.3, 0.3), angle(0.0, 3.14);
+  const double a = angle(rng);
+  const Eigen::Vector2d c(u(rng), u(rng)), n(std::cos(a), std::sin(a));
+  const double rho1 = n.dot(c), rho3 = rho1 + moved;
+  ClusterObservation cl;
+  cl.l1.t = t1;
+  cl.l3.t = t3;
+  cl.l1.normal = (motion.rotation(t1).transpose() * Vec3(n.x(), n.y(), -rho1)).normalized();
+  cl.l3.normal = -(motion.rotation(t3).transpose() * Vec3(n.x(), n.y(), -rho3)).normalized();  // sign is free
+  // Events symmetric about c along the line: their centroid is c.
+  for (int k = -20; k <= 20; ++k) {
+    const double t = t1 + (t3 - t1) * (k + 20) / 40.0;
+    const Vec3 p(c.x() - n.y() * 0.01 * k, c.y() + n.x() * 0.01 * k, 1.0);
+    cl.times.push_back(t);
+    cl.bearings.push_back(motion.rotation(t).transpose() * p);
+  }
+  return cl;
 }
 }  // namespace
 
-// D = median over clusters of f * angle(m1, m3) * window / (t3 - t1), with the
-// rotation removed: a camera turning at 2 rad/s moves the camera-frame lines
-// by ~0.2 rad, which must not count.
+// D = median over clusters of f * (offset change at the centroid) * window /
+// (t3 - t1), with the rotation removed: a camera turning at 2 rad/s moves the
+// camera-frame lines by ~0.2 rad, which must not count.
 TEST(WindowPolicy, LineTranslationIsTheMedianRotationFreeMotionOverTheWindow) {
   std::mt19937 rng(3);
   const MotionModel motion = MotionModel::constantTwist(Vec3(0.5, -1.8, 0.6), 0.0);
   WindowObservations obs;
   obs.focal_px = 320.0;
-  // Angles 0.01 .. 0.05 rad over [0.02, 0.08] s of a 0.1 s window: D_k = 320 * a_k * 0.1 / 0.06.
-  for (double a : {0.05, 0.01, 0.03, 0.02, 0.04}) obs.clusters.push_back(clusterWithAngle(motion, 0.02, 0.08, a, rng));
-  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1), 320.0 * 0.03 * 0.1 / 0.06, 1e-9);
+  // Offsets 0.01 .. 0.05 over [0.02, 0.08] s of a 0.1 s window: D_k = 320 * o_k * 0.1 / 0.06.
+  for (double o : {0.05, 0.01, 0.03, 0.02, 0.04}) obs.clusters.push_back(clusterMoved(motion, 0.02, 0.08, o, rng));
+  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1), 320.0 * 0.03 * 0.1 / 0.06, 1e-6);
   // Clusters without lines do not count; fewer than 3 with lines: NaN.
   obs.clusters[0].has_lines = obs.clusters[1].has_lines = obs.clusters[2].has_lines = false;
   EXPECT_TRUE(std::isnan(lineTranslationPx(obs, motion, 0.0, 0.1)));
-  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1, 2), 320.0 * 0.04 * 0.1 / 0.06, 1e-9);  // median of 2: upper
+  EXPECT_NEAR(lineTranslationPx(obs, motion, 0.0, 0.1, 2), 320.0 * 0.04 * 0.1 / 0.06, 1e-6);  // median of 2: upper
+  // A cluster whose lines span less than a quarter of the window does not count.
+  WindowObservations short_lived;
+  short_lived.focal_px = 320.0;
+  for (int k = 0; k < 3; ++k) short_lived.clusters.push_back(clusterMoved(motion, 0.02, 0.04, 0.01, rng));
+  EXPECT_TRUE(std::isnan(lineTranslationPx(short_lived, motion, 0.0, 0.1)));
+  EXPECT_NEAR(lineTranslationPx(short_lived, motion, 0.0, 0.06), 320.0 * 0.01 * 0.06 / 0.02, 1e-6);
 }
 
 TEST(WindowPolicy, GrowthAimsAtTheTargetWithinOneAndAHalfToThreeTimes) {

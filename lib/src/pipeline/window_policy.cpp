@@ -43,13 +43,30 @@ void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
 
 double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
                          int min_clusters) {
+  constexpr std::size_t kCentroidEvents = 64;  // events per cluster for its centroid
   std::vector<double> d;
   for (const ClusterObservation& c : obs.clusters) {
-    if (!c.has_lines || !(c.l3.t > c.l1.t)) continue;
-    const Vec3 m1 = (motion.rotation(c.l1.t) * c.l1.normal).normalized();
-    const Vec3 m3 = (motion.rotation(c.l3.t) * c.l3.normal).normalized();
-    const double angle = std::acos(std::min(1.0, std::abs(m1.dot(m3))));
-    const double px = obs.focal_px * angle * (t1 - t0) / (c.l3.t - c.l1.t);
+    const double span = c.l3.t - c.l1.t;
+    if (!c.has_lines || c.size() == 0 || !(span >= kMinSpanShare * (t1 - t0))) continue;
+    const Vec3 m1 = motion.rotation(c.l1.t) * c.l1.normal;
+    const Vec3 m3 = motion.rotation(c.l3.t) * c.l3.normal;
+    // The cluster's centroid in the reference image (events turned by R(t)).
+    Vec3 centroid = Vec3::Zero();
+    int n = 0;
+    const std::size_t step = std::max<std::size_t>(1, c.size() / kCentroidEvents);
+    for (std::size_t j = 0; j < c.size(); j += step) {
+      const Vec3 g = motion.rotation(c.times[j]) * c.bearings[j];
+      if (!(g.z() > 1e-9)) continue;
+      centroid += g / g.z();
+      ++n;
+    }
+    if (n == 0) continue;
+    centroid /= n;
+    // Signed distances of the centroid to both lines [normalised units].
+    auto distance = [&](const Vec3& m) { return m.dot(centroid) / m.head<2>().norm(); };
+    const double s1 = distance(m1), s3 = distance(m3);
+    const double moved = std::min(std::abs(s1 - s3), std::abs(s1 + s3));  // the sign of a normal is free
+    const double px = obs.focal_px * moved * (t1 - t0) / span;
     if (std::isfinite(px)) d.push_back(px);
   }
   if (static_cast<int>(d.size()) < std::max(1, min_clusters)) return NAN;

@@ -7,11 +7,14 @@
 ///    lines show enough translation, or a maximum duration is reached.
 /// The translation a window shows is measured on its clusters' lines: with
 /// the rotation removed (the motion model's R(t), from the gyroscope), l1 and
-/// l3 of a cluster differ only by what translation moved; the angle between
-/// their reference-frame normals m1 = R(t1) l1, m3 = R(t3) l3, times the focal
-/// length, is that motion in pixels, scaled here to the whole window:
-///   D = median over clusters with lines of f acos|m1 . m3| (t_end - t_start) / (t3 - t1)   [px].
-/// The accuracy of the line methods follows D (docs/results.md): a window is
+/// l3 of a cluster differ only by what translation moved; how far, in pixels,
+/// is read at the cluster's centroid c (its events turned into the reference
+/// frame), where a line's position is well defined even when its direction
+/// is not: with m1 = R(t1) l1, m3 = R(t3) l3 and d(m) = m . c / |m_xy|,
+///   D = median over clusters of f |d(m1) - d(m3)| (t_end - t_start) / (t3 - t1)   [px],
+/// over the clusters with lines whose t3 - t1 covers at least a quarter of
+/// the window (a short one, scaled up to the window, would mostly add noise).
+/// The accuracy of the line methods follows D (docs/runs.md): a window is
 /// grown until D >= parallax_px.
 #include <cmath>
 #include <cstddef>
@@ -45,8 +48,10 @@ struct ParallaxWindowOptions {
 /// The parallax keys of the `windows:` section (core/fields.hpp).
 void describe(FieldVisitor& v, ParallaxWindowOptions& options);
 
+/// Clusters count for D when t3 - t1 is at least this share of the window.
+constexpr double kMinSpanShare = 0.25;
 /// D of the window [t0, t1] (see the file comment) [px]; NaN when fewer than
-/// `min_clusters` clusters have lines.
+/// `min_clusters` clusters count.
 double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
                          int min_clusters = 3);
 
