@@ -22,13 +22,13 @@ ClusterObservation clusterMoved(const MotionModel& motion, double t1, double t3,
   std::uniform_real_distribution<double> u(-0.3, 0.3), angle(0.0, 3.14);
   const double a = angle(rng);
   const Eigen::Vector2d c(u(rng), u(rng)), n(std::cos(a), std::sin(a));
-  const double rho1 = n.dot(c), rho3 = rho1 + moved;
+  const double rho1 = n.dot(c) - 0.5 * moved, rho3 = rho1 + moved;  // c halfway, as real events lie
   ClusterObservation cl;
   cl.l1.t = t1;
   cl.l3.t = t3;
   cl.l1.normal = (motion.rotation(t1).transpose() * Vec3(n.x(), n.y(), -rho1)).normalized();
   cl.l3.normal = -(motion.rotation(t3).transpose() * Vec3(n.x(), n.y(), -rho3)).normalized();  // sign is free
-  // Events symmetric about c along the line: their centroid is c.
+  // Events symmetric about c along the lines: their centroid is c.
   for (int k = -20; k <= 20; ++k) {
     const double t = t1 + (t3 - t1) * (k + 20) / 40.0;
     const Vec3 p(c.x() - n.y() * 0.01 * k, c.y() + n.x() * 0.01 * k, 1.0);

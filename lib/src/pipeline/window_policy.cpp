@@ -49,7 +49,8 @@ double lineTranslationPx(const WindowObservations& obs, const MotionModel& motio
     const double span = c.l3.t - c.l1.t;
     if (!c.has_lines || c.size() == 0 || !(span >= kMinSpanShare * (t1 - t0))) continue;
     const Vec3 m1 = motion.rotation(c.l1.t) * c.l1.normal;
-    const Vec3 m3 = motion.rotation(c.l3.t) * c.l3.normal;
+    Vec3 m3 = motion.rotation(c.l3.t) * c.l3.normal;
+    if (m1.dot(m3) < 0.0) m3 = -m3;  // the sign of a normal is free: orient l3 as l1
     // The cluster's centroid in the reference image (events turned by R(t)).
     Vec3 centroid = Vec3::Zero();
     int n = 0;
@@ -65,8 +66,7 @@ double lineTranslationPx(const WindowObservations& obs, const MotionModel& motio
     // Signed distances of the centroid to both lines [normalised units].
     auto distance = [&](const Vec3& m) { return m.dot(centroid) / m.head<2>().norm(); };
     const double s1 = distance(m1), s3 = distance(m3);
-    const double moved = std::min(std::abs(s1 - s3), std::abs(s1 + s3));  // the sign of a normal is free
-    const double px = obs.focal_px * moved * (t1 - t0) / span;
+    const double px = obs.focal_px * std::abs(s1 - s3) * (t1 - t0) / span;
     if (std::isfinite(px)) d.push_back(px);
   }
   if (static_cast<int>(d.size()) < std::max(1, min_clusters)) return NAN;
