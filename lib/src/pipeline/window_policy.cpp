@@ -125,7 +125,10 @@ void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
 bool ParallaxWindowJoiner::next(EventWindow& window) {
   const int min_steps = std::max(1, static_cast<int>(std::ceil(o_.min_seconds / o_.step_seconds - 1e-9)));
   const int max_steps = std::max(min_steps, static_cast<int>(std::floor(o_.max_seconds / o_.step_seconds + 1e-9)));
-  int steps = min_steps;
+  // The first try is the last window's length (the motion changes slowly);
+  // one that shows twice the target is shrunk once toward it.
+  int steps = std::clamp(last_steps_, min_steps, max_steps);
+  bool may_shrink = steps > min_steps;
   translation_px_ = NAN;
   for (;;) {
     const int have = contiguousSteps(steps);
@@ -137,9 +140,16 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     }
     join(steps, window);
     translation_px_ = probe_(window.t0, window.t1, window.events);
+    if (may_shrink && translation_px_ >= 2.0 * o_.target_px) {
+      may_shrink = false;
+      steps = std::max(min_steps, static_cast<int>(std::ceil(steps * o_.target_px / translation_px_ - 1e-9)));
+      continue;
+    }
+    may_shrink = false;
     if (translation_px_ >= o_.target_px || steps >= max_steps) break;
     steps = nextWindowSteps(steps, translation_px_, o_.target_px, max_steps);
   }
+  last_steps_ = std::isfinite(translation_px_) ? steps : min_steps;
   join(steps, window);
   const bool at_end = source_done_ && static_cast<int>(pending_.size()) == steps;
   if (at_end && steps < min_steps) {  // the end of the data cut the window short

@@ -62,7 +62,9 @@ int nextWindowSteps(int steps, double d_px, double target_px, int max_steps);
 
 /// The parallax policy's windows, joined from consecutive steps of a
 /// WindowSource cut by duration (step_seconds each, no overlap). A window
-/// starts as min_seconds; while the probe measures D < target_px it grows by
+/// starts as long as the last one (min_seconds at first, and after a window
+/// the probe could not measure); one that shows twice target_px is shrunk
+/// once toward it; while the probe measures D < target_px it grows by
 /// nextWindowSteps, up to max_seconds (where D is measured once more). A gap the source skipped ends a window.
 /// The last window, cut by the end of the data, is emitted when its events
 /// span at least partial_min_share of min_seconds (else tail() reports it).
@@ -95,6 +97,7 @@ class ParallaxWindowJoiner {
   std::uint64_t index_ = 0;
   WindowTail tail_;
   double translation_px_ = NAN;
+  int last_steps_ = 0;  ///< steps of the last measured window (0: none yet)
 };
 
 }  // namespace celc
