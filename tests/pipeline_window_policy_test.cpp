@@ -123,6 +123,12 @@ TEST(WindowPolicy, JoinerGrowsEachWindowUntilTheTargetOrTheMaximum) {
   }
   EXPECT_LE(total, ev.size());
   EXPECT_GE(total, ev.size() - 2600);  // at most a quarter of min_seconds (0.5 share) dropped
+  // Later windows start from the last one's length: one probe each.
+  EXPECT_NEAR(w[1].t1 - w[1].t0, 0.125, 1e-9);
+  EXPECT_NEAR(probed[2], 0.125, 1e-9);
+  // Two probes for the first window, at most one for each later one (none for
+  // a last window cut by the data); starting each at min_seconds takes two each.
+  EXPECT_LE(probed.size(), w.size() + 1);
   // No parallax at all: every window is max_seconds long (the last cut by the data).
   const auto flat = joinAll(d.file("e.txt"), o, 0.0);
   EXPECT_NEAR(flat[0].t1 - flat[0].t0, 0.3, 1e-9);
@@ -130,6 +136,32 @@ TEST(WindowPolicy, JoinerGrowsEachWindowUntilTheTargetOrTheMaximum) {
   const auto fast = joinAll(d.file("e.txt"), o, 1e4);
   EXPECT_NEAR(fast[0].t1 - fast[0].t0, 0.05, 1e-9);
   EXPECT_NEAR(fast[3].t0, fast[0].t0 + 0.15, 1e-9);
+}
+
+// A camera that speeds up: a window started at the last one's length that
+// shows twice the target is shrunk once toward it.
+TEST(WindowPolicy, JoinerShrinksWhenTheMotionSpeedsUp) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(100000, 240, 180, 5, 1.0);  // ~1 s from t = 1 s
+  writeEventsText(d.file("e.txt"), ev);
+  auto reader = openEventSource(d.file("e.txt"));
+  WindowOptions steps;
+  steps.seconds_per_window = 0.025;
+  steps.keep_partial = true;
+  WindowSource source(*reader, steps);
+  ParallaxWindowOptions o;
+  // 100 px/s before t = 1.3 s (windows of 0.25 s), 1000 px/s after (0.025 s would do: min_seconds).
+  ParallaxWindowJoiner joiner(source, o, 0.5, [](double t0, double t1, const std::vector<Event>&) {
+    return (t0 < 1.3 ? 100.0 : 1000.0) * (t1 - t0);
+  });
+  EventWindow w;
+  ASSERT_TRUE(joiner.next(w));
+  EXPECT_NEAR(w.t1 - w.t0, 0.25, 1e-9);
+  ASSERT_TRUE(joiner.next(w));  // starts at 1.25 s < 1.3: still slow, 0.25 s
+  EXPECT_NEAR(w.t1 - w.t0, 0.25, 1e-9);
+  ASSERT_TRUE(joiner.next(w));  // 0.25 s would show 250 px: shrunk to min_seconds
+  EXPECT_NEAR(w.t1 - w.t0, 0.05, 1e-9);
+  EXPECT_GE(joiner.translationPx(), o.target_px);
 }
 
 TEST(WindowPolicy, JoinerReportsTheShortLastWindow) {
