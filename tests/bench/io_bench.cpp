@@ -16,6 +16,7 @@
 #include "celc/geometry/undistort.hpp"
 #include "celc/io/event_reader.hpp"
 #include "celc/io/window_source.hpp"
+#include "read_all.hpp"
 #include "celc/io/writers.hpp"
 
 namespace {
@@ -64,19 +65,7 @@ Inputs& inputs() {
   return in;
 }
 
-void readAll(benchmark::State& state, const std::string& path) {
-  std::vector<Event> batch;
-  std::size_t total = 0;
-  for (auto _ : state) {
-    auto r = openEventSource(path);
-    std::size_t n = 0;
-    while (r->next(batch, 1 << 16)) n += batch.size();
-    benchmark::DoNotOptimize(n);
-    total += n;
-  }
-  state.SetItemsProcessed(std::int64_t(total));  // items/s = events/s
-  state.counters["MB"] = double(std::filesystem::file_size(path)) / 1e6;
-}
+using celc::bench::readAll;
 
 void BM_ReadEventsText(benchmark::State& s) { readAll(s, inputs().txt); }
 void BM_ReadAedat2(benchmark::State& s) { readAll(s, inputs().a2); }

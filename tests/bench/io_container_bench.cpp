@@ -14,6 +14,9 @@
 
 #include "celc/io/event_reader.hpp"
 #include "celc/io/window_source.hpp"
+#include "read_all.hpp"
+
+using celc::bench::readAll;
 
 namespace {
 
@@ -43,18 +46,7 @@ void readContainer(benchmark::State& state, const char* name) {
     state.SkipWithError("make_fixtures.py --bench failed (python3-rosbag, python3-h5py installed?)");
     return;
   }
-  const std::string path = containerInputs().file(name);
-  std::vector<Event> batch;
-  std::size_t total = 0;
-  for (auto _ : state) {
-    auto r = openEventSource(path);
-    std::size_t n = 0;
-    while (r->next(batch, 1 << 16)) n += batch.size();
-    benchmark::DoNotOptimize(n);
-    total += n;
-  }
-  state.SetItemsProcessed(std::int64_t(total));  // items/s = events/s
-  state.counters["MB"] = double(std::filesystem::file_size(path)) / 1e6;
+  readAll(state, containerInputs().file(name));
 }
 
 void BM_ReadRosBagLz4(benchmark::State& s) { readContainer(s, "bench_lz4.bag"); }
