@@ -112,6 +112,30 @@ static void BM_CelcLinearPeers(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
+// celc_ml with the default options on the peers' scene (V = 2 m/s, 1 px
+// noise), as solveMethods runs it: its linear and npt starts, the line
+// profile's screen, the joint refinements. Cycles over 16 trials (the time
+// depends on the trial); arg = events per line, 5 lines. Target (issue 14):
+// median <= 1 ms at 200 events per line, <= 0.3 ms at 20.
+static void BM_CelcMlPeers(benchmark::State& state) {
+  PeerSceneOptions o;
+  o.events_per_line = static_cast<int>(state.range(0));
+  std::vector<PeerSceneTrial> trials;
+  std::mt19937_64 rng(42);
+  while (trials.size() < 16) {
+    auto tr = generatePeerScene(o, rng);
+    if (tr.ok) trials.push_back(std::move(tr));
+  }
+  SolverOptions opt;
+  opt.check_parallax = false;  // as the peer study runs it
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& tr = trials[i++ % trials.size()];
+    benchmark::DoNotOptimize(solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, opt));
+  }
+}
+BENCHMARK(BM_CelcMlPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
 // CE3LC itself (5 clusters, 15 rows) with its cluster frames; the window
 // checks are measured apart.
 static void BM_Ce3lc5Lines(benchmark::State& state) {

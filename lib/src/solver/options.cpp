@@ -40,6 +40,11 @@ std::string MlOptions::validate() const {
   if (!(second_start_max_twist >= 0.0)) e += "second_start_max_twist must be >= 0; ";
   if (grid_starts < 0 || grid_starts > 10000) e += "grid_starts must be in [0, 10000]; ";
   if (screen_events < 0) e += "screen_events must be >= 0; ";
+  if (profile_lattice < 0 || profile_lattice > 100000) e += "profile_lattice must be in [0, 100000]; ";
+  if (profile_starts < 1 || profile_starts > 100) e += "profile_starts must be in [1, 100]; ";
+  if (profile_events < 0) e += "profile_events must be >= 0; ";
+  if (start_iterations < 0) e += "start_iterations must be >= 0; ";
+  if (!(huber_scale >= 0.0) || !std::isfinite(huber_scale)) e += "huber_scale must be finite and >= 0; ";
   return e;
 }
 

@@ -59,8 +59,17 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"second_start_deg", "deg", "... and the celc start ends this far from it"}, o.second_start_deg);
   v.field({"grid_starts", "", "extra starts on a hemisphere lattice, lowest cost kept (0 = off)"},
           o.grid_starts);
-  v.field({"screen_events", "events", "lattice starts screened on this many events (0 = all)"},
+  v.field({"screen_events", "events", "with several starts, each refined on about this many events (0 = all)"},
           o.screen_events);
+  v.field({"profile_lattice", "", "start from the line profile's minima: lattice directions (0 = off)"},
+          o.profile_lattice);
+  v.field({"profile_starts", "", "... its lowest minima refined"}, o.profile_starts);
+  v.field({"profile_events", "events", "... events per cluster in the profile (0 = all)"}, o.profile_events);
+  v.field({"start_iterations", "", "with several starts: iterations of each before the best continues (0 = all)"},
+          o.start_iterations);
+  v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
+                                "refine.huber_px (0 = off)"},
+          o.huber_scale);
 }
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {

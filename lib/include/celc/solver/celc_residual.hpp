@@ -58,9 +58,11 @@ inline double eventDistance(const EventTerm& e, const Vec3& v, const Vec3& m1, c
   if (dv || dm1 || dm3) {
     // dd/dl (as a column vector).
     const Vec3 dl = focal * (e.fp / gn - num * (e.Rt01.transpose() * g) / (gn * gn * gn));
-    if (dv) *dv = (m1 * u.transpose() - m3 * s.transpose()).transpose() * dl;
-    if (dm1) *dm1 = (uv * Mat3::Identity() - m3 * (e.Ds * v).transpose()).transpose() * dl;
-    if (dm3) *dm3 = (m1 * (e.De * v).transpose() - sv * Mat3::Identity()).transpose() * dl;
+    // dl/dv = m1 u^T - m3 s^T, dl/dm1 = uv I - m3 (Ds v)^T, dl/dm3 = m1 (De v)^T - sv I.
+    const double m1dl = m1.dot(dl), m3dl = m3.dot(dl);
+    if (dv) *dv = u * m1dl - s * m3dl;
+    if (dm1) *dm1 = uv * dl - (e.Ds * v) * m3dl;
+    if (dm3) *dm3 = (e.De * v) * m1dl - sv * dl;
   }
   return d;
 }

@@ -117,10 +117,30 @@ struct MlOptions {
   /// and keep the end point of lowest robust cost; each start costs one joint
   /// refinement.
   int grid_starts = 0;
-  /// With grid_starts: every start is refined on a seeded subset of this many
-  /// events, and only the lowest-cost end point on all (refine.max_events) of
-  /// them (0 = every start on all events).
+  /// With several starts, each is refined on every k-th event of the
+  /// refinement's subset, k chosen so that about this many are used, and only
+  /// the lowest-cost end point on all (refine.max_events) of them
+  /// (0 = every start on all events).
   int screen_events = 1000;
+  /// Also start from the lowest local minima of the line profile J(v), the
+  /// algebraic event-line cost with every cluster's line eliminated in closed
+  /// form (no fitted lines; docs/peers.md): J on a hemisphere lattice of
+  /// profile_lattice directions (0 = off), a pattern search from the
+  /// profile_starts lowest separated points, profile_events events per
+  /// cluster summed into J (0 = all).
+  int profile_lattice = 100;
+  int profile_starts = 3;
+  int profile_events = 100;
+  /// With several starts, each runs this many Levenberg-Marquardt iterations
+  /// (0 = refine.max_iterations) and only the lowest-cost one continues to
+  /// convergence.
+  int start_iterations = 8;
+  /// The Huber threshold of the joint cost becomes huber_scale times the
+  /// robust scale (1.4826 MAD) of the residuals at the first start's end
+  /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
+  /// Huber's estimator keeps ~95% of least squares' efficiency under Gaussian
+  /// noise at 1.345 sigma, ~99% at 2 sigma.
+  double huber_scale = 2.0;  ///< [-]
   std::string validate() const;  ///< empty when valid
 };
 

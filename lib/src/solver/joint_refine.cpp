@@ -1,0 +1,201 @@
+// celc_ml's joint Levenberg-Marquardt with the lines eliminated per cluster.
+#include "joint_refine.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "refine_costs.hpp"
+#include "sampling.hpp"
+
+namespace celc::detail {
+
+namespace {
+
+using Mat32 = Eigen::Matrix<double, 3, 2>;
+using Mat4 = Eigen::Matrix4d;
+using Vec4 = Eigen::Vector4d;
+using Mat24 = Eigen::Matrix<double, 2, 4>;
+
+/// An orthonormal basis of the tangent plane of the unit sphere at x.
+Mat32 tangentBasis(const Vec3& x) {
+  const Vec3 a = std::abs(x.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 e1 = x.cross(a).normalized();
+  Mat32 b;
+  b.col(0) = e1;
+  b.col(1) = x.cross(e1);
+  return b;
+}
+
+/// x moved by the tangent step B delta, back on the sphere.
+Vec3 retract(const Vec3& x, const Mat32& B, const Eigen::Vector2d& delta) {
+  return (x + B * delta).normalized();
+}
+
+std::vector<EventTerm>& threadBuffer() {
+  thread_local std::vector<EventTerm> buffer;
+  return buffer;
+}
+
+}  // namespace
+
+JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& motion,
+                           const WindowFrames& frames, int max_events, bool balance_clusters,
+                           std::uint64_t event_seed, double huber_px)
+    : focal_(obs.focal_px), huber_(huber_px) {
+  const std::vector<int>& usable = frames.clusters();
+  std::vector<size_t> sizes;
+  for (int c : usable) sizes.push_back(obs.clusters[c].size());
+  const std::vector<size_t> quota =
+      rowQuota(sizes, static_cast<size_t>(std::max(0, max_events)), balance_clusters);
+  terms_.swap(threadBuffer());
+  terms_.clear();
+  size_t total = 0;
+  for (size_t q : quota) total += q;
+  terms_.reserve(total);
+  for (size_t ci = 0; ci < usable.size(); ++ci) {
+    const ClusterObservation& cl = obs.clusters[usable[ci]];
+    const ClusterFrame& frame = frames[usable[ci]];
+    const size_t first = terms_.size();
+    for (size_t k : sampleIndices(cl.size(), quota[ci], event_seed + ci)) {
+      const double t = cl.times[k];
+      const Vec3& f = cl.bearings[k];
+      if (!f.allFinite() || !std::isfinite(t)) continue;
+      Mat3 Rk, Pk;
+      motion.pose(t, Rk, Pk);
+      const EventTerm e = makeEventTerm(frame, Rk, Pk, f);
+      if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms_.push_back(e);
+    }
+    if (terms_.size() == first) continue;
+    begin_.push_back(terms_.size());
+    m1_.push_back(frame.m1.normalized());
+    m3_.push_back(frame.m3.normalized());
+  }
+}
+
+JointProblem::~JointProblem() {
+  if (terms_.capacity() > threadBuffer().capacity()) terms_.swap(threadBuffer());
+}
+
+size_t JointProblem::events() const { return terms_.size(); }
+
+double JointProblem::robustScale(const State& s) const {
+  std::vector<double> d;
+  d.reserve(terms_.size());
+  for (size_t c = 0; c + 1 < begin_.size(); ++c)
+    for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
+      d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
+  return 1.4826 * medianAbs(d);
+}
+
+JointProblem::State JointProblem::start(const Vec3& v) const { return {v.normalized(), m1_, m3_}; }
+
+double JointProblem::cost(const State& s, int stride) const {
+  double total = 0.0;
+  for (size_t c = 0; c + 1 < begin_.size(); ++c)
+    for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
+      const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr);
+      if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
+      double slope;
+      const double r = sqrtHuber(d, huber_, &slope);
+      total += r * r;
+    }
+  return 0.5 * total;
+}
+
+JointProblem::Result JointProblem::refine(State s, int max_iterations, double function_tolerance,
+                                          int stride) const {
+  Result out;
+  const size_t nc = begin_.size() - 1;
+  for (size_t c = 0; c < nc; ++c)
+    out.events += static_cast<int>((begin_[c + 1] - begin_[c] + stride - 1) / stride);
+  double f = cost(s, stride);
+  if (!std::isfinite(f) || out.events < 3) return out;
+  std::vector<Mat4> U(nc);
+  std::vector<Mat24> W(nc);
+  std::vector<Vec4> bc(nc);
+  std::vector<Mat32> B1(nc), B3(nc);
+  double lambda = 1e-4;
+  State trial = s;
+  for (int it = 0; it < max_iterations; ++it) {
+    out.iterations = it + 1;
+    // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s.
+    const Mat32 Bv = tangentBasis(s.v);
+    Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d bv = Eigen::Vector2d::Zero();
+    for (size_t c = 0; c < nc; ++c) {
+      B1[c] = tangentBasis(s.m1[c]);
+      B3[c] = tangentBasis(s.m3[c]);
+      U[c].setZero();
+      W[c].setZero();
+      bc[c].setZero();
+      for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
+        Vec3 gv = Vec3::Zero(), g1 = Vec3::Zero(), g3 = Vec3::Zero();
+        const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, &gv, &g1, &g3);
+        if (!std::isfinite(d)) continue;  // not at s: its cost is finite
+        double slope;
+        const double r = sqrtHuber(d, huber_, &slope);
+        const Eigen::Vector2d jv = slope * (Bv.transpose() * gv);
+        Vec4 jc;
+        jc.head<2>() = slope * (B1[c].transpose() * g1);
+        jc.tail<2>() = slope * (B3[c].transpose() * g3);
+        V.noalias() += jv * jv.transpose();
+        bv += jv * r;
+        U[c].noalias() += jc * jc.transpose();
+        W[c].noalias() += jv * jc.transpose();
+        bc[c] += jc * r;
+      }
+    }
+    // Damped steps until one lowers the cost (lambda grows on failure).
+    bool accepted = false;
+    for (int tries = 0; tries < 12 && !accepted; ++tries) {
+      Eigen::Matrix2d S = V;
+      S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
+      Eigen::Vector2d rhs = -bv;
+      std::vector<Eigen::LDLT<Mat4>> Uinv(nc);
+      for (size_t c = 0; c < nc; ++c) {
+        Mat4 Ud = U[c];
+        Ud.diagonal() += lambda * U[c].diagonal().cwiseMax(1e-12);
+        Uinv[c].compute(Ud);
+        const Mat24 WUi = Uinv[c].solve(W[c].transpose()).transpose();
+        S.noalias() -= WUi * W[c].transpose();
+        rhs.noalias() += WUi * bc[c];
+      }
+      const Eigen::Vector2d dv = S.ldlt().solve(rhs);
+      if (!dv.allFinite()) {
+        lambda *= 10.0;
+        continue;
+      }
+      trial.v = retract(s.v, Bv, dv);
+      for (size_t c = 0; c < nc; ++c) {
+        const Vec4 dc = -Uinv[c].solve(bc[c] + W[c].transpose() * dv);
+        if (!dc.allFinite()) {
+          trial.m1[c] = s.m1[c];
+          trial.m3[c] = s.m3[c];
+          continue;
+        }
+        trial.m1[c] = retract(s.m1[c], B1[c], dc.head<2>());
+        trial.m3[c] = retract(s.m3[c], B3[c], dc.tail<2>());
+      }
+      const double ft = cost(trial, stride);
+      if (ft < f) {
+        const double decrease = (f - ft) / std::max(f, 1e-300);
+        std::swap(s, trial);
+        f = ft;
+        lambda = std::max(lambda / 3.0, 1e-12);
+        accepted = true;
+        if (decrease < function_tolerance) it = max_iterations;  // converged
+      } else {
+        lambda *= 4.0;
+      }
+    }
+    if (!accepted) break;  // no step lowers the cost: a minimum at this precision
+  }
+  out.state = std::move(s);
+  out.cost = f;
+  out.ok = std::isfinite(f) && out.state.v.allFinite();
+  return out;
+}
+
+}  // namespace celc::detail

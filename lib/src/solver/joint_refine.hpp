@@ -1,0 +1,70 @@
+#pragma once
+// Internal: celc_ml's joint refinement of v and every cluster's lines
+// (m1, m3), a Levenberg-Marquardt on the cost of refine_costs.hpp
+// (sum of Huber rho(d^2) over the events, d the CELC event distance in px)
+// with each cluster's lines eliminated per step (Schur complement): the
+// normal equations have a 2x2 block for v (tangent of the unit sphere),
+// a 4x4 block per cluster (the tangents of m1 and m3) and their coupling,
+// so one step costs O(events) and a 2x2 solve. The same cost as the Ceres
+// refinement (refine.hpp), without its per-problem set-up.
+#include <cstdint>
+#include <vector>
+
+#include "celc/geometry/motion_model.hpp"
+#include "celc/core/observations.hpp"
+#include "celc/solver/celc_residual.hpp"
+#include "constraint_rows.hpp"
+
+namespace celc::detail {
+
+/// The joint problem of one window: the event terms of the usable clusters
+/// (a seeded subset of max_events events, as refine.hpp draws it; 0 = all).
+class JointProblem {
+ public:
+  JointProblem(const WindowObservations& obs, const MotionModel& motion, const WindowFrames& frames,
+               int max_events, bool balance_clusters, std::uint64_t event_seed, double huber_px);
+  ~JointProblem();
+  JointProblem(const JointProblem&) = delete;
+  JointProblem& operator=(const JointProblem&) = delete;
+
+  /// A point of the problem: v and each cluster's plane normals (unit).
+  struct State {
+    Vec3 v;
+    std::vector<Vec3> m1, m3;
+  };
+  /// v with the fitted lines of the frames.
+  State start(const Vec3& v) const;
+  /// Robust cost 1/2 sum rho(d^2) [px^2] over every stride-th event of each
+  /// cluster; +inf when a distance is not finite.
+  double cost(const State& s, int stride = 1) const;
+
+  struct Result {
+    State state;
+    double cost = 0.0;  ///< at the end, over the events used
+    int iterations = 0;
+    int events = 0;     ///< events used
+    bool ok = false;
+  };
+  /// Levenberg-Marquardt from s over every stride-th event, until the
+  /// relative cost decrease is below function_tolerance or max_iterations.
+  Result refine(State s, int max_iterations, double function_tolerance, int stride = 1) const;
+
+  /// Events in the problem.
+  size_t events() const;
+  /// 1.4826 median |d| over the events at s [px]: the residuals' robust scale.
+  double robustScale(const State& s) const;
+  /// The Huber threshold of the cost [px].
+  void setHuber(double huber_px) { huber_ = huber_px; }
+
+ private:
+  /// The terms of cluster c: terms_[begin_[c], begin_[c + 1]). The buffer's
+  /// memory is kept per thread across problems: allocating and releasing it
+  /// per window made the kernel map and unmap its pages every time, which
+  /// cost more than building the terms.
+  std::vector<EventTerm> terms_;
+  std::vector<size_t> begin_{0};
+  std::vector<Vec3> m1_, m3_;                  // fitted lines (frames), unit
+  double focal_, huber_;
+};
+
+}  // namespace celc::detail

@@ -1,0 +1,146 @@
+// celc_ml's screen: the profile of the event-line constraint over directions.
+#include "ml_screen.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "celc/solver/result.hpp"
+#include "robust_nullspace.hpp"
+#include "sampling.hpp"
+
+namespace celc::detail {
+
+namespace {
+
+constexpr int kPairs[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+
+Mat3 skew(const Vec3& a) {
+  Mat3 m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+/// A unit vector orthogonal to v.
+Vec3 orthogonal(const Vec3& v) {
+  const Vec3 a = std::abs(v.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return v.cross(a).normalized();
+}
+
+}  // namespace
+
+LineProfile::LineProfile(const WindowObservations& obs, const MotionModel& motion,
+                         const std::vector<int>& clusters, int max_events, std::uint64_t seed) {
+  for (size_t i = 0; i < clusters.size(); ++i) {
+    const ClusterObservation& cl = obs.clusters[static_cast<size_t>(clusters[i])];
+    Sums s;
+    s.S.setZero();
+    for (auto& row : s.beta)
+      for (Vec3& b : row) b.setZero();
+    for (Mat3& h : s.Hq) h.setZero();
+    int n = 0;
+    for (size_t k : sampleIndices(cl.size(), static_cast<size_t>(std::max(0, max_events)), seed + i)) {
+      const double t = cl.times[k];
+      const Vec3& f = cl.bearings[k];
+      if (!std::isfinite(t) || !f.allFinite() || !(f.norm() > 0.0)) continue;
+      const Vec3 b = motion.rotation(t) * f.normalized();
+      const Mat3 K = -skew(b) * motion.positionMatrix(t);  // h = K v
+      if (!b.allFinite() || !K.allFinite()) continue;
+      s.S += b * b.transpose();
+      for (int a = 0; a < 3; ++a)
+        for (int j = 0; j < 3; ++j) s.beta[a][j] += b(a) * K.row(j).transpose();
+      for (int p = 0; p < 6; ++p)
+        s.Hq[p] += K.row(kPairs[p][0]).transpose() * K.row(kPairs[p][1]);
+      ++n;
+    }
+    if (n < 5) continue;  // fewer events than a line and a plane need
+    for (Mat3& h : s.Hq) h = 0.5 * (h + h.transpose()).eval();
+    sums_.push_back(s);
+  }
+}
+
+void LineProfile::forms(const Sums& s, const Vec3& v, Mat3& H, Mat3& B) {
+  for (int p = 0; p < 6; ++p) {
+    const double q = v.dot(s.Hq[p] * v);
+    H(kPairs[p][0], kPairs[p][1]) = q;
+    H(kPairs[p][1], kPairs[p][0]) = q;
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int j = 0; j < 3; ++j) B(a, j) = s.beta[a][j].dot(v);
+  // H is singular along the direction that moves the line along the
+  // camera's path (exactly v when P = tau I), and B(v) vanishes there too:
+  // a relative ridge of 1e-9 leaves the minimum over d unchanged but for
+  // rounding.
+  H.diagonal().array() += 1e-9 * H.trace() + 1e-300;
+}
+
+double LineProfile::operator()(const Vec3& v) const {
+  double total = 0.0;
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  for (const Sums& s : sums_) {
+    Mat3 H, B;
+    forms(s, v, H, B);
+    const Mat3 Q = s.S - B * Eigen::LLT<Mat3>(H).solve(B.transpose());  // S - B H^-1 B^T
+    eig.computeDirect(0.5 * (Q + Q.transpose()), Eigen::EigenvaluesOnly);
+    total += std::max(0.0, eig.eigenvalues()(0));
+  }
+  return total;
+}
+
+std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice, int keep,
+                                         double tolerance_deg, double separation_deg) {
+  std::vector<ScreenMinimum> out;
+  if (profile.size() == 0 || lattice < 1 || keep < 1) return out;
+  const std::vector<Vec3> dirs = hemisphereDirections(lattice);
+  std::vector<ScreenMinimum> grid;
+  grid.reserve(dirs.size());
+  for (const Vec3& d : dirs) grid.push_back({d, profile(d)});
+  std::sort(grid.begin(), grid.end(),
+            [](const ScreenMinimum& a, const ScreenMinimum& b) { return a.cost < b.cost; });
+  // Lattice spacing on the hemisphere (2 pi sr): the first pattern step, and
+  // the suppression radius among lattice starts.
+  const double spacing = std::sqrt(2.0 * M_PI / static_cast<double>(dirs.size()));
+  std::vector<ScreenMinimum> starts;
+  for (const ScreenMinimum& g : grid) {
+    bool near = false;
+    for (const ScreenMinimum& s : starts) near = near || angleBetweenSignAgnostic(g.v, s.v) < 2.0 * spacing;
+    if (!near) starts.push_back(g);
+    if (static_cast<int>(starts.size()) >= keep) break;
+  }
+  const double tol = tolerance_deg * M_PI / 180.0;
+  for (ScreenMinimum s : starts) {
+    // Pattern search on the tangent plane: 8 directions, step halved when
+    // none is lower.
+    double step = spacing;
+    Vec3 e1 = orthogonal(s.v), e2 = s.v.cross(e1);
+    while (step > tol) {
+      ScreenMinimum best = s;
+      for (int k = 0; k < 8; ++k) {
+        const double a = k * M_PI / 4.0;
+        const Vec3 c = (s.v + step * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+        const double j = profile(c);
+        if (j < best.cost) best = {c, j};
+      }
+      if (best.cost < s.cost) {
+        s = best;
+        e1 = (e1 - e1.dot(s.v) * s.v).normalized();
+        e2 = s.v.cross(e1);
+      } else {
+        step *= 0.5;
+      }
+    }
+    bool merged = false;
+    for (ScreenMinimum& o : out)
+      if (angleBetweenSignAgnostic(o.v, s.v) * 180.0 / M_PI < separation_deg) {
+        if (s.cost < o.cost) o = s;
+        merged = true;
+      }
+    if (!merged) out.push_back(s);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const ScreenMinimum& a, const ScreenMinimum& b) { return a.cost < b.cost; });
+  return out;
+}
+
+}  // namespace celc::detail

@@ -1,0 +1,69 @@
+#pragma once
+// Internal: celc_ml's screen of the velocity direction by the profile of the
+// event-line constraint (no fitted lines needed).
+//
+// An event k with bearing b_k = R_k f_k (reference frame, unit) seen from the
+// camera centre c_k = P_k v lies on the 3D line L (direction d, moment m) iff
+// its ray meets L:
+//   r_k = b_k.m + ((P_k v) x b_k).d = b_k.n_k = 0,   n_k = m + c_k x d,
+// n_k being the normal of the line's interpretation plane at t_k (n at the
+// reference time is m). For a given v, r is linear in (d, m). With |m| = 1
+// (which excludes the line through the camera's own path, a trivial zero of
+// r; r_k is then the event's angle to the plane up to |n_k| / |m|), the line
+// of a cluster is eliminated in closed form:
+//   E_c(v) = min_{|m| = 1, d} sum_k r_k^2 = lambda_min(S - B(v) H(v)^+ B(v)^T),
+//   S = sum b b^T,  B(v) = sum b h_k(v)^T,  H(v) = sum h_k(v) h_k(v)^T,
+//   h_k(v) = (P_k v) x b_k = K_k v,  K_k = -[b_k]_x P_k,
+// where H's entries are quadratic forms in v and B's linear forms, summed
+// once per cluster. The profile J(v) = sum_c E_c(v) is the algebraic cost
+// with every line at its best for v; it is cheap (a 3x3 system per cluster
+// and direction) and, unlike the joint refinement, has no line start to
+// fall from.
+#include <cstdint>
+#include <vector>
+
+#include "celc/geometry/motion_model.hpp"
+#include "celc/core/observations.hpp"
+
+namespace celc::detail {
+
+/// The profile J(v) of a window's clusters.
+class LineProfile {
+ public:
+  /// Clusters `clusters` of obs, at most max_events events of each (a seeded
+  /// subset, cluster i drawn with seed + i; 0 = all).
+  LineProfile(const WindowObservations& obs, const MotionModel& motion,
+              const std::vector<int>& clusters, int max_events, std::uint64_t seed);
+  /// J(v) for a unit v [rad^2: squared angles up to |n_k| / |m|].
+  double operator()(const Vec3& v) const;
+  /// Clusters summed.
+  size_t size() const { return sums_.size(); }
+
+ private:
+  /// One cluster's sums: S (3x3), the linear forms beta[a][j] with
+  /// B(v)_aj = beta[a][j].v, and the quadratic forms of H(v)_ij = v^T Hq[ij] v
+  /// (ij over the 6 pairs i <= j).
+  struct Sums {
+    Mat3 S;
+    Vec3 beta[3][3];
+    Mat3 Hq[6];
+  };
+  std::vector<Sums> sums_;
+  /// H(v) with its ridge, and B(v), of one cluster.
+  static void forms(const Sums& s, const Vec3& v, Mat3& H, Mat3& B);
+};
+
+/// The screen's result: local minima of J, lowest first.
+struct ScreenMinimum {
+  Vec3 v;
+  double cost;
+};
+
+/// Local minima of J over the hemisphere: J on a lattice of `lattice`
+/// directions, then a pattern search (tangent steps halving down to
+/// `tolerance_deg`) from the lattice's `keep` lowest points that are local
+/// minima of the lattice; minima closer than `separation_deg` merge.
+std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice, int keep,
+                                         double tolerance_deg, double separation_deg);
+
+}  // namespace celc::detail

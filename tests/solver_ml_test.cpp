@@ -1,0 +1,172 @@
+// celc_ml: the line profile's screen (solver/ml_screen.hpp), the joint
+// Levenberg-Marquardt (solver/joint_refine.hpp) and the method's accuracy
+// beside the Cramér-Rao bound with its default options.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "celc/eval/crlb.hpp"
+#include "celc/pipeline/peer_study.hpp"
+#include "celc/sim/line_scene.hpp"
+#include "celc/sim/peer_scene.hpp"
+#include "celc/solver/solver.hpp"
+#include "solver/constraint_rows.hpp"
+#include "solver/joint_refine.hpp"
+#include "solver/ml_screen.hpp"
+#include "solver/robust_nullspace.hpp"
+
+using namespace celc;
+
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+PeerSceneTrial peerTrial(std::uint64_t seed, double speed, double sigma, int events) {
+  PeerSceneOptions o;
+  o.speed = speed;
+  o.event_noise_px = sigma;
+  o.events_per_line = events;
+  std::mt19937_64 rng(seed);
+  return generatePeerScene(o, rng);
+}
+
+/// J at the truth against its median over a lattice: noise-free events fit
+/// their lines exactly only at the true direction.
+void expectProfileZeroAtTruth(const WindowObservations& obs, const MotionModel& motion, const Vec3& truth) {
+  const detail::WindowFrames frames(obs, motion);
+  const detail::LineProfile profile(obs, motion, frames.clusters(), 0, 1);
+  ASSERT_EQ(profile.size(), obs.clusters.size());
+  std::vector<double> lattice;
+  for (const Vec3& d : detail::hemisphereDirections(100)) lattice.push_back(profile(d));
+  std::nth_element(lattice.begin(), lattice.begin() + 50, lattice.end());
+  // Not 0: the ridge that keeps H invertible (1e-9 of its trace, against
+  // H's small eigenvalues) leaves 1e-7 to 2e-5 of the lattice's median here;
+  // 0.5 px of noise adds ~1e-1 of it.
+  EXPECT_LT(profile(truth), 1e-4 * lattice[50]);
+  const auto minima = detail::screenProfile(profile, 100, 3, 0.01, 2.0);
+  ASSERT_FALSE(minima.empty());
+  EXPECT_LT(angleBetweenSignAgnostic(minima[0].v, truth) * kDeg, 0.05);
+}
+
+}  // namespace
+
+// The peers' model (P = tau I, reference frame), where H(v) is singular along v.
+TEST(LineProfile, VanishesAtTheTruthWithoutNoiseInTheReferenceFrame) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const PeerSceneTrial tr = peerTrial(seed, 2.0, 0.0, 100);
+    ASSERT_TRUE(tr.ok) << tr.message;
+    expectProfileZeroAtTruth(tr.observations, tr.given_motion, tr.true_direction);
+  }
+}
+
+// The paper's model: a constant twist in the body frame (|w| T = 1 rad).
+TEST(LineProfile, VanishesAtTheTruthWithoutNoiseUnderAConstantTwist) {
+  LineSceneOptions o;
+  o.event_noise_px = 0.0;
+  o.line_noise_px = 0.0;
+  o.events_per_line = 100;
+  for (std::uint64_t seed : {4, 5}) {
+    std::mt19937_64 rng(seed);
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    expectProfileZeroAtTruth(tr.observations, tr.true_motion, tr.true_direction);
+  }
+}
+
+// The joint Levenberg-Marquardt minimises the same cost as the Ceres
+// refinement (refine.hpp): from the same start both end at the same point.
+TEST(JointProblem, ReachesTheCeresRefinementsMinimum) {
+  for (std::uint64_t seed : {7, 8, 9}) {
+    const PeerSceneTrial tr = peerTrial(seed, 5.0, 1.0, 200);
+    ASSERT_TRUE(tr.ok);
+    const RefineOptions ro;
+    const SolverResult linear = solveCelcLinear(tr.observations, tr.given_motion, {});
+    ASSERT_TRUE(linear.ok());
+    const SolverResult ceres = refineVelocity(tr.observations, tr.given_motion, linear.v, true, ro);
+    ASSERT_TRUE(ceres.ok()) << ceres.message;
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const detail::JointProblem problem(tr.observations, tr.given_motion, frames, ro.max_events,
+                                       ro.balance_clusters, ro.seed, ro.huber_px);
+    const auto r = problem.refine(problem.start(linear.v), ro.max_iterations, ro.function_tolerance);
+    ASSERT_TRUE(r.ok);
+    EXPECT_EQ(r.events, ceres.rows_used);
+    const double residual = std::sqrt(2.0 * r.cost / r.events);
+    EXPECT_NEAR(residual, ceres.residual_px, 1e-6 * ceres.residual_px) << "seed " << seed;
+    EXPECT_LT(angleBetweenSignAgnostic(r.state.v, ceres.v) * kDeg, 1e-3) << "seed " << seed;
+  }
+}
+
+// Without noise the refinement from 10 deg off returns to the truth.
+TEST(JointProblem, ConvergesToTheTruthWithoutNoise) {
+  const PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
+  ASSERT_TRUE(tr.ok);
+  const detail::WindowFrames frames(tr.observations, tr.given_motion);
+  const detail::JointProblem problem(tr.observations, tr.given_motion, frames, 0, false, 1, 1.5);
+  const Vec3 axis = tr.true_direction.cross(Vec3::UnitZ()).normalized();
+  const Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
+  const auto r = problem.refine(problem.start(start), 100, 1e-14);
+  ASSERT_TRUE(r.ok);
+  EXPECT_LT(angleBetweenSignAgnostic(r.state.v, tr.true_direction) * kDeg, 1e-4);
+}
+
+// The default celc_ml beside the bound on fixed trials of the peers' scene
+// (5 lines x 200 events). The targets are on the RMS over the peer
+// study's 500 trials per cell (docs/peers.md); over 40 trials one trial in a
+// wrong basin moves the RMS by 2x, so this test checks the median (within
+// 1.3x of the bound's median; the study: 0.67-0.82x) and the tail: at most 3
+// of 40 trials beyond 4x their own bound (measured: 2, 0, 0; at V = 1 both
+// are trials whose lowest cost lies in a wrong basin).
+TEST(CelcMl, DefaultOptionsNearTheBound) {
+  SolverOptions options;
+  options.check_parallax = false;  // as the peer study runs it
+  struct Cell {
+    double speed, sigma;
+  };
+  for (const Cell cell : {Cell{1.0, 0.5}, Cell{2.0, 1.0}, Cell{5.0, 1.0}}) {
+    std::vector<double> phi, bound;
+    int far = 0;
+    for (std::uint64_t t = 0; t < 40; ++t) {
+      const PeerSceneTrial tr = peerTrial(100 + t, cell.speed, cell.sigma, 200);
+      if (!tr.ok) continue;
+      const CrlbResult b = velocityDirectionCrlb(tr.truth, tr.true_motion, tr.true_direction, cell.sigma);
+      const SolverResult r = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options)[0];
+      ASSERT_TRUE(r.ok()) << "trial " << t << ": " << r.message;
+      ASSERT_TRUE(b.ok);
+      const double p = angleBetweenSignAgnostic(r.v, tr.true_direction) * kDeg;
+      phi.push_back(p);
+      bound.push_back(b.rms_rad * kDeg);
+      far += p > 4.0 * b.rms_rad * kDeg;
+    }
+    ASSERT_GE(phi.size(), 35u);
+    const auto median = [](std::vector<double> x) {
+      std::nth_element(x.begin(), x.begin() + static_cast<long>(x.size() / 2), x.end());
+      return x[x.size() / 2];
+    };
+    EXPECT_LT(median(phi), 1.3 * median(bound)) << "V " << cell.speed;
+    EXPECT_LE(far, 3) << "V " << cell.speed;
+  }
+}
+
+// The profile's minima as starts (the default) against the linear and npt
+// starts alone, at the lowest parallax of the study (V = 1 m/s, 0.5 px): the
+// peer study's first 100 trials of that cell (a few trials hold the whole
+// difference, so fewer trials would not show it). Measured: RMS 13.6 -> 6.3 deg
+// (the bound: 5.9).
+TEST(CelcMl, ProfileStartsEscapeWrongBasins) {
+  PeerStudyConfig config;
+  config.methods = {Method::CelcMl};
+  config.trials = 100;
+  config.solver.check_parallax = false;
+  PeerCell cell;
+  cell.speed = 1.0;
+  cell.sigma_px = 0.5;
+  const auto with = runPeerStudy({cell}, config, 0);
+  config.solver.ml.profile_lattice = 0;
+  const auto without = runPeerStudy({cell}, config, 0);
+  ASSERT_EQ(with.size(), 1u);
+  ASSERT_EQ(without.size(), 1u);
+  EXPECT_EQ(with[0].n_ok, 100);
+  EXPECT_LT(with[0].rms_agn_deg, 0.7 * without[0].rms_agn_deg);
+  EXPECT_LT(with[0].rms_agn_deg, 1.5 * with[0].crlb_rms_deg);
+}
