@@ -8,23 +8,15 @@
 
 #include "celc/solver/celc_residual.hpp"
 #include "sampling.hpp"
+#include "sphere_tangent.hpp"
 
 namespace celc {
 namespace {
 
-using Mat32 = Eigen::Matrix<double, 3, 2>;
+using detail::Mat32;
+using detail::tangentBasis;
 using Mat4 = Eigen::Matrix4d;
 using Mat24 = Eigen::Matrix<double, 2, 4>;
-
-// Orthonormal basis of the tangent plane of the unit sphere at u.
-Mat32 tangentBasis(const Vec3& u) {
-  const Vec3 a = std::abs(u.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 b1 = u.cross(a).normalized();
-  Mat32 B;
-  B.col(0) = b1;
-  B.col(1) = u.cross(b1);
-  return B;
-}
 
 // Moore-Penrose pseudo-inverse of a symmetric positive semi-definite matrix.
 template <typename M>

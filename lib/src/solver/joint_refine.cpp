@@ -8,25 +8,17 @@
 
 #include "refine_costs.hpp"
 #include "sampling.hpp"
+#include "sphere_tangent.hpp"
 
 namespace celc::detail {
 
 namespace {
 
-using Mat32 = Eigen::Matrix<double, 3, 2>;
 using Mat4 = Eigen::Matrix4d;
 using Vec4 = Eigen::Vector4d;
 using Mat24 = Eigen::Matrix<double, 2, 4>;
 
-/// An orthonormal basis of the tangent plane of the unit sphere at x.
-Mat32 tangentBasis(const Vec3& x) {
-  const Vec3 a = std::abs(x.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 e1 = x.cross(a).normalized();
-  Mat32 b;
-  b.col(0) = e1;
-  b.col(1) = x.cross(e1);
-  return b;
-}
+constexpr double kStepTolerance = 1e-8;  // [rad]
 
 /// x moved by the tangent step B delta, back on the sphere.
 Vec3 retract(const Vec3& x, const Mat32& B, const Eigen::Vector2d& delta) {
@@ -185,7 +177,9 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
         f = ft;
         lambda = std::max(lambda / 3.0, 1e-12);
         accepted = true;
-        if (decrease < function_tolerance) it = max_iterations;  // converged
+        // Converged: the cost or v no longer moves (v's step below
+        // kStepTolerance rad, as Ceres' parameter tolerance).
+        if (decrease < function_tolerance || dv.norm() < kStepTolerance) it = max_iterations;
       } else {
         lambda *= 4.0;
       }

@@ -9,6 +9,7 @@
 #include "celc/solver/result.hpp"
 #include "robust_nullspace.hpp"
 #include "sampling.hpp"
+#include "sphere_tangent.hpp"
 
 namespace celc::detail {
 
@@ -20,12 +21,6 @@ Mat3 skew(const Vec3& a) {
   Mat3 m;
   m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
   return m;
-}
-
-/// A unit vector orthogonal to v.
-Vec3 orthogonal(const Vec3& v) {
-  const Vec3 a = std::abs(v.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  return v.cross(a).normalized();
 }
 
 }  // namespace
@@ -113,7 +108,7 @@ std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice
     // Pattern search on the tangent plane: 8 directions, step halved when
     // none is lower.
     double step = spacing;
-    Vec3 e1 = orthogonal(s.v), e2 = s.v.cross(e1);
+    Vec3 e1 = tangentBasis(s.v).col(0), e2 = s.v.cross(e1);
     while (step > tol) {
       ScreenMinimum best = s;
       for (int k = 0; k < 8; ++k) {
