@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -418,4 +419,65 @@ TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
     expectPrintable(m);
     EXPECT_NE(m.find("c.yaml:1"), std::string::npos) << m;
   }
+}
+
+// ---- found by fuzz_hdf5: a chunk layout that disagrees with its stored chunks -------
+
+TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
+  // An MVSEC file whose events are stored in unfiltered chunks of 16 x 4 doubles
+  // (512 bytes each), written by h5py; then the layout message's chunk rows
+  // 16 -> 199 (the fuzzer's change): the HDF5 library used to copy 6368 bytes
+  // out of each 512-byte chunk buffer (a heap overflow inside libhdf5).
+  TempDir d;
+  const std::string py = d.file("w.py"), h5 = d.file("m.h5");
+  writeBytes(py,
+             "import sys, numpy as np, h5py\n"
+             "with h5py.File(sys.argv[1], 'w') as f:\n"
+             "    ev = np.zeros((60, 4)); ev[:, 2] = 1.0 + np.arange(60) * 1e-5; ev[:, 3] = 1.0\n"
+             "    f.create_dataset('davis/left/events', data=ev, chunks=(16, 4))\n");
+  if (std::system(("/usr/bin/python3 '" + py + "' '" + h5 + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
+  std::string b = readBytes(h5);
+  // the layout message's dimensions: chunk rows, columns, then the element size (uint32 each)
+  const std::string dims("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12);
+  const std::size_t at = b.find(dims);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_EQ(b.find(dims, at + 1), std::string::npos);
+  b[at] = char(199);
+  writeBytes(h5, b);
+  EXPECT_IO_ERROR(celc::test::drain(h5), "m.h5: dataset /davis/left/events: chunk 0 at byte",
+                  "holds 512 bytes, an unfiltered chunk of its layout 6368 (damaged file)");
+}
+
+TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
+  // A DSEC file whose /events/x is stored compact (in its object header, 60
+  // uint16 = 120 bytes), written by h5py; then the layout message's compact size
+  // 120 -> 0 (the fuzzer turned a chunked layout into a compact one of no
+  // bytes): the HDF5 library used to copy the values from a null buffer.
+  TempDir d;
+  const std::string py = d.file("w.py"), h5 = d.file("c.h5");
+  writeBytes(py,
+             "import sys, numpy as np, h5py\n"
+             "with h5py.File(sys.argv[1], 'w') as f:\n"
+             "    n = 60\n"
+             "    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)\n"
+             "    dcpl.set_layout(h5py.h5d.COMPACT)\n"
+             "    g = f.create_group('events')\n"
+             "    x = np.arange(n, dtype=np.uint16) + 0x4100\n"
+             "    h5py.h5d.create(g.id, b'x', h5py.h5t.STD_U16LE, h5py.h5s.create_simple((n,)), dcpl=dcpl)"
+             ".write(h5py.h5s.ALL, h5py.h5s.ALL, x)\n"
+             "    g['y'] = np.zeros(n, np.uint16); g['t'] = np.arange(n, dtype=np.uint32); g['p'] = np.ones(n, np.uint8)\n");
+  if (std::system(("/usr/bin/python3 '" + py + "' '" + h5 + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
+  std::string b = readBytes(h5);
+  // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
+  const std::string head("\x03\x00\x78\x00\x00\x41\x01\x41", 8);
+  const std::size_t at = b.find(head);
+  ASSERT_NE(at, std::string::npos);
+  b[at + 2] = '\0';
+  writeBytes(h5, b);
+  EXPECT_IO_ERROR(celc::test::drain(h5), "c.h5: dataset /events/x: compact data of 0 bytes for 120 bytes of values",
+                  "(damaged file)");
 }
