@@ -118,9 +118,9 @@ class Aedat4Reader final : public EventReader {
       f_.fail(hdr_at, "data table position " + std::to_string(table_pos_) + " outside the file");
     if (table_pos_ >= 0 && std::uint64_t(table_pos_) >= f_.size()) {
       // the file was cut before its data table: read the packets that are there
-      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(hdr_at) + ": the data table at byte " +
-                                           std::to_string(table_pos_) + " is beyond the end of the file at byte " +
-                                           std::to_string(f_.size()) + ": truncated, read without the table");
+      warnTruncated(f_.size(), path_ + ": byte " + std::to_string(hdr_at) + ": the data table at byte " +
+                                   std::to_string(table_pos_) + " is beyond the end of the file at byte " +
+                                   std::to_string(f_.size()) + ": truncated, read without the table");
       table_pos_ = -1;
     }
     streams_ = parseStreams(xml);
@@ -189,9 +189,9 @@ class Aedat4Reader final : public EventReader {
   /// The file ends inside the packet at `at`: the complete packets before it are
   /// read; a counted warning (an error with `strict`) names both bytes.
   void truncatedAt(std::uint64_t at, const std::string& what) {
-    warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) + ": " + what +
-                                         " cut by the end of the file at byte " + std::to_string(f_.size()) +
-                                         ": truncated, ignored");
+    warnTruncated(f_.size(), path_ + ": byte " + std::to_string(at) + ": " + what +
+                                 " cut by the end of the file at byte " + std::to_string(f_.size()) +
+                                 ": truncated, ignored");
     f_.seek(f_.size());
   }
   std::uint64_t end_of_packets() const { return table_pos_ >= 0 ? std::uint64_t(table_pos_) : f_.size(); }
