@@ -49,6 +49,25 @@ void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
 }
 
+/// Writes `path` with a Python script given h5py (`f`, the file open for
+/// writing) and numpy (`np`); false when Debian's python3-h5py is missing.
+bool writeWithH5py(const TempDir& d, const std::string& path, const std::string& body) {
+  const std::string py = d.file("write_h5.py");
+  writeBytes(py, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
+  return std::system(("/usr/bin/python3 '" + py + "' '" + path + "' 2>/dev/null").c_str()) == 0;
+}
+
+/// Sets byte `offset` of the one place `pattern` stands in the file at `path`
+/// to `value`; false when the pattern stands there not exactly once.
+bool patchUnique(const std::string& path, const std::string& pattern, std::size_t offset, char value) {
+  std::string b = readBytes(path);
+  const std::size_t at = b.find(pattern);
+  if (at == std::string::npos || b.find(pattern, at + 1) != std::string::npos) return false;
+  b[at + offset] = value;
+  writeBytes(path, b);
+  return true;
+}
+
 ReaderOptions strictOptions() {
   ReaderOptions o;
   o.strict = true;
@@ -429,23 +448,14 @@ TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
   // 16 -> 199 (the fuzzer's change): the HDF5 library used to copy 6368 bytes
   // out of each 512-byte chunk buffer (a heap overflow inside libhdf5).
   TempDir d;
-  const std::string py = d.file("w.py"), h5 = d.file("m.h5");
-  writeBytes(py,
-             "import sys, numpy as np, h5py\n"
-             "with h5py.File(sys.argv[1], 'w') as f:\n"
-             "    ev = np.zeros((60, 4)); ev[:, 2] = 1.0 + np.arange(60) * 1e-5; ev[:, 3] = 1.0\n"
-             "    f.create_dataset('davis/left/events', data=ev, chunks=(16, 4))\n");
-  if (std::system(("/usr/bin/python3 '" + py + "' '" + h5 + "' 2>/dev/null").c_str()) != 0)
+  const std::string h5 = d.file("m.h5");
+  if (!writeWithH5py(d, h5,
+                     "    ev = np.zeros((60, 4)); ev[:, 2] = 1.0 + np.arange(60) * 1e-5; ev[:, 3] = 1.0\n"
+                     "    f.create_dataset('davis/left/events', data=ev, chunks=(16, 4))\n"))
     GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
-  std::string b = readBytes(h5);
   // the layout message's dimensions: chunk rows, columns, then the element size (uint32 each)
-  const std::string dims("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12);
-  const std::size_t at = b.find(dims);
-  ASSERT_NE(at, std::string::npos);
-  ASSERT_EQ(b.find(dims, at + 1), std::string::npos);
-  b[at] = char(199);
-  writeBytes(h5, b);
+  ASSERT_TRUE(patchUnique(h5, std::string("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12), 0, char(199)));
   EXPECT_IO_ERROR(celc::test::drain(h5), "m.h5: dataset /davis/left/events: chunk 0 at byte",
                   "holds 512 bytes, an unfiltered chunk of its layout 6368 (damaged file)");
 }
@@ -456,28 +466,20 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
   // 120 -> 0 (the fuzzer turned a chunked layout into a compact one of no
   // bytes): the HDF5 library used to copy the values from a null buffer.
   TempDir d;
-  const std::string py = d.file("w.py"), h5 = d.file("c.h5");
-  writeBytes(py,
-             "import sys, numpy as np, h5py\n"
-             "with h5py.File(sys.argv[1], 'w') as f:\n"
-             "    n = 60\n"
-             "    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)\n"
-             "    dcpl.set_layout(h5py.h5d.COMPACT)\n"
-             "    g = f.create_group('events')\n"
-             "    x = np.arange(n, dtype=np.uint16) + 0x4100\n"
-             "    h5py.h5d.create(g.id, b'x', h5py.h5t.STD_U16LE, h5py.h5s.create_simple((n,)), dcpl=dcpl)"
-             ".write(h5py.h5s.ALL, h5py.h5s.ALL, x)\n"
-             "    g['y'] = np.zeros(n, np.uint16); g['t'] = np.arange(n, dtype=np.uint32); g['p'] = np.ones(n, np.uint8)\n");
-  if (std::system(("/usr/bin/python3 '" + py + "' '" + h5 + "' 2>/dev/null").c_str()) != 0)
+  const std::string h5 = d.file("c.h5");
+  if (!writeWithH5py(d, h5,
+                     "    n = 60\n"
+                     "    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)\n"
+                     "    dcpl.set_layout(h5py.h5d.COMPACT)\n"
+                     "    g = f.create_group('events')\n"
+                     "    x = np.arange(n, dtype=np.uint16) + 0x4100\n"
+                     "    h5py.h5d.create(g.id, b'x', h5py.h5t.STD_U16LE, h5py.h5s.create_simple((n,)), dcpl=dcpl)"
+                     ".write(h5py.h5s.ALL, h5py.h5s.ALL, x)\n"
+                     "    g['y'] = np.zeros(n, np.uint16); g['t'] = np.arange(n, dtype=np.uint32); g['p'] = np.ones(n, np.uint8)\n"))
     GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
-  std::string b = readBytes(h5);
   // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
-  const std::string head("\x03\x00\x78\x00\x00\x41\x01\x41", 8);
-  const std::size_t at = b.find(head);
-  ASSERT_NE(at, std::string::npos);
-  b[at + 2] = '\0';
-  writeBytes(h5, b);
+  ASSERT_TRUE(patchUnique(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, '\0'));
   EXPECT_IO_ERROR(celc::test::drain(h5), "c.h5: dataset /events/x: compact data of 0 bytes for 120 bytes of values",
                   "(damaged file)");
 }
