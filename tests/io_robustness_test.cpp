@@ -49,12 +49,16 @@ void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
 }
 
-/// Writes `path` with a Python script given h5py (`f`, the file open for
-/// writing) and numpy (`np`); false when Debian's python3-h5py is missing.
-bool writeWithH5py(const TempDir& d, const std::string& path, const std::string& body) {
-  const std::string py = d.file("write_h5.py");
-  writeBytes(py, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
+/// Writes `path` with a Python script (its sys.argv[1]) run by Debian's
+/// python3; false when it fails (a module such as python3-h5py missing).
+bool writeWithPython(const TempDir& d, const std::string& path, const std::string& script) {
+  const std::string py = d.file("write.py");
+  writeBytes(py, script);
   return std::system(("/usr/bin/python3 '" + py + "' '" + path + "' 2>/dev/null").c_str()) == 0;
+}
+/// The same with h5py (`f`, the file open for writing) and numpy (`np`).
+bool writeWithH5py(const TempDir& d, const std::string& path, const std::string& body) {
+  return writeWithPython(d, path, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
 }
 
 /// Sets byte `offset` of the one place `pattern` stands in the file at `path`
@@ -482,4 +486,52 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
   ASSERT_TRUE(patchUnique(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, '\0'));
   EXPECT_IO_ERROR(celc::test::drain(h5), "c.h5: dataset /events/x: compact data of 0 bytes for 120 bytes of values",
                   "(damaged file)");
+}
+
+// ---- found by fuzz_rosbag: a connection header whose field length runs past its data ---
+
+TEST(IoRobustness, BagConnectionHeaderFieldBeyondItsDataIsAnError) {
+  // A bag with one std_msgs/String message (python3-rosbag); then, in the index
+  // section, the length of the connection header's `topic=/t` field 8 ->
+  // 0x7FFFFFF0: the bag library copied that many bytes out of its buffer while
+  // opening the bag (a heap overflow inside librosbag-storage).
+  TempDir d;
+  const std::string bag = d.file("c.bag");
+  if (!writeWithPython(d, bag,
+                       "import sys, genpy, genpy.dynamic, rosbag\n"
+                       "S = genpy.dynamic.generate_dynamic('std_msgs/String', 'string data\\n')['std_msgs/String']\n"
+                       "with rosbag.Bag(sys.argv[1], 'w') as b:\n"
+                       "    m = S(); m.data = 'hello'\n"
+                       "    b.write('/t', m, genpy.Time(1, 0))\n"))
+    GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
+  EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
+  std::string b = readBytes(bag);
+  const std::string field("\x08\x00\x00\x00topic=/t", 12);
+  const std::size_t at = b.rfind(field);  // the index section's copy (the chunk holds the other)
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_NE(b.find(field), at);
+  putLE32(b, at, 0x7FFFFFF0);
+  writeBytes(bag, b);
+  EXPECT_IO_ERROR(celc::test::drain(bag), "c.bag: byte ",
+                  "connection record data: field of 2147483632 bytes beyond its end");
+}
+
+// ---- found by fuzz_aedat4_zstd: a Zstd frame asking for a huge window -------------
+
+TEST(IoRobustness, Aedat4ZstdFrameWithAHugeWindowIsAnErrorNotAnAllocation) {
+  // The first Zstd frame with a 2-byte content size (header 0x60) is given a
+  // header without one and the window descriptor 0xA0 (2^30 bytes): zstd used
+  // to allocate the window (the fuzzer's frame: 98 MB from a 1.4 KB file).
+  TempDir d;
+  auto ev = celc::test::randomEvents(600, 240, 180, 6, 3.0);
+  writeAedat4(d.file("z.aedat4"), ev, {}, 240, 180, Aedat4Compression::Zstd, 200, false);
+  EXPECT_EQ(celc::test::drain(d.file("z.aedat4")), 600u);
+  std::string b = readBytes(d.file("z.aedat4"));
+  const std::size_t at = b.find(std::string("\x28\xb5\x2f\xfd\x60", 5));
+  ASSERT_NE(at, std::string::npos);
+  b[at + 4] = '\x00';
+  b[at + 5] = '\xA0';
+  writeBytes(d.file("z.aedat4"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("z.aedat4")), "z.aedat4: byte ",
+                  "corrupt Zstd frame: Frame requires too much memory for decoding");
 }

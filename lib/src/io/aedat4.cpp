@@ -24,6 +24,10 @@
 namespace celc::detail {
 namespace {
 
+/// Largest Zstd window a packet may ask for: 2^25 = 32 MB (zstd's default limit
+/// is 2^27; a window is allocated whole before any byte is decoded).
+constexpr int kZstdWindowLogMax = 25;
+
 struct StreamInfo {
   int id = -1;
   std::string type;
@@ -264,6 +268,10 @@ class Aedat4Reader final : public EventReader {
     // Zstd
     ZSTD_DStream* ds = ZSTD_createDStream();
     ZSTD_initDStream(ds);
+    // The frame header sizes the decoder's window (up to 128 MB by default):
+    // bound it like the packet (a DV packet's frame fits its content). Found by
+    // the aedat4_zstd fuzz target: a 98 MB window from a 3 KB file.
+    ZSTD_DCtx_setParameter(ds, ZSTD_d_windowLogMax, kZstdWindowLogMax);
     ZSTD_inBuffer ib{in.data(), in.size(), 0};
     out_.resize(std::min(cap, std::max<std::size_t>(in.size() * 4, 1 << 16)));
     std::size_t used = 0;
