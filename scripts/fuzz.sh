@@ -105,6 +105,7 @@ for t in "${targets[@]}"; do
   echo "fuzz: $t for $seconds s" >&2
   start=$(date +%s)
   set +e
+  LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp}" \
   ASAN_OPTIONS="${ASAN_OPTIONS:-allocator_may_return_null=0:detect_leaks=1}" \
   UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
     nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb="$rss" \
