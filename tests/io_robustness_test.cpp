@@ -535,3 +535,14 @@ TEST(IoRobustness, Aedat4ZstdFrameWithAHugeWindowIsAnErrorNotAnAllocation) {
   EXPECT_IO_ERROR(celc::test::drain(d.file("z.aedat4")), "z.aedat4: byte ",
                   "corrupt Zstd frame: Frame requires too much memory for decoding");
 }
+
+TEST(IoRobustness, Bag12RecordHeaderLongerThanTheFileIsAnError) {
+  // Found by the rosbag campaign: a format 1.2 bag (no index checks then) whose
+  // first record declares a 1.4 GB header; the bag library allocated it.
+  TempDir d;
+  std::string b = "#ROSBAG V1.2\n";
+  b += std::string("\x00\x00\x50\x53", 4) + "op=\x03" + std::string(40, '\0');
+  writeBytes(d.file("o.bag"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.bag")), "o.bag: byte 13: record: record header length 1397751808",
+                  "beyond the end of the file");
+}

@@ -280,6 +280,13 @@ class RosBagReader final : public EventReader {
           chunks += (chunks.empty() ? "" : ", ") + std::to_string(n) + " " + name;
         notes_.push_back("bag format 2.0, chunks: " + (chunks.empty() ? std::string("none") : chunks));
       } else if (m == "#ROSBAG V1.2\n") {
+        // The same record framing without chunks: every record's header and
+        // data within the file before the library sizes a buffer from them
+        // (a 1.4 GB header length in a 178-byte file, found by the rosbag campaign).
+        for (std::uint64_t at = 13; at < f.size();) {
+          const BagRecord r = readRecord(f, at, "record");
+          at = r.data_at + r.data_len;
+        }
         notes_.push_back("bag format 1.2 (no chunks)");
       } else {
         f.fail(0, "unsupported bag version '" + printable(m.substr(0, 12), 12) + "' (2.0, 1.2)");
