@@ -61,13 +61,19 @@ bool writeWithH5py(const TempDir& d, const std::string& path, const std::string&
   return writeWithPython(d, path, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
 }
 
-/// Sets byte `offset` of the one place `pattern` stands in the file at `path`
-/// to `value`; false when the pattern stands there not exactly once.
-bool patchUnique(const std::string& path, const std::string& pattern, std::size_t offset, char value) {
+/// Which place of a pattern patchBytes() edits.
+enum class Place { Only, First, LastOfSeveral };
+/// Overwrites the file at `path` with `bytes` from `offset` after the start of
+/// `pattern` (at its only, first, or last of at least two places); false when
+/// the pattern does not stand there that way.
+bool patchBytes(const std::string& path, const std::string& pattern, std::size_t offset, const std::string& bytes,
+                Place place = Place::Only) {
   std::string b = readBytes(path);
-  const std::size_t at = b.find(pattern);
-  if (at == std::string::npos || b.find(pattern, at + 1) != std::string::npos) return false;
-  b[at + offset] = value;
+  const std::size_t first = b.find(pattern), last = b.rfind(pattern);
+  if (first == std::string::npos || (place == Place::Only && first != last) ||
+      (place == Place::LastOfSeveral && first == last))
+    return false;
+  b.replace((place == Place::LastOfSeveral ? last : first) + offset, bytes.size(), bytes);
   writeBytes(path, b);
   return true;
 }
@@ -459,7 +465,7 @@ TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
     GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the layout message's dimensions: chunk rows, columns, then the element size (uint32 each)
-  ASSERT_TRUE(patchUnique(h5, std::string("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12), 0, char(199)));
+  ASSERT_TRUE(patchBytes(h5, std::string("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12), 0, "\xC7"));
   EXPECT_IO_ERROR(celc::test::drain(h5), "m.h5: dataset /davis/left/events: chunk 0 at byte",
                   "holds 512 bytes, an unfiltered chunk of its layout 6368 (damaged file)");
 }
@@ -483,7 +489,7 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
     GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
-  ASSERT_TRUE(patchUnique(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, '\0'));
+  ASSERT_TRUE(patchBytes(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, std::string(1, '\0')));
   EXPECT_IO_ERROR(celc::test::drain(h5), "c.h5: dataset /events/x: compact data of 0 bytes for 120 bytes of values",
                   "(damaged file)");
 }
@@ -505,13 +511,8 @@ TEST(IoRobustness, BagConnectionHeaderFieldBeyondItsDataIsAnError) {
                        "    b.write('/t', m, genpy.Time(1, 0))\n"))
     GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
   EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
-  std::string b = readBytes(bag);
-  const std::string field("\x08\x00\x00\x00topic=/t", 12);
-  const std::size_t at = b.rfind(field);  // the index section's copy (the chunk holds the other)
-  ASSERT_NE(at, std::string::npos);
-  ASSERT_NE(b.find(field), at);
-  putLE32(b, at, 0x7FFFFFF0);
-  writeBytes(bag, b);
+  // the index section's copy of the field (the chunk holds the other)
+  ASSERT_TRUE(patchBytes(bag, std::string("\x08\x00\x00\x00topic=/t", 12), 0, "\xF0\xFF\xFF\x7F", Place::LastOfSeveral));
   EXPECT_IO_ERROR(celc::test::drain(bag), "c.bag: byte ",
                   "connection record data: field of 2147483632 bytes beyond its end");
 }
@@ -526,12 +527,7 @@ TEST(IoRobustness, Aedat4ZstdFrameWithAHugeWindowIsAnErrorNotAnAllocation) {
   auto ev = celc::test::randomEvents(600, 240, 180, 6, 3.0);
   writeAedat4(d.file("z.aedat4"), ev, {}, 240, 180, Aedat4Compression::Zstd, 200, false);
   EXPECT_EQ(celc::test::drain(d.file("z.aedat4")), 600u);
-  std::string b = readBytes(d.file("z.aedat4"));
-  const std::size_t at = b.find(std::string("\x28\xb5\x2f\xfd\x60", 5));
-  ASSERT_NE(at, std::string::npos);
-  b[at + 4] = '\x00';
-  b[at + 5] = '\xA0';
-  writeBytes(d.file("z.aedat4"), b);
+  ASSERT_TRUE(patchBytes(d.file("z.aedat4"), "\x28\xb5\x2f\xfd\x60", 4, std::string("\x00\xA0", 2), Place::First));
   EXPECT_IO_ERROR(celc::test::drain(d.file("z.aedat4")), "z.aedat4: byte ",
                   "corrupt Zstd frame: Frame requires too much memory for decoding");
 }
