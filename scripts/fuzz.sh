@@ -1,56 +1,96 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz with Debian's clang (address and
 # undefined sanitizers, libFuzzer) in build-fuzz/, writes their seed corpora
-# with the project's writers, runs every target for SECONDS each and prints a
-# table: target, executions, crashes, timeouts, peak RSS.
+# with the project's writers, runs every target for SECONDS each, one process
+# at a time, and prints a table: target, executions, exec/s, crashes, timeouts,
+# peak RSS. Exit status 1 when any target crashed or timed out.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 30 s, every target)
+#   scripts/fuzz.sh --build-only                          (install, build, seeds; no run)
 # Environment: CELC_FUZZ_BUILD_DIR (default build-fuzz), CELC_JOBS (default nproc),
 #   CELC_FUZZ_RSS_MB (default 1024), CELC_FUZZ_MALLOC_MB (default 64: no single
-#   allocation above 64 MB), CELC_FUZZ_TIMEOUT (default 10 s per input).
+#   allocation above 64 MB), CELC_FUZZ_TIMEOUT (default 10 s per input),
+#   CELC_FUZZ_NICE (default 0: the nice level of the fuzzer processes).
 # The corpus grows in BUILD/fuzz-corpus/<target> across runs (the long campaign:
-# run it again with a larger SECONDS); findings go to BUILD/fuzz-artifacts/<target>/
-# (reproduce: BUILD/tests/fuzz/fuzz_<target> FILE).
+# run it again with a larger SECONDS; docs/fuzzing.md); findings go to
+# BUILD/fuzz-artifacts/<target>/ (reproduce: BUILD/tests/fuzz/fuzz_<target> FILE).
+# The build also makes celc_sanitize_tests (scripts/test_sanitize.sh --subset).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+build_only=0
+if [ "${1:-}" = "--build-only" ]; then
+  build_only=1
+  shift
+fi
 seconds="${1:-30}"
 shift || true
 build="${CELC_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 rss="${CELC_FUZZ_RSS_MB:-1024}"
 malloc_mb="${CELC_FUZZ_MALLOC_MB:-64}"
 timeout_s="${CELC_FUZZ_TIMEOUT:-10}"
-all_targets=(events_text rpg_sequence calibration config_yaml aedat2 aedat31 aedat4_none aedat4_lz4 aedat4_zstd)
+nice_level="${CELC_FUZZ_NICE:-0}"
+all_targets=(events_text rpg_sequence calibration config_yaml aedat2 aedat31 aedat4_none aedat4_lz4 aedat4_zstd
+             rosbag hdf5)
 targets=("$@")
 [ "${#targets[@]}" -eq 0 ] && targets=("${all_targets[@]}")
 
-# clang with libFuzzer (Debian: clang, and libclang-rt-<version>-dev for the runtime)
-need=()
-command -v clang++ >/dev/null || need+=(clang)
-if [ "${#need[@]}" -gt 0 ] || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
-  sudo_cmd=()
-  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+# clang with libFuzzer (Debian: clang, and libclang-rt-<version>-dev for the
+# runtime); the bag seeds' writer (tests/fixtures/make_fixtures.py) needs
+# python3-rosbag, python3-h5py and python3-numpy.
+sudo_cmd=()
+[ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+apt_install() {
   "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends clang >&2
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "$@" >&2
+}
+if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  command -v clang++ >/dev/null || apt_install clang
   version="$(clang++ --version | sed -n 's/.*clang version \([0-9]*\).*/\1/p' | head -1)"
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
-    "libclang-rt-${version}-dev" >&2
+  apt_install "libclang-rt-${version}-dev"
 fi
+/usr/bin/python3 -c 'import rosbag, h5py, numpy' 2>/dev/null || apt_install python3-rosbag python3-h5py python3-numpy
 
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCELC_FUZZ=ON \
   -DCELC_BUILD_TESTS=OFF -DCELC_BUILD_BENCHMARKS=OFF "${launcher[@]}" >&2
-cmake --build "$build" --target celc_fuzz -j "${CELC_JOBS:-$(nproc)}" >&2
+build_targets=(celc_fuzz)
+grep -q '^celc_sanitize_tests:' "$build/Makefile" 2>/dev/null && build_targets+=(celc_sanitize_tests)
+cmake --build "$build" --target "${build_targets[@]}" -j "${CELC_JOBS:-$(nproc)}" >&2
 
+# Seeds: celc_fuzz_seeds, then the bags of make_fixtures.py from its small sequence.
 seeds="$build/fuzz-seeds"
 rm -rf "$seeds"
 "$build/tests/fuzz/celc_fuzz_seeds" "$seeds" >&2
+# (it writes the bags first; its HDF5 files need 16384 events, more than the
+# small sequence has, so it stops there: the HDF5 seeds come from celc_fuzz_seeds)
+/usr/bin/python3 "$root/tests/fixtures/make_fixtures.py" "$seeds/bag_sequence" "$seeds/bag_fixtures" \
+  >"$seeds/make_fixtures.log" 2>&1 || true
+for b in seq_none seq_bz2 seq_lz4 seq_odom bad_truncated bad_unindexed bad_type; do
+  [ -f "$seeds/bag_fixtures/$b.bag" ] || { cat "$seeds/make_fixtures.log" >&2; echo "fuzz: no $b.bag" >&2; exit 1; }
+  cp "$seeds/bag_fixtures/$b.bag" "$seeds/rosbag/seed_$b"
+done
+rm -rf "$seeds/bag_sequence" "$seeds/bag_fixtures"
+[ "$build_only" -eq 1 ] && exit 0
 
 dict_of() {
   case "$1" in
     aedat2) echo "$root/tests/fuzz/aedat2.dict" ;;
     aedat31) echo "$root/tests/fuzz/aedat31.dict" ;;
     aedat4_*) echo "$root/tests/fuzz/aedat4.dict" ;;
+    rosbag) echo "$root/tests/fuzz/rosbag.dict" ;;
+    hdf5) echo "$root/tests/fuzz/hdf5.dict" ;;
     *) echo "$root/tests/fuzz/text.dict" ;;
+  esac
+}
+
+# Largest input per target: a few times its largest seed. The readers never
+# need more (the text reader holds a whole small file in one block either
+# way), and small inputs keep each execution short.
+max_len_of() {
+  case "$1" in
+    events_text|rpg_sequence|calibration) echo 4096 ;;
+    config_yaml|aedat*) echo 16384 ;;
+    *) echo 32768 ;;
   esac
 }
 
@@ -63,26 +103,33 @@ for t in "${targets[@]}"; do
   before="$(ls "$artifacts" | wc -l)"
   log="$build/fuzz-$t.log"
   echo "fuzz: $t for $seconds s" >&2
+  start=$(date +%s)
   set +e
+  LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp}" \
   ASAN_OPTIONS="${ASAN_OPTIONS:-allocator_may_return_null=0:detect_leaks=1}" \
   UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
-    "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb="$rss" -malloc_limit_mb="$malloc_mb" \
-    -timeout="$timeout_s" -max_len=65536 -dict="$(dict_of "$t")" -print_final_stats=1 \
-    -artifact_prefix="$artifacts/" "$corpus" "$seeds/$t" >"$log" 2>&1
+    nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb="$rss" \
+    -malloc_limit_mb="$malloc_mb" -timeout="$timeout_s" -max_len="$(max_len_of "$t")" -dict="$(dict_of "$t")" \
+    -print_final_stats=1 -artifact_prefix="$artifacts/" "$corpus" "$seeds/$t" >"$log" 2>&1
   rc=$?
   set -e
+  wall=$(( $(date +%s) - start ))
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)"
   peak="$(sed -n 's/^stat::peak_rss_mb: *//p' "$log" | tail -1)"
+  rate="?"
+  [ -n "$execs" ] && [ "$wall" -gt 0 ] && rate=$(( execs / wall ))
   new=$(( $(ls "$artifacts" | wc -l) - before ))
   timeouts="$(ls -t "$artifacts" | head -n "$new" | grep -c '^timeout-' || true)"
   crashes=$(( new - timeouts ))
   if [ "$rc" -ne 0 ] && [ "$new" -eq 0 ]; then crashes=$(( crashes + 1 )); fi
-  [ "$crashes" -ne 0 ] || [ "$timeouts" -ne 0 ] && status=1
-  rows+=("$(printf '| %-13s | %12s | %7s | %8s | %11s |' "$t" "${execs:-?}" "$crashes" "$timeouts" "${peak:-?} MB")")
+  if [ "$crashes" -ne 0 ] || [ "$timeouts" -ne 0 ]; then status=1; fi
+  rows+=("$(printf '| %-13s | %12s | %7s | %7s | %8s | %11s | %6s |' "$t" "${execs:-?}" "$rate" "$crashes" \
+            "$timeouts" "${peak:-?} MB" "$wall")")
 done
 
-echo "| target        |   executions | crashes | timeouts | peak RSS    |"
-echo "|---------------|--------------|---------|----------|-------------|"
+echo "| target        |   executions |  exec/s | crashes | timeouts | peak RSS    | wall s |"
+echo "|---------------|--------------|---------|---------|----------|-------------|--------|"
 printf '%s\n' "${rows[@]}"
-echo "($seconds s per target, -rss_limit_mb=$rss -malloc_limit_mb=$malloc_mb -timeout=$timeout_s; logs in $build/fuzz-<target>.log)"
+echo "($seconds s per target, -rss_limit_mb=$rss -malloc_limit_mb=$malloc_mb -timeout=$timeout_s -max_len 4096-32768;" \
+     "logs in $build/fuzz-<target>.log)"
 exit "$status"

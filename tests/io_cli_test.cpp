@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <sys/wait.h>
 
 #include "celc/io/writers.hpp"
@@ -64,4 +66,50 @@ TEST(IoCli, InfoBadFileIsOneLineErrorNonZeroExit) {
   EXPECT_NE(run(std::string(CELC_BINARY) + " info " + d.file("b.txt"), out), 0);
   EXPECT_NE(out.find("b.txt: line 2: timestamp"), std::string::npos) << out;
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+}
+
+TEST(IoCli, InfoPrintsEachWarningCountOnItsOwnLine) {
+  TempDir d;
+  // 1 ms steps with: a step back within the tolerance (kept), one beyond it (sorted
+  // or dropped), an outlier at 30 s (dropped), a pixel outside 240x180 (dropped) and
+  // a confirmed gap to 20 s (kept).
+  celc::test::writeBytes(d.file("w.txt"),
+                         "1.000 1 1 1\n1.001 2 2 0\n1.0015 3 3 1\n1.0012 4 4 1\n1.002 5 5 0\n1.000 6 6 1\n"
+                         "1.003 7 7 1\n30.0 8 8 1\n1.004 9 9 0\n1.0055 300 9 1\n1.006 10 10 1\n20.0 11 11 1\n"
+                         "20.001 12 12 0\n20.002 13 13 1\n");
+  const std::string base = std::string(CELC_BINARY) + " info --width 240 --height 180 " + d.file("w.txt");
+  std::string out;
+  ASSERT_EQ(run(base + " --backwards sort", out), 0) << out;
+  EXPECT_NE(out.find("events:        12\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("time jumps:    2 (outliers dropped 1, gaps kept 1; input.max_time_jump = 10 s)"),
+            std::string::npos) << out;
+  EXPECT_NE(out.find("backwards:     2 (kept within input.backwards_tolerance 1, sorted 1, dropped 0)"),
+            std::string::npos) << out;
+  EXPECT_NE(out.find("outside:       1 events with a pixel outside the sensor (dropped)"), std::string::npos) << out;
+  EXPECT_NE(out.find("truncated:     no\n"), std::string::npos) << out;
+  ASSERT_EQ(run(base + " --backwards drop", out), 0) << out;
+  EXPECT_NE(out.find("events:        11\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("backwards:     2 (kept within input.backwards_tolerance 1, sorted 0, dropped 1)"),
+            std::string::npos) << out;
+  // A larger bound: the outlier and the gap are ordinary steps.
+  ASSERT_EQ(run(base + " --backwards drop --max-time-jump 100", out), 0) << out;
+  EXPECT_NE(out.find("time jumps:    0 (outliers dropped 0, gaps kept 0; input.max_time_jump = 100 s)"),
+            std::string::npos) << out;
+  EXPECT_NE(run(base, out), 0);  // the default policy: the step back beyond the tolerance is an error
+  EXPECT_NE(out.find("w.txt: line 6: timestamp"), std::string::npos) << out;
+
+  // An AEDAT 2.0 file cut 3 bytes into its last 8-byte record: the byte where it ends.
+  auto ev = celc::test::randomEvents(100, 240, 180, 4, 2.0);
+  writeAedat2(d.file("cut.aedat"), ev, {});
+  std::string bytes;
+  {
+    std::ifstream in(d.file("cut.aedat"), std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  bytes.resize(bytes.size() - 5);
+  celc::test::writeBytes(d.file("cut.aedat"), bytes);
+  ASSERT_EQ(run(std::string(CELC_BINARY) + " info " + d.file("cut.aedat"), out), 0) << out;
+  EXPECT_NE(out.find("events:        99\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("truncated:     yes: the file ends at byte " + std::to_string(bytes.size()) + " inside"),
+            std::string::npos) << out;
 }

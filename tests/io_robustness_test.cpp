@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -46,6 +47,35 @@ std::string ioError(const std::function<void()>& f) {
 void putLE32(std::string& b, std::size_t at, std::int32_t v) { std::memcpy(&b[at], &v, 4); }
 void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
+}
+
+/// Writes `path` with a Python script (its sys.argv[1]) run by Debian's
+/// python3; false when it fails (a module such as python3-h5py missing).
+bool writeWithPython(const TempDir& d, const std::string& path, const std::string& script) {
+  const std::string py = d.file("write.py");
+  writeBytes(py, script);
+  return std::system(("/usr/bin/python3 '" + py + "' '" + path + "' 2>/dev/null").c_str()) == 0;
+}
+/// The same with h5py (`f`, the file open for writing) and numpy (`np`).
+bool writeWithH5py(const TempDir& d, const std::string& path, const std::string& body) {
+  return writeWithPython(d, path, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
+}
+
+/// Which place of a pattern patchBytes() edits.
+enum class Place { Only, First, LastOfSeveral };
+/// Overwrites the file at `path` with `bytes` from `offset` after the start of
+/// `pattern` (at its only, first, or last of at least two places); false when
+/// the pattern does not stand there that way.
+bool patchBytes(const std::string& path, const std::string& pattern, std::size_t offset, const std::string& bytes,
+                Place place = Place::Only) {
+  std::string b = readBytes(path);
+  const std::size_t first = b.find(pattern), last = b.rfind(pattern);
+  if (first == std::string::npos || (place == Place::Only && first != last) ||
+      (place == Place::LastOfSeveral && first == last))
+    return false;
+  b.replace((place == Place::LastOfSeveral ? last : first) + offset, bytes.size(), bytes);
+  writeBytes(path, b);
+  return true;
 }
 
 ReaderOptions strictOptions() {
@@ -418,4 +448,97 @@ TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
     expectPrintable(m);
     EXPECT_NE(m.find("c.yaml:1"), std::string::npos) << m;
   }
+}
+
+// ---- found by fuzz_hdf5: a chunk layout that disagrees with its stored chunks -------
+
+TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
+  // An MVSEC file whose events are stored in unfiltered chunks of 16 x 4 doubles
+  // (512 bytes each), written by h5py; then the layout message's chunk rows
+  // 16 -> 199 (the fuzzer's change): the HDF5 library used to copy 6368 bytes
+  // out of each 512-byte chunk buffer (a heap overflow inside libhdf5).
+  TempDir d;
+  const std::string h5 = d.file("m.h5");
+  if (!writeWithH5py(d, h5,
+                     "    ev = np.zeros((60, 4)); ev[:, 2] = 1.0 + np.arange(60) * 1e-5; ev[:, 3] = 1.0\n"
+                     "    f.create_dataset('davis/left/events', data=ev, chunks=(16, 4))\n"))
+    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
+  // the layout message's dimensions: chunk rows, columns, then the element size (uint32 each)
+  ASSERT_TRUE(patchBytes(h5, std::string("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12), 0, "\xC7"));
+  EXPECT_IO_ERROR(celc::test::drain(h5), "m.h5: dataset /davis/left/events: chunk 0 at byte",
+                  "holds 512 bytes, an unfiltered chunk of its layout 6368 (damaged file)");
+}
+
+TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
+  // A DSEC file whose /events/x is stored compact (in its object header, 60
+  // uint16 = 120 bytes), written by h5py; then the layout message's compact size
+  // 120 -> 0 (the fuzzer turned a chunked layout into a compact one of no
+  // bytes): the HDF5 library used to copy the values from a null buffer.
+  TempDir d;
+  const std::string h5 = d.file("c.h5");
+  if (!writeWithH5py(d, h5,
+                     "    n = 60\n"
+                     "    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)\n"
+                     "    dcpl.set_layout(h5py.h5d.COMPACT)\n"
+                     "    g = f.create_group('events')\n"
+                     "    x = np.arange(n, dtype=np.uint16) + 0x4100\n"
+                     "    h5py.h5d.create(g.id, b'x', h5py.h5t.STD_U16LE, h5py.h5s.create_simple((n,)), dcpl=dcpl)"
+                     ".write(h5py.h5s.ALL, h5py.h5s.ALL, x)\n"
+                     "    g['y'] = np.zeros(n, np.uint16); g['t'] = np.arange(n, dtype=np.uint32); g['p'] = np.ones(n, np.uint8)\n"))
+    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
+  // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
+  ASSERT_TRUE(patchBytes(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, std::string(1, '\0')));
+  EXPECT_IO_ERROR(celc::test::drain(h5), "c.h5: dataset /events/x: compact data of 0 bytes for 120 bytes of values",
+                  "(damaged file)");
+}
+
+// ---- found by fuzz_rosbag: a connection header whose field length runs past its data ---
+
+TEST(IoRobustness, BagConnectionHeaderFieldBeyondItsDataIsAnError) {
+  // A bag with one std_msgs/String message (python3-rosbag); then, in the index
+  // section, the length of the connection header's `topic=/t` field 8 ->
+  // 0x7FFFFFF0: the bag library copied that many bytes out of its buffer while
+  // opening the bag (a heap overflow inside librosbag-storage).
+  TempDir d;
+  const std::string bag = d.file("c.bag");
+  if (!writeWithPython(d, bag,
+                       "import sys, genpy, genpy.dynamic, rosbag\n"
+                       "S = genpy.dynamic.generate_dynamic('std_msgs/String', 'string data\\n')['std_msgs/String']\n"
+                       "with rosbag.Bag(sys.argv[1], 'w') as b:\n"
+                       "    m = S(); m.data = 'hello'\n"
+                       "    b.write('/t', m, genpy.Time(1, 0))\n"))
+    GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
+  EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
+  // the index section's copy of the field (the chunk holds the other)
+  ASSERT_TRUE(patchBytes(bag, std::string("\x08\x00\x00\x00topic=/t", 12), 0, "\xF0\xFF\xFF\x7F", Place::LastOfSeveral));
+  EXPECT_IO_ERROR(celc::test::drain(bag), "c.bag: byte ",
+                  "connection record data: field of 2147483632 bytes beyond its end");
+}
+
+// ---- found by fuzz_aedat4_zstd: a Zstd frame asking for a huge window -------------
+
+TEST(IoRobustness, Aedat4ZstdFrameWithAHugeWindowIsAnErrorNotAnAllocation) {
+  // The first Zstd frame with a 2-byte content size (header 0x60) is given a
+  // header without one and the window descriptor 0xA0 (2^30 bytes): zstd used
+  // to allocate the window (the fuzzer's frame: 98 MB from a 1.4 KB file).
+  TempDir d;
+  auto ev = celc::test::randomEvents(600, 240, 180, 6, 3.0);
+  writeAedat4(d.file("z.aedat4"), ev, {}, 240, 180, Aedat4Compression::Zstd, 200, false);
+  EXPECT_EQ(celc::test::drain(d.file("z.aedat4")), 600u);
+  ASSERT_TRUE(patchBytes(d.file("z.aedat4"), "\x28\xb5\x2f\xfd\x60", 4, std::string("\x00\xA0", 2), Place::First));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("z.aedat4")), "z.aedat4: byte ",
+                  "corrupt Zstd frame: Frame requires too much memory for decoding");
+}
+
+TEST(IoRobustness, Bag12RecordHeaderLongerThanTheFileIsAnError) {
+  // Found by the rosbag campaign: a format 1.2 bag (no index checks then) whose
+  // first record declares a 1.4 GB header; the bag library allocated it.
+  TempDir d;
+  std::string b = "#ROSBAG V1.2\n";
+  b += std::string("\x00\x00\x50\x53", 4) + "op=\x03" + std::string(40, '\0');
+  writeBytes(d.file("o.bag"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.bag")), "o.bag: byte 13: record: record header length 1397751808",
+                  "beyond the end of the file");
 }

@@ -1,6 +1,7 @@
 // `celc info FILE|DIR`: what an event recording holds.
 #include <spdlog/spdlog.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -17,6 +18,8 @@ struct InfoArgs {
   std::string imu_columns = "auto";
   double time_scale = 1.0;
   bool strict = false;
+  std::string backwards = "error";
+  double max_time_jump = ReaderOptions().max_time_jump;
   std::string topic_events, topic_imu, topic_pose;
 };
 
@@ -27,6 +30,9 @@ int runInfo(const InfoArgs& a) {
   o.imu_columns = parseImuColumns(a.imu_columns);
   o.text_time_scale = a.time_scale;
   o.strict = a.strict;
+  o.backwards = a.backwards == "sort" ? BackwardsPolicy::Sort
+                : a.backwards == "drop" ? BackwardsPolicy::Drop : BackwardsPolicy::Error;
+  o.max_time_jump = a.max_time_jump;
   o.topic_events = a.topic_events;
   o.topic_imu = a.topic_imu;
   o.topic_pose = a.topic_pose;
@@ -72,6 +78,21 @@ int runInfo(const InfoArgs& a) {
               static_cast<unsigned long long>(info.warnings.skipped_records),
               static_cast<unsigned long long>(info.warnings.time_jumps),
               static_cast<unsigned long long>(info.warnings.truncated));
+  // The same counts, one line each, with their breakdowns.
+  const ReaderWarnings& w = info.warnings;
+  const auto u = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
+  std::printf("time jumps:    %llu (outliers dropped %llu, gaps kept %llu; input.max_time_jump = %g s)\n",
+              u(w.time_jumps), u(w.time_outliers), u(w.time_jumps - w.time_outliers), o.max_time_jump);
+  std::printf("backwards:     %llu (kept within input.backwards_tolerance %llu, sorted %llu, dropped %llu)\n",
+              u(w.backwards_time), u(w.backwards_time - w.backwards_sorted - w.backwards_dropped),
+              u(w.backwards_sorted), u(w.backwards_dropped));
+  std::printf("outside:       %llu events with a pixel outside the sensor (dropped)\n", u(w.outside_sensor));
+  if (w.truncated > 0)
+    std::printf("truncated:     yes: the file ends at byte %llu inside a record or packet (ignored; the complete "
+                "ones are read)\n",
+                u(w.truncated_at));
+  else
+    std::printf("truncated:     no\n");
   for (const auto& m : info.warnings.messages) std::printf("  warning: %s\n", m.c_str());
   return 0;
 }
@@ -93,6 +114,15 @@ void registerInfo(CLI::App& app) {
   cmd->add_option("--topic-imu", args->topic_imu, "ROS bag IMU topic (default: the sensor_msgs/Imu topic)");
   cmd->add_option("--topic-pose", args->topic_pose,
                   "ROS bag pose topic (default: the geometry_msgs/PoseStamped or nav_msgs/Odometry topic)");
+  cmd->add_option("--backwards", args->backwards,
+                  "timestamps more than input.backwards_tolerance before the previous event: error | drop | sort")
+      ->check(CLI::IsMember({"error", "drop", "sort"}))
+      ->capture_default_str();
+  cmd->add_option("--max-time-jump", args->max_time_jump,
+                  "largest plausible step between events [s]: one event beyond it is an outlier (dropped), "
+                  "a confirmed one a gap (kept)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_flag("--strict", args->strict, "treat warnings (backwards timestamps, pixels outside) as errors");
   cmd->callback([args]() {
     const int rc = runInfo(*args);

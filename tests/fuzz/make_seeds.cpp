@@ -1,7 +1,14 @@
 // Writes the seed corpora of the fuzz targets with the project's own writers:
 //   celc_fuzz_seeds OUTDIR
 // gives OUTDIR/<target>/seed_* for every target of tests/fuzz (small, valid
-// inputs plus a few edge cases), so that no shared recording is needed.
+// inputs plus a few edge cases), so that no shared recording is needed. The
+// HDF5 seeds are written here with the HDF5 C library (small, unchunked,
+// chunked and deflate-compressed); the ROS bag seeds come from the bag writer
+// of the io fixtures (tests/fixtures/make_fixtures.py), which scripts/fuzz.sh
+// runs on the small sequence written to OUTDIR/bag_sequence.
+#include <hdf5.h>
+
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -47,6 +54,78 @@ void text(const fs::path& p, const std::string& s) {
   std::ofstream(p, std::ios::binary) << s;
 }
 
+/// HDF5 seed writing: one dataset of `dims` (rank 0 for a scalar), chunked
+/// by `chunk` rows when non-zero, deflate-compressed when `deflate`.
+void dataset(hid_t file, const char* name, hid_t type, const std::vector<hsize_t>& dims, const void* data,
+             hsize_t chunk = 0, bool deflate = false) {
+  const hid_t space = dims.empty() ? H5Screate(H5S_SCALAR) : H5Screate_simple(int(dims.size()), dims.data(), nullptr);
+  const hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
+  H5Pset_create_intermediate_group(lcpl, 1);
+  const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  if (chunk) {
+    std::vector<hsize_t> c = dims;
+    c[0] = chunk;
+    H5Pset_chunk(dcpl, int(c.size()), c.data());
+    if (deflate) H5Pset_deflate(dcpl, 6);
+  }
+  const hid_t d = H5Dcreate2(file, name, type, space, lcpl, dcpl, H5P_DEFAULT);
+  if (d < 0 || H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    std::cerr << "celc_fuzz_seeds: cannot write HDF5 dataset " << name << "\n";
+    std::exit(1);
+  }
+  H5Dclose(d);
+  H5Pclose(dcpl);
+  H5Pclose(lcpl);
+  H5Sclose(space);
+}
+
+/// DSEC layout: /events/{x,y,t,p}, /ms_to_idx, /t_offset (times in whole us).
+void writeDsec(const fs::path& path, const std::vector<Event>& ev, hsize_t chunk, bool deflate) {
+  const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const auto t0 = static_cast<std::int64_t>(std::llround(ev.front().t * 1e6));
+  std::vector<std::uint16_t> x, y;
+  std::vector<std::uint32_t> t;
+  std::vector<std::uint8_t> p;
+  std::vector<std::uint64_t> ms;
+  for (std::size_t i = 0; i < ev.size(); ++i) {
+    x.push_back(std::uint16_t(ev[i].x));
+    y.push_back(std::uint16_t(ev[i].y));
+    t.push_back(std::uint32_t(std::llround(ev[i].t * 1e6) - t0));
+    p.push_back(ev[i].on ? 1 : 0);
+    while (std::uint64_t(ms.size()) * 1000 <= t.back()) ms.push_back(i);
+  }
+  const std::vector<hsize_t> n{ev.size()};
+  dataset(f, "/events/x", H5T_NATIVE_UINT16, n, x.data(), chunk, deflate);
+  dataset(f, "/events/y", H5T_NATIVE_UINT16, n, y.data(), chunk, deflate);
+  dataset(f, "/events/t", H5T_NATIVE_UINT32, n, t.data(), chunk, deflate);
+  dataset(f, "/events/p", H5T_NATIVE_UINT8, n, p.data(), chunk, deflate);
+  dataset(f, "/ms_to_idx", H5T_NATIVE_UINT64, {ms.size()}, ms.data());
+  dataset(f, "/t_offset", H5T_NATIVE_INT64, {}, &t0);
+  H5Fclose(f);
+}
+
+/// MVSEC layout: /davis/left/{events (N x 4), imu (N x 6), imu_ts, pose (N x 4 x 4), pose_ts}.
+void writeMvsec(const fs::path& path, const std::vector<Event>& ev, const std::vector<ImuSample>& imu,
+                hsize_t chunk) {
+  const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  std::vector<double> rows, im, im_t, pose, pose_t;
+  for (const Event& e : ev) rows.insert(rows.end(), {double(e.x), double(e.y), e.t, e.on ? 1.0 : -1.0});
+  for (const ImuSample& s : imu) {
+    im.insert(im.end(), {s.accel.x(), s.accel.y(), s.accel.z(), s.gyro.x(), s.gyro.y(), s.gyro.z()});
+    im_t.push_back(s.t);
+  }
+  for (int k = 0; k < 3; ++k) {
+    pose.insert(pose.end(), {1, 0, 0, 0.1 * k, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1});
+    pose_t.push_back(ev.front().t + 0.001 * k);
+  }
+  dataset(f, "/davis/left/events", H5T_NATIVE_DOUBLE, {ev.size(), 4}, rows.data(), chunk);
+  dataset(f, "/davis/left/imu", H5T_NATIVE_DOUBLE, {imu.size(), 6}, im.data());
+  dataset(f, "/davis/left/imu_ts", H5T_NATIVE_DOUBLE, {imu.size()}, im_t.data());
+  dataset(f, "/davis/left/pose", H5T_NATIVE_DOUBLE, {pose_t.size(), 4, 4}, pose.data());
+  dataset(f, "/davis/left/pose_ts", H5T_NATIVE_DOUBLE, {pose_t.size()}, pose_t.data());
+  H5Fclose(f);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,7 +135,7 @@ int main(int argc, char** argv) {
   }
   const fs::path out = argv[1];
   for (const char* t : {"events_text", "rpg_sequence", "calibration", "config_yaml", "aedat2", "aedat31",
-                        "aedat4_none", "aedat4_lz4", "aedat4_zstd"})
+                        "aedat4_none", "aedat4_lz4", "aedat4_zstd", "rosbag", "hdf5", "bag_sequence"})
     fs::create_directories(out / t);
   const auto ev = events(60, 240, 180, 1, 1.0);
   const auto im = imu(ev.front().t, ev.back().t);
@@ -111,6 +190,20 @@ int main(int argc, char** argv) {
   writeAedat4((out / "aedat4_none/seed_no_table").string(), ev, im, 240, 180, Aedat4Compression::None, 30, false);
   writeAedat4((out / "aedat4_lz4/seed").string(), ev, im, 240, 180, Aedat4Compression::Lz4, 20, true);
   writeAedat4((out / "aedat4_zstd/seed").string(), ev, im, 240, 180, Aedat4Compression::Zstd, 20, true);
+
+  // HDF5: DSEC (contiguous, chunked, deflate) and MVSEC
+  writeDsec(out / "hdf5/seed_dsec", ev, 0, false);
+  writeDsec(out / "hdf5/seed_dsec_chunked", ev, 16, false);
+  writeDsec(out / "hdf5/seed_dsec_deflate", ev, 32, true);
+  writeMvsec(out / "hdf5/seed_mvsec", ev, im, 0);
+  writeMvsec(out / "hdf5/seed_mvsec_chunked", ev, im, 16);
+
+  // ROS bags: the sequence make_fixtures.py turns into bags (fuzz.sh runs it)
+  writeEventsText((out / "bag_sequence/events.txt").string(), ev);
+  writeImuText((out / "bag_sequence/imu.txt").string(), im, false);
+  writePosesText((out / "bag_sequence/groundtruth.txt").string(), poses);
+  text(out / "bag_sequence/calib.yaml",
+       "width: 240\nheight: 180\nfx: 200.0\nfy: 200.0\ncx: 120.0\ncy: 90.0\ndistortion: [-0.3, 0.1, 0.0, 0.0, 0.0]\n");
   std::cout << "seeds in " << out.string() << "\n";
   return 0;
 }

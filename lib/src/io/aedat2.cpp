@@ -288,7 +288,7 @@ class Aedat2Reader final : public EventReader {
     if (got % 8 != 0) {
       if (f_.tell() < f_.size()) f_.fail(f_.tell(), "internal: unaligned read");
       if (len_ == 0) {  // only the partial record is left: the complete ones are read
-        warn(&ReaderWarnings::truncated,
+        warnTruncated(f_.size(),
              path_ + ": byte " + std::to_string(buf_start_) + ": truncated event record: the file ends at byte " +
                  std::to_string(f_.size()) + ", " + std::to_string(got) + " trailing bytes ignored (records are 8 bytes)");
         return false;

@@ -121,9 +121,9 @@ class Aedat31Reader final : public EventReader {
     if (at == f_.size()) return false;
     unsigned char h[28];
     if (f_.size() - at < 28) {
-      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) +
-                                           ": packet header cut by the end of the file at byte " +
-                                           std::to_string(f_.size()) + ": truncated, ignored");
+      warnTruncated(f_.size(), path_ + ": byte " + std::to_string(at) +
+                                   ": packet header cut by the end of the file at byte " +
+                                   std::to_string(f_.size()) + ": truncated, ignored");
       f_.seek(f_.size());
       return false;
     }
@@ -142,9 +142,9 @@ class Aedat31Reader final : public EventReader {
                       ", capacity " + std::to_string(capacity) + ", number " + std::to_string(number) + ")");
     const std::uint64_t bytes = std::uint64_t(size) * std::uint64_t(capacity);
     if (bytes > f_.size() - f_.tell()) {  // the last packet cut by the end of the file: the complete ones are read
-      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) + ": packet of " +
-                                           std::to_string(bytes) + " bytes extends beyond the end of the file at byte " +
-                                           std::to_string(f_.size()) + ": truncated, ignored");
+      warnTruncated(f_.size(), path_ + ": byte " + std::to_string(at) + ": packet of " +
+                                   std::to_string(bytes) + " bytes extends beyond the end of the file at byte " +
+                                   std::to_string(f_.size()) + ": truncated, ignored");
       f_.seek(f_.size());
       return false;
     }

@@ -24,6 +24,10 @@
 namespace celc::detail {
 namespace {
 
+/// Largest Zstd window a packet may ask for: 2^25 = 32 MB (zstd's default limit
+/// is 2^27; a window is allocated whole before any byte is decoded).
+constexpr int kZstdWindowLogMax = 25;
+
 struct StreamInfo {
   int id = -1;
   std::string type;
@@ -118,9 +122,9 @@ class Aedat4Reader final : public EventReader {
       f_.fail(hdr_at, "data table position " + std::to_string(table_pos_) + " outside the file");
     if (table_pos_ >= 0 && std::uint64_t(table_pos_) >= f_.size()) {
       // the file was cut before its data table: read the packets that are there
-      warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(hdr_at) + ": the data table at byte " +
-                                           std::to_string(table_pos_) + " is beyond the end of the file at byte " +
-                                           std::to_string(f_.size()) + ": truncated, read without the table");
+      warnTruncated(f_.size(), path_ + ": byte " + std::to_string(hdr_at) + ": the data table at byte " +
+                                   std::to_string(table_pos_) + " is beyond the end of the file at byte " +
+                                   std::to_string(f_.size()) + ": truncated, read without the table");
       table_pos_ = -1;
     }
     streams_ = parseStreams(xml);
@@ -189,9 +193,9 @@ class Aedat4Reader final : public EventReader {
   /// The file ends inside the packet at `at`: the complete packets before it are
   /// read; a counted warning (an error with `strict`) names both bytes.
   void truncatedAt(std::uint64_t at, const std::string& what) {
-    warn(&ReaderWarnings::truncated, path_ + ": byte " + std::to_string(at) + ": " + what +
-                                         " cut by the end of the file at byte " + std::to_string(f_.size()) +
-                                         ": truncated, ignored");
+    warnTruncated(f_.size(), path_ + ": byte " + std::to_string(at) + ": " + what +
+                                 " cut by the end of the file at byte " + std::to_string(f_.size()) +
+                                 ": truncated, ignored");
     f_.seek(f_.size());
   }
   std::uint64_t end_of_packets() const { return table_pos_ >= 0 ? std::uint64_t(table_pos_) : f_.size(); }
@@ -264,6 +268,10 @@ class Aedat4Reader final : public EventReader {
     // Zstd
     ZSTD_DStream* ds = ZSTD_createDStream();
     ZSTD_initDStream(ds);
+    // The frame header sizes the decoder's window (up to 128 MB by default):
+    // bound it like the packet (a DV packet's frame fits its content). Found by
+    // the aedat4_zstd fuzz target: a 98 MB window from a 3 KB file.
+    ZSTD_DCtx_setParameter(ds, ZSTD_d_windowLogMax, kZstdWindowLogMax);
     ZSTD_inBuffer ib{in.data(), in.size(), 0};
     out_.resize(std::min(cap, std::max<std::size_t>(in.size() * 4, 1 << 16)));
     std::size_t used = 0;

@@ -128,6 +128,11 @@ void EventReader::warn(std::uint64_t ReaderWarnings::*counter, const std::string
   if (warnings_.messages.size() < 20) warnings_.messages.push_back(m);
 }
 
+void EventReader::warnTruncated(std::uint64_t file_end, const std::string& message) {
+  warn(&ReaderWarnings::truncated, message);
+  warnings_.truncated_at = file_end;
+}
+
 void EventReader::outsideSensor(const std::string& where, double x, double y) {
   char px[96];
   std::snprintf(px, sizeof px, "pixel (%g, %g) outside the %dx%d sensor", x, y, width_, height_);
@@ -160,6 +165,7 @@ void EventReader::accept(std::vector<Event>& out, const Event& e) {
       warn(&ReaderWarnings::backwards_time,
            path_ + ": an event at " + std::to_string(first.t) + " s arrived more than " +
                std::to_string(kSortBufferEvents) + " events late for the sort buffer: dropped");
+      ++warnings_.backwards_dropped;
       return;
     }
     emitted_any_ = true;
@@ -188,6 +194,7 @@ void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::
                     "outlier dropped (input.max_time_jump = %g s)",
                     held_.t, held_.t - prev_t_, J);
       warn(&ReaderWarnings::time_jumps, held_where_ + msg);
+      ++warnings_.time_outliers;
     }
   }
   const double d = e.t - prev_t_;
@@ -204,6 +211,7 @@ void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::
                     beyond ? "sorted" : "kept");
       warn(&ReaderWarnings::backwards_time, where + msg);
       if (beyond) {  // sort mode: keep the running maximum as the reference
+        ++warnings_.backwards_sorted;
         const double keep = prev_t_;
         accept(out, e);
         prev_t_ = keep;
@@ -215,6 +223,7 @@ void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::
     if (options_.backwards == BackwardsPolicy::Drop) {
       std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the previous event: dropped", e.t, -d);
       warn(&ReaderWarnings::backwards_time, where + msg);
+      ++warnings_.backwards_dropped;
       return;
     }
     std::snprintf(msg, sizeof msg,

@@ -82,10 +82,6 @@ class Hdf5Reader final : public EventReader {
       }
       notes_.push_back("HDF5 layout DSEC: /events/{x,y,t,p}" + std::string(exists("/ms_to_idx") ? ", /ms_to_idx" : "") +
                        ", t_offset " + std::to_string(t_offset_us_) + " us");
-      x_.resize(kBlockEvents);
-      y_.resize(kBlockEvents);
-      t_.resize(kBlockEvents);
-      p_.resize(kBlockEvents);
     } else if (exists("/davis/left/events")) {
       layout_ = Layout::Mvsec;
       mvsec_ = open("/davis/left/events", 2);
@@ -95,12 +91,21 @@ class Hdf5Reader final : public EventReader {
       notes_.push_back(std::string("HDF5 layout MVSEC: /davis/left/events") +
                        (exists("/davis/left/imu") ? ", /davis/left/imu" : "") +
                        (exists("/davis/left/pose") ? ", /davis/left/pose" : ""));
-      rows_.resize(kBlockEvents * 4);
     } else {
       throw IoError(path + ": neither the DSEC layout (/events/x, /events/y, /events/t, /events/p) nor the MVSEC "
                            "layout (/davis/left/events) is in the file");
     }
     notes_.push_back(std::to_string(count_) + " events in the file");
+    // The block buffers: a small file needs no block of kBlockEvents (2 MB for MVSEC).
+    const std::size_t block = std::size_t(std::min<hsize_t>(kBlockEvents, count_));
+    if (layout_ == Layout::Dsec) {
+      x_.resize(block);
+      y_.resize(block);
+      t_.resize(block);
+      p_.resize(block);
+    } else {
+      rows_.resize(block * 4);
+    }
     width_ = o.width;
     height_ = o.height;
   }
@@ -211,7 +216,23 @@ class Hdf5Reader final : public EventReader {
     // A filtered (compressed) dataset whose filter is not available cannot be read: say which.
     H5Id plist(H5Dget_create_plist(d.id.get()), H5Pclose);
     // A chunk is decompressed whole: its size is bounded like an AEDAT packet.
-    if (plist.valid() && rank > 0 && H5Pget_layout(plist.get()) == H5D_CHUNKED) {
+    const int nf = plist.valid() ? H5Pget_nfilters(plist.get()) : 0;
+    // Compact (in the header) and contiguous data are stored whole: a stored
+    // size other than the dataset's makes the HDF5 library copy from a buffer
+    // too small or absent (found by the hdf5 fuzz target). Contiguous data not
+    // yet written (size 0) reads as fill values.
+    const H5D_layout_t layout = plist.valid() ? H5Pget_layout(plist.get()) : H5D_LAYOUT_ERROR;
+    if (layout == H5D_COMPACT || layout == H5D_CONTIGUOUS) {
+      H5Id type(H5Dget_type(d.id.get()), H5Tclose);
+      double need = type.valid() ? double(H5Tget_size(type.get())) : 0.0;
+      for (hsize_t n : d.dims) need *= double(n);
+      const double stored = double(H5Dget_storage_size(d.id.get()));
+      if (stored != need && !(layout == H5D_CONTIGUOUS && stored == 0.0))
+        fail(name, std::string(layout == H5D_COMPACT ? "compact" : "contiguous") + " data of " +
+                       std::to_string(std::uint64_t(stored)) + " bytes for " + std::to_string(std::uint64_t(need)) +
+                       " bytes of values (damaged file)");
+    }
+    if (plist.valid() && rank > 0 && layout == H5D_CHUNKED) {
       std::vector<hsize_t> chunk(std::size_t(rank), 0);
       H5Id type(H5Dget_type(d.id.get()), H5Tclose);
       double bytes = type.valid() ? double(H5Tget_size(type.get())) : 8.0;
@@ -220,8 +241,27 @@ class Hdf5Reader final : public EventReader {
       if (bytes > double(options_.max_packet_bytes))
         fail(name, "chunks of " + std::to_string(std::uint64_t(bytes)) +
                        " bytes, more than input.max_packet_bytes = " + std::to_string(options_.max_packet_bytes));
+      // An unfiltered chunk is stored whole: a stored size that differs from
+      // the chunk's (a damaged layout or chunk index) makes the HDF5 library
+      // copy beyond its own buffer (found by the hdf5 fuzz target).
+      hsize_t n = 0;
+      if (nf == 0) {
+        if (H5Dget_num_chunks(d.id.get(), d.space.get(), &n) < 0)
+          fail(name, "its chunk index cannot be read (damaged file)");
+        std::vector<hsize_t> offset(std::size_t(rank), 0);
+        for (hsize_t i = 0; i < n; ++i) {
+          unsigned mask = 0;
+          haddr_t addr = 0;
+          hsize_t stored = 0;
+          if (H5Dget_chunk_info(d.id.get(), d.space.get(), i, offset.data(), &mask, &addr, &stored) < 0)
+            fail(name, "chunk " + std::to_string(i) + ": its index cannot be read (damaged file)");
+          if (double(stored) != bytes)
+            fail(name, "chunk " + std::to_string(i) + " at byte " + std::to_string(addr) + " holds " +
+                           std::to_string(stored) + " bytes, an unfiltered chunk of its layout " +
+                           std::to_string(std::uint64_t(bytes)) + " (damaged file)");
+        }
+      }
     }
-    const int nf = plist.valid() ? H5Pget_nfilters(plist.get()) : 0;
     for (int i = 0; i < nf; ++i) {
       unsigned flags = 0, cd[8];
       std::size_t ncd = 8;

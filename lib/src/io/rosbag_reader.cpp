@@ -89,6 +89,21 @@ BagRecord readRecord(BinFile& f, std::uint64_t at, const char* what) {
   return r;
 }
 
+/// Where the "len, name=value" fields of a header held in [p, end) go wrong:
+/// "" when each lies inside it and has its '='. The bag library parses a
+/// connection record's data this way and copies before it checks a length.
+std::string badHeaderFields(const unsigned char* p, const unsigned char* end) {
+  while (p < end) {
+    if (end - p < 4) return "cut field length";
+    const auto flen = loadLE<std::uint32_t>(p);
+    p += 4;
+    if (flen > std::uint64_t(end - p)) return "field of " + std::to_string(flen) + " bytes beyond its end";
+    if (!std::memchr(p, '=', flen)) return "field without '='";
+    p += flen;
+  }
+  return {};
+}
+
 /// The records of one decompressed chunk (offset -> op): each header's fields
 /// and each data length must lie inside the chunk.
 std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64_t chunk_at,
@@ -123,6 +138,9 @@ std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64
     if (dlen > b.size() - p) bad(start, "data of " + std::to_string(dlen) + " bytes beyond the chunk's end");
     p += dlen;
     if (op != 0x02 && op != 0x07) bad(start, "op " + std::to_string(int(op)) + " inside a chunk");
+    if (op == 0x07)
+      if (const std::string e = badHeaderFields(b.data() + p - dlen, b.data() + p); !e.empty())
+        bad(start, "connection data: " + e);
     ops[std::uint32_t(start)] = op;
   }
   return ops;
@@ -150,8 +168,17 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
   std::uint32_t conns = 0;
   for (std::uint64_t at = index_pos; at < f.size();) {
     const BagRecord r = readRecord(f, at, "index record");
-    if (r.op() == 0x07) ++conns;
-    else if (r.op() == 0x06) {
+    if (r.op() == 0x07) {
+      ++conns;
+      // its data is the connection header (topic, type, md5sum, definition): found by the rosbag fuzz target
+      if (r.data_len > kMaxRecordHeaderBytes)
+        f.fail(at, "connection record data of " + std::to_string(r.data_len) + " bytes");
+      std::vector<unsigned char> data(r.data_len);
+      f.seek(r.data_at);
+      f.readExact(data.data(), data.size(), "connection record data");
+      if (const std::string e = badHeaderFields(data.data(), data.data() + data.size()); !e.empty())
+        f.fail(r.data_at, "connection record data: " + e + kReindexHint);
+    } else if (r.op() == 0x06) {
       std::uint64_t chunk_pos = 0;
       if (!r.value("chunk_pos", chunk_pos) || chunk_pos < head.data_at || chunk_pos >= index_pos)
         f.fail(at, "chunk info without a chunk position inside the file");
@@ -253,6 +280,13 @@ class RosBagReader final : public EventReader {
           chunks += (chunks.empty() ? "" : ", ") + std::to_string(n) + " " + name;
         notes_.push_back("bag format 2.0, chunks: " + (chunks.empty() ? std::string("none") : chunks));
       } else if (m == "#ROSBAG V1.2\n") {
+        // The same record framing without chunks: every record's header and
+        // data within the file before the library sizes a buffer from them
+        // (a 1.4 GB header length in a 178-byte file, found by the rosbag campaign).
+        for (std::uint64_t at = 13; at < f.size();) {
+          const BagRecord r = readRecord(f, at, "record");
+          at = r.data_at + r.data_len;
+        }
         notes_.push_back("bag format 1.2 (no chunks)");
       } else {
         f.fail(0, "unsupported bag version '" + printable(m.substr(0, 12), 12) + "' (2.0, 1.2)");

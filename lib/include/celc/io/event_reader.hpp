@@ -121,6 +121,11 @@ struct ReaderWarnings {
   std::uint64_t skipped_records = 0;  ///< unknown event types / special events skipped
   std::uint64_t time_jumps = 0;       ///< outlier timestamps dropped and gaps beyond max_time_jump
   std::uint64_t truncated = 0;        ///< a final packet / record cut by the end of the file
+  // Breakdowns of the counts above (not added again by total()):
+  std::uint64_t backwards_sorted = 0;   ///< of backwards_time: beyond the tolerance, reordered (input.backwards: sort)
+  std::uint64_t backwards_dropped = 0;  ///< of backwards_time: dropped (input.backwards: drop; too late for the sort buffer)
+  std::uint64_t time_outliers = 0;      ///< of time_jumps: single outlier timestamps dropped (the others: gaps, kept)
+  std::uint64_t truncated_at = 0;       ///< with `truncated`: the byte where the file ends
   std::vector<std::string> messages;  ///< up to 20 first messages
   std::uint64_t total() const {
     return backwards_time + outside_sensor + skipped_records + time_jumps + truncated;
@@ -164,6 +169,9 @@ class EventReader {
   /// Counts a warning and keeps its message (printable, one line); with
   /// `strict` it is an IoError instead.
   void warn(std::uint64_t ReaderWarnings::*counter, const std::string& message);
+  /// A record or packet cut by the end of the file at byte `file_end`: counted
+  /// in `truncated` with that byte kept (an error with `strict`).
+  void warnTruncated(std::uint64_t file_end, const std::string& message);
   /// An event whose pixel is outside the sensor: counted; an IoError once more
   /// than max_outside_share of the events read are outside. `where` is
   /// "FILE: line N" / "FILE: byte N".
