@@ -9,7 +9,9 @@
 # Environment: CELC_FUZZ_BUILD_DIR (default build-fuzz), CELC_JOBS (default nproc),
 #   CELC_FUZZ_RSS_MB (default 1024), CELC_FUZZ_MALLOC_MB (default 64: no single
 #   allocation above 64 MB), CELC_FUZZ_TIMEOUT (default 10 s per input),
-#   CELC_FUZZ_NICE (default 0: the nice level of the fuzzer processes).
+#   CELC_FUZZ_NICE (default 0: the nice level of the fuzzer processes),
+#   CELC_FUZZ_SEED (default 0: libFuzzer picks one; CI sets 1, so that its run
+#   repeats the same mutations).
 # The corpus grows in BUILD/fuzz-corpus/<target> across runs (the long campaign:
 # run it again with a larger SECONDS; docs/fuzzing.md); findings go to
 # BUILD/fuzz-artifacts/<target>/ (reproduce: BUILD/tests/fuzz/fuzz_<target> FILE).
@@ -110,7 +112,7 @@ for t in "${targets[@]}"; do
   UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
     nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb="$rss" \
     -malloc_limit_mb="$malloc_mb" -timeout="$timeout_s" -max_len="$(max_len_of "$t")" -dict="$(dict_of "$t")" \
-    -print_final_stats=1 -artifact_prefix="$artifacts/" "$corpus" "$seeds/$t" >"$log" 2>&1
+    -seed="${CELC_FUZZ_SEED:-0}" -print_final_stats=1 -artifact_prefix="$artifacts/" "$corpus" "$seeds/$t" >"$log" 2>&1
   rc=$?
   set -e
   wall=$(( $(date +%s) - start ))
