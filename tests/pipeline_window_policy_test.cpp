@@ -164,6 +164,47 @@ TEST(WindowPolicy, JoinerShrinksWhenTheMotionSpeedsUp) {
   EXPECT_GE(joiner.translationPx(), o.target_px);
 }
 
+// A probe that finds no D on a longer window (fast motion ends the clusters
+// early, or its subsample is too sparse to cluster) does not grow the window
+// to max_seconds: after a finite D the window keeps the length aimed at from
+// it, and a warm start that cannot be measured is measured again from
+// min_seconds.
+TEST(WindowPolicy, JoinerStopsGrowingWhenALongerWindowCannotBeMeasured) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(60000, 240, 180, 5, 1.0);  // ~0.6 s
+  writeEventsText(d.file("e.txt"), ev);
+  auto reader = openEventSource(d.file("e.txt"));
+  WindowOptions steps;
+  steps.seconds_per_window = 0.025;
+  steps.keep_partial = true;
+  WindowSource source(*reader, steps);
+  ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s
+  std::vector<double> probed;
+  // 200 px/s, but nothing measurable beyond 0.1 s.
+  ParallaxWindowJoiner joiner(source, o, 0.5, [&](double t0, double t1, const std::vector<Event>&) {
+    probed.push_back(t1 - t0);
+    return t1 - t0 > 0.1 + 1e-9 ? NAN : 200.0 * (t1 - t0);
+  });
+  EventWindow w;
+  ASSERT_TRUE(joiner.next(w));
+  EXPECT_NEAR(w.t1 - w.t0, 0.125, 1e-9);  // aimed at from 10 px in 0.05 s, not 0.3 s
+  EXPECT_TRUE(std::isnan(joiner.translationPx()));
+  ASSERT_EQ(probed.size(), 2u);
+  ASSERT_TRUE(joiner.next(w));  // warm start at 0.125 s: no D, so from 0.05 s again
+  EXPECT_NEAR(w.t1 - w.t0, 0.125, 1e-9);
+  ASSERT_EQ(probed.size(), 5u);
+  EXPECT_NEAR(probed[2], 0.125, 1e-9);
+  EXPECT_NEAR(probed[3], 0.05, 1e-9);
+  // Never measurable: the window grows to max_seconds as before.
+  TempDir d2;
+  writeEventsText(d2.file("e.txt"), ev);
+  auto reader2 = openEventSource(d2.file("e.txt"));
+  WindowSource source2(*reader2, steps);
+  ParallaxWindowJoiner never(source2, o, 0.5, [](double, double, const std::vector<Event>&) { return NAN; });
+  ASSERT_TRUE(never.next(w));
+  EXPECT_NEAR(w.t1 - w.t0, 0.3, 1e-9);
+}
+
 TEST(WindowPolicy, JoinerReportsTheShortLastWindow) {
   TempDir d;
   auto ev = celc::test::randomEvents(10000, 240, 180, 9, 1.0);  // ~0.1 s
@@ -202,6 +243,10 @@ TEST(WindowPolicy, PolicyKeysAreCheckedAgainstThePolicy) {
   EXPECT_NE(error("windows: {min_seconds: 0.2, max_seconds: 0.1}").find("windows.max_seconds"), std::string::npos);
   EXPECT_NE(error("windows: {overlap: 0.5}").find("windows.overlap"), std::string::npos);
   EXPECT_NE(error("windows: {parallax_px: .nan}").find("windows.parallax_px"), std::string::npos);
+  EXPECT_EQ(error("windows: {parallax_px: 20, no_parallax_px: 20}"), "");
+  EXPECT_NE(error("windows: {parallax_px: 20, no_parallax_px: 21}").find("windows.no_parallax_px: must be in [0, parallax_px (20)]"),
+            std::string::npos);
+  EXPECT_NE(error("windows: {no_parallax_px: -1}").find("windows.no_parallax_px"), std::string::npos);
   // --set: keys that belong together are validated together, in any order.
   RunConfig c;
   applyRunSettings({"windows.seconds=0.1", "windows.policy=seconds"}, c);

@@ -67,22 +67,31 @@ struct SequenceRunner::Impl {
   /// D of a growing parallax window (window_policy.hpp) [px], measured on at
   /// most parallax.probe_events of its events (every k-th); NaN when it cannot
   /// be measured (no motion model, clustering failed, too few lines).
+  /// Every k-th event is k times sparser in (x, y, c t), and the clustering's
+  /// density checks can then find no cluster: a probe without a D is repeated
+  /// with a 4 times denser subset, down to every event.
   double probeTranslation(double t0, double t1, const std::vector<Event>& events) const {
     MotionModel motion = MotionModel::constantTwist(Vec3::Zero(), t0);
     Vec3 omega;
     std::string status;
     if (!motionFor(t0, t1, motion, omega, status)) return NAN;
-    const std::size_t keep_every = std::max<std::size_t>(
+    std::size_t keep_every = std::max<std::size_t>(
         1, (events.size() + config.parallax.probe_events - 1) / config.parallax.probe_events);
-    std::vector<Event> probe;
-    probe.reserve(events.size() / keep_every + 1);
-    for (std::size_t i = 0; i < events.size(); i += keep_every) probe.push_back(events[i]);
-    const ClusterResult clusters = clusterEvents(probe, config.cluster);
-    if (clusters.status != ClusterStatus::Ok) return NAN;
-    const WindowObservations obs = toObservations(
-        probe, clusters, [&](const Vec2& p) { return bearing(p); }, calib.camera.focal(), config.observations,
-        &motion, nullptr);
-    return lineTranslationPx(obs, motion, t0, t1);
+    for (;;) {
+      std::vector<Event> probe;
+      probe.reserve(events.size() / keep_every + 1);
+      for (std::size_t i = 0; i < events.size(); i += keep_every) probe.push_back(events[i]);
+      const ClusterResult clusters = clusterEvents(probe, config.cluster);
+      double d = NAN;
+      if (clusters.status == ClusterStatus::Ok) {
+        const WindowObservations obs = toObservations(
+            probe, clusters, [&](const Vec2& p) { return bearing(p); }, calib.camera.focal(),
+            config.observations, &motion, nullptr);
+        d = lineTranslationPx(obs, motion, t0, t1);
+      }
+      if (std::isfinite(d) || keep_every == 1) return d;
+      keep_every = std::max<std::size_t>(1, keep_every / 4);
+    }
   }
 };
 
@@ -231,12 +240,12 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // The parallax policy grew the window to windows.max_seconds and its lines
   // still show too little translation: no method is asked for a direction.
-  if (std::isfinite(translation_px) && translation_px < cfg.parallax.target_px) {
+  if (std::isfinite(translation_px) && translation_px < cfg.parallax.no_parallax_px) {
     for (MethodRow& row : rec.rows) {
       row.result.status = SolveStatus::Degenerate;
       row.result.degeneracy = Degeneracy::NoParallax;
-      row.result.message = fmt::format("the lines moved {:.1f} px in {:.3f} s, less than windows.parallax_px = {:g}",
-                                       translation_px, t1 - t0, cfg.parallax.target_px);
+      row.result.message = fmt::format("the lines moved {:.1f} px in {:.3f} s, less than windows.no_parallax_px = {:g}",
+                                       translation_px, t1 - t0, cfg.parallax.no_parallax_px);
     }
     spdlog::debug("window {}: {}", index, rec.rows.front().result.message);
     return rec;

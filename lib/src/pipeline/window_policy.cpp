@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+
+#include <spdlog/spdlog.h>
 #include <sstream>
 #include <vector>
 
@@ -20,6 +22,8 @@ std::string ParallaxWindowOptions::validate() const {
   std::ostringstream e;
   e.precision(6);
   if (!(target_px > 0.0) || !std::isfinite(target_px)) e << "parallax_px: must be finite and > 0; ";
+  if (!(no_parallax_px >= 0.0) || !(no_parallax_px <= target_px))
+    e << "no_parallax_px: must be in [0, parallax_px (" << target_px << ")]; ";
   if (!(step_seconds > 0.0) || !std::isfinite(step_seconds)) e << "step_seconds: must be finite and > 0; ";
   if (!(min_seconds > 0.0) || !std::isfinite(min_seconds)) e << "min_seconds: must be finite and > 0; ";
   if (!(max_seconds >= min_seconds) || !std::isfinite(max_seconds))
@@ -33,6 +37,8 @@ std::string ParallaxWindowOptions::validate() const {
 void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
   v.field({"parallax_px", "px", "parallax policy: grow a window until its lines' translation reaches this"},
           o.target_px);
+  v.field({"no_parallax_px", "px", "parallax policy: a window at max_seconds with less is degenerate (no_parallax)"},
+          o.no_parallax_px);
   v.field({"min_seconds", "s", "parallax policy: shortest window"}, o.min_seconds);
   v.field({"max_seconds", "s", "parallax policy: longest window (reached without parallax: degenerate)"},
           o.max_seconds);
@@ -129,6 +135,7 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
   // one that shows twice the target is shrunk once toward it.
   int steps = std::clamp(last_steps_, min_steps, max_steps);
   bool may_shrink = steps > min_steps;
+  bool measured = false;  // a finite D on a shorter try of this window
   translation_px_ = NAN;
   for (;;) {
     const int have = contiguousSteps(steps);
@@ -140,16 +147,32 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     }
     join(steps, window);
     translation_px_ = probe_(window.t0, window.t1, window.events);
+    spdlog::debug("parallax window at {:.3f} s: {} steps ({:.3f} s, {} events): D = {:.1f} px", window.t0, steps,
+                  window.t1 - window.t0, window.events.size(), translation_px_);
     if (may_shrink && translation_px_ >= 2.0 * o_.target_px) {
       may_shrink = false;
       steps = std::max(min_steps, static_cast<int>(std::ceil(steps * o_.target_px / translation_px_ - 1e-9)));
       continue;
     }
+    if (!std::isfinite(translation_px_)) {
+      // No cluster of the probe spans enough of this longer window (fast
+      // motion ends clusters early, or the probe's subsample is too sparse
+      // for the clustering): a longer window would not measure better. After
+      // a finite D, keep the length aimed at from it; a warm start that
+      // cannot be measured starts again from the shortest window.
+      if (measured) break;
+      if (may_shrink) {
+        may_shrink = false;
+        steps = min_steps;
+        continue;
+      }
+    }
     may_shrink = false;
+    measured = measured || std::isfinite(translation_px_);
     if (translation_px_ >= o_.target_px || steps >= max_steps) break;
     steps = nextWindowSteps(steps, translation_px_, o_.target_px, max_steps);
   }
-  last_steps_ = std::isfinite(translation_px_) ? steps : min_steps;
+  last_steps_ = std::isfinite(translation_px_) || measured ? steps : min_steps;
   join(steps, window);
   const bool at_end = source_done_ && static_cast<int>(pending_.size()) == steps;
   if (at_end && steps < min_steps) {  // the end of the data cut the window short

@@ -36,12 +36,16 @@ std::string toString(WindowPolicy policy);  ///< "parallax" | "events" | "second
 /// The parallax policy's options (keys of the `windows:` section).
 struct ParallaxWindowOptions {
   double target_px = 25.0;     ///< grow until the lines' translation D reaches this [px]
+  /// A window that stops at max_seconds with D below this [px] is degenerate
+  /// (no_parallax) for every method; between it and target_px it is solved.
+  double no_parallax_px = 15.0;
   double min_seconds = 0.05;   ///< first (shortest) window tried [s]
-  double max_seconds = 0.3;    ///< longest window [s]; a window that stops here may be degenerate (no_parallax)
+  double max_seconds = 0.3;    ///< longest window [s]; see no_parallax_px
   /// Growth is in steps of this duration [s]: windows are whole numbers of steps.
   double step_seconds = 0.025;
   /// The measurement of D while a window grows clusters at most this many
-  /// events (every k-th event of the window); the window itself keeps all.
+  /// events (every k-th event of the window; denser where that finds no D);
+  /// the window itself keeps all.
   std::size_t probe_events = 30000;
   std::string validate() const;  ///< "key: what; " per problem ("" = valid)
 };
