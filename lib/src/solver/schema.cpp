@@ -74,6 +74,9 @@ void describe(FieldVisitor& v, MlOptions& o) {
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"enabled", "", "report sigma_deg, the direction's standard deviation, per estimate"}, o.enabled);
+  v.field({"agreement", "", "sigma_deg at least the angle to a celc / celc_opt / celc_ml estimate of the window that "
+                            "disagrees beyond 2 sigma"},
+          o.agreement);
   v.field({"max_events", "events", "events per window used for it (0 = all)"}, o.max_events);
   v.field({"scale_celc", "-", "calibration factor of sigma_deg for celc"}, o.scale_celc);
   v.field({"scale_celc_opt", "-", "... for celc_opt"}, o.scale_celc_opt);

@@ -1,5 +1,7 @@
 // The method dispatcher: the window checks once, the clusters' frames once,
 // then every requested method (celc computed once for the methods it starts).
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "ce3lc.hpp"
@@ -15,6 +17,24 @@
 #include "window_checks.hpp"
 
 namespace celc {
+
+namespace {
+
+/// sigma_i at least the largest angle to a disagreeing witness
+/// (UncertaintyOptions::agreement). `witnesses` holds estimates with their
+/// Fisher sigma_deg; `self` is i's own witness index or -1.
+void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResult>& witnesses) {
+  const double sigma = r.sigma_deg;
+  double raised = sigma;
+  for (size_t j = 0; j < witnesses.size(); ++j) {
+    if (static_cast<int>(j) == self) continue;
+    const double angle_deg = angleBetweenSignAgnostic(r.v, witnesses[j].v) * 180.0 / M_PI;
+    if (angle_deg > 2.0 * std::hypot(sigma, witnesses[j].sigma_deg)) raised = std::max(raised, angle_deg);
+  }
+  r.sigma_deg = raised;
+}
+
+}  // namespace
 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
@@ -97,6 +117,33 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Npt: scale = u.scale_npt; break;
     }
     r.sigma_deg = directionSigmaDeg(obs, motion, r.v, scale, u.max_events);
+  }
+  if (!u.enabled || !u.agreement) return out;
+  // The witnesses: one estimate per method of the celc family, with its Fisher sigma.
+  std::vector<SolverResult> witnesses;
+  std::vector<int> witness_of(out.size(), -1);
+  bool celc_witness = false;
+  for (size_t i = 0; i < out.size(); ++i) {
+    const Method m = methods[i];
+    if (m != Method::Celc && m != Method::CelcOpt && m != Method::CelcMl) continue;
+    if (!out[i].ok() || !std::isfinite(out[i].sigma_deg)) continue;
+    bool seen = false;
+    for (size_t k = 0; k < i; ++k) seen = seen || (methods[k] == m && witness_of[k] >= 0);
+    if (seen) continue;
+    witness_of[i] = static_cast<int>(witnesses.size());
+    witnesses.push_back(out[i]);
+    celc_witness = celc_witness || m == Method::Celc;
+  }
+  if (!celc_witness && have_linear && linear.ok()) {
+    SolverResult w = linear;
+    w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
+    if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
+  }
+  for (size_t i = 0; i < out.size(); ++i) {
+    int self = witness_of[i];
+    for (size_t k = 0; k < i && self < 0; ++k)  // a repeated method is its first occurrence's witness
+      if (methods[k] == methods[i] && witness_of[k] >= 0) self = witness_of[k];
+    if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], self, witnesses);
   }
   return out;
 }

@@ -151,8 +151,20 @@ struct MlOptions {
 /// (direction_information.hpp), times a per-method factor. The factors
 /// calibrate the Fisher value (the ML bound) to each method's actual spread,
 /// so that about 9 in 10 windows have phi <= 2 sigma (docs/uncertainty.md).
+///
+/// The Fisher value sees the noise, not a model that fails (a rotation that
+/// is not constant, clusters that mix edges, a wrong basin): with
+/// `agreement`, estimates of the same window are compared. Witnesses are the
+/// estimates of celc, celc_opt and celc_ml in the window (celc's also when
+/// only celc_opt or celc_ml was asked for, which start from it); two
+/// estimates i, j disagree when their angle exceeds
+/// 2 sqrt(sigma_i^2 + sigma_j^2) (Fisher values), and then each method's
+/// sigma_deg is at least the largest angle to a witness it disagrees with.
+/// ce3lc and npt are not witnesses: their sigma_deg is not a calibrated
+/// standard deviation, so their disagreements are not evidence.
 struct UncertaintyOptions {
   bool enabled = true;          ///< compute sigma_deg (off: NaN)
+  bool agreement = true;        ///< raise sigma_deg to the angle to a disagreeing witness
   int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
   double scale_celc = 2.5;      ///< [-] factor for method celc
   double scale_celc_opt = 2.5;  ///< [-] for celc_opt
