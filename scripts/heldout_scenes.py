@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Write a held-out set of scene files: random variants of the shipped
+rendered scenes (config/scenes), drawn from a fixed seed, that no default was
+chosen on. Each variant takes one of three base scenes (the room, the
+hand-held room with its sinusoidal rotation, the rectangles wall as a
+constant twist) and draws a new scene seed, a speed of 0.8-3 m/s and a
+rotation rate of 0.2-2.5 rad/s in random directions, and a background noise
+rate; durations are 0.6 s. Render them with `celc synth FILE -o DIR`.
+
+    scripts/heldout_scenes.py OUTDIR [--count N] [--seed S]
+
+Writes OUTDIR/hNN_<base>.yaml and prints one line per scene (its motion)."""
+import argparse
+import math
+import os
+import random
+import re
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BASES = [("room", "e2e_davis346_room_fast"), ("hand", "handheld_fast_rotation"),
+         ("rect", "davis240_rectangles")]
+
+
+def random_vector(rng, norm):
+    """A vector of the given norm in a uniformly random direction."""
+    while True:
+        v = [rng.uniform(-1.0, 1.0) for _ in range(3)]
+        n = math.sqrt(sum(x * x for x in v))
+        if 0.2 < n <= 1.0:
+            return [round(norm * x / n, 2) for x in v]
+
+
+def set_key(text, pattern, value):
+    """Replace the first match of `pattern` (group 1 kept) with group 1 + value."""
+    new, n = re.subn(pattern, lambda m: m.group(1) + value, text, count=1, flags=re.M)
+    if n != 1:
+        raise SystemExit(f"heldout_scenes.py: no match for {pattern!r}")
+    return new
+
+
+def variant(rng, index, kind, base):
+    text = open(os.path.join(ROOT, "config", "scenes", base + ".yaml")).read()
+    speed, rate = rng.uniform(0.8, 3.0), rng.uniform(0.2, 2.5)
+    v, w = random_vector(rng, speed), random_vector(rng, rate)
+    noise = rng.choice([0.1, 0.5, 1.0, 2.0])
+    text = set_key(text, r"^(seed: )\d+", str(1000 + index))
+    text = set_key(text, r"^(duration: )[0-9.]+", "0.6")
+    if kind == "rect":  # the shipped wall moves sinusoidally: here a constant twist
+        text = set_key(text, r"^(\s*type: )sinusoid", "constant_twist")
+        text = re.sub(r"^\s*(amplitude_v|amplitude_w|frequency):.*\n", "", text, flags=re.M)
+    text = set_key(text, r"^(\s*v: )\[[^\]]*\]", str(v))
+    text = set_key(text, r"^(\s*w: )\[[^\]]*\]", str(w))
+    text = set_key(text, r"^(\s*noise_rate: )[0-9.]+", str(noise))
+    header = (f"# Held-out variant {index} of {base}.yaml (scripts/heldout_scenes.py): "
+              f"speed {speed:.2f} m/s, rotation {rate:.2f} rad/s, noise {noise} Hz/px.\n")
+    return header + text, f"speed {speed:.2f} m/s v {v}, rotation {rate:.2f} rad/s w {w}, noise {noise}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("outdir")
+    ap.add_argument("--count", type=int, default=16, help="scenes to write (default 16)")
+    ap.add_argument("--seed", type=int, default=2026, help="seed of the draw (default 2026)")
+    a = ap.parse_args()
+    if a.count < 1:
+        raise SystemExit("heldout_scenes.py: --count must be >= 1")
+    os.makedirs(a.outdir, exist_ok=True)
+    rng = random.Random(a.seed)
+    for i in range(a.count):
+        kind, base = BASES[i % len(BASES)]
+        text, motion = variant(rng, i, kind, base)
+        name = f"h{i:02d}_{kind}"
+        with open(os.path.join(a.outdir, name + ".yaml"), "w") as f:
+            f.write(text)
+        print(f"{name}: {motion}")
+
+
+if __name__ == "__main__":
+    main()
