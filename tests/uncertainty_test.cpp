@@ -262,3 +262,77 @@ TEST(Uncertainty, GyroBiasIsSubtractedInThePipeline) {
     EXPECT_GE(a[i].n_lines, 0);
   }
 }
+
+// motion.gyro_bias_from_still: the sample shifted by 1.5 s behind an IMU
+// that rests for its first 1.5 s with a bias b (plus 1 mrad/s of noise), b
+// added to every later sample: the bias is taken from the still second, so
+// every window's angular velocity is the original sample's to within the
+// noise's mean over 1000 samples (3e-5 rad/s per axis; 2e-4 allowed). A
+// recording whose IMU never rests, and one that turns steadily, are errors
+// naming the key.
+TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
+  const fs::path d = test::freshTempDir("unc_bias_still");
+  const Vec3 bias(0.012, -0.021, 0.008);
+  const double shift = 1.5;
+  fs::create_directories(d / "seq");
+  fs::copy_file(kSample + "/calib.yaml", d / "seq" / "calib.yaml");
+  {
+    std::ifstream in(kSample + "/events.txt");
+    std::ofstream out((d / "seq" / "events.txt").string());
+    out.precision(9);
+    double t;
+    int x, y, p;
+    while (in >> t >> x >> y >> p) out << t + shift << ' ' << x << ' ' << y << ' ' << p << '\n';
+  }
+  auto writeImu = [&](const fs::path& path, const Vec3& still_rate) {
+    std::ofstream out(path.string());
+    out.precision(10);
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> noise(0.0, 1e-3);
+    for (int k = 0; k < 1500; ++k) {
+      const Vec3 g = still_rate + bias + Vec3(noise(rng), noise(rng), noise(rng));
+      out << k * 1e-3 << " 0 -9.81 0 " << g.x() << ' ' << g.y() << ' ' << g.z() << '\n';
+    }
+    std::ifstream in(kSample + "/imu.txt");
+    double t, ax, ay, az, gx, gy, gz;
+    while (in >> t >> ax >> ay >> az >> gx >> gy >> gz)
+      out << t + shift << ' ' << ax << ' ' << ay << ' ' << az << ' ' << gx + bias.x() << ' ' << gy + bias.y()
+          << ' ' << gz + bias.z() << '\n';
+  };
+  writeImu(d / "seq" / "imu.txt", Vec3::Zero());
+  const std::string common = " -q --threads 2 --methods celc --window-events 15000 ";
+  auto r = test::runCelc("run '" + kSample + "' -o '" + (d / "a").string() + "'" + common + "--set windows.t_end=0.05", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "b").string() + "'" + common +
+                        "--set windows.t_end=1.55 --set motion.gyro_bias_from_still=true",
+                    d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto a = readWindowsCsv((d / "a" / "windows.csv").string(), false);
+  const auto b = readWindowsCsv((d / "b" / "windows.csv").string(), false);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_FALSE(a.empty());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_TRUE(a[i].has_omega && b[i].has_omega);
+    EXPECT_LT((a[i].omega - b[i].omega).norm(), 2e-4) << "window " << i;
+  }
+  // The sample's own IMU (0.3 s) has no still second.
+  r = test::runCelc("run '" + kSample + "' -o '" + (d / "c").string() + "'" + common +
+                        "--set motion.gyro_bias_from_still=true",
+                    d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("motion.gyro_bias_from_still: the IMU has no still second"), std::string::npos) << r.err;
+  // A camera turning steadily at 0.3 rad/s for 1.5 s is not at rest.
+  writeImu(d / "seq" / "imu.txt", Vec3(0.3, 0.0, 0.0));
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "e").string() + "'" + common +
+                        "--set motion.gyro_bias_from_still=true",
+                    d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("not one at rest"), std::string::npos) << r.err;
+  // Both ways at once is an error naming the keys.
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "f").string() + "'" + common +
+                        "--set motion.gyro_bias_from_still=true --set 'motion.gyro_bias=[0.01, 0, 0]'",
+                    d);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("set with motion.gyro_bias"), std::string::npos) << r.err;
+  fs::remove_all(d);
+}

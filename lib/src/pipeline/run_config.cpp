@@ -54,6 +54,10 @@ std::string RunConfig::validate() const {
   if (methods.empty()) e += "methods: at least one; ";
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
   if (!gyro_bias.allFinite()) e += "motion.gyro_bias must be finite; ";
+  if (gyro_bias_from_still && !gyro_bias.isZero(0.0))
+    e += "motion.gyro_bias_from_still: set with motion.gyro_bias (use one of them); ";
+  if (gyro_bias_from_still && omega_source != OmegaSource::Gyro)
+    e += "motion.gyro_bias_from_still: needs motion.omega_source gyro; ";
   // One line: the problems joined by "; ", without the last separator.
   while (!e.empty() && (e.back() == ' ' || e.back() == ';')) e.pop_back();
   return e;
@@ -83,6 +87,9 @@ void describe(FieldVisitor& v, RunConfig& c) {
     s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed"}, c.fixed_omega);
     s.field({"gyro_bias", "rad/s", "constant gyro bias, IMU frame, subtracted from every sample (celc info estimates it)"},
             c.gyro_bias);
+    s.field({"gyro_bias_from_still", "", "instead, the mean gyro rate over the recording's first still second "
+                                         "(an error without one)"},
+            c.gyro_bias_from_still);
     describe(s, c.gyro);
   });
   describeClustering(v, c.cluster, c.observations.lines);

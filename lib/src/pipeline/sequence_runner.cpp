@@ -15,6 +15,7 @@
 #include "celc/io/calibration.hpp"
 #include "celc/io/sequence_layout.hpp"
 #include "celc/io/text_io.hpp"
+#include "celc/pipeline/imu_still.hpp"
 
 namespace fs = std::filesystem;
 
@@ -34,6 +35,7 @@ struct SequenceRunner::Impl {
   std::unique_ptr<EventReader> reader;
   std::unique_ptr<UndistortLut> lut;
   GyroTrack gyro;
+  Vec3 gyro_bias = Vec3::Zero();  ///< subtracted from every gyro sample [rad/s], IMU frame
   std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
 
@@ -136,8 +138,22 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
                                "(motion.omega_source: fixed) for a recording without IMU");
     // The constant gyro bias (IMU frame) comes off every sample here, before
     // the track rotates the rates into the camera frame.
-    if (!m.config.gyro_bias.isZero(0.0))
-      for (ImuSample& sample : imu) sample.gyro -= m.config.gyro_bias;
+    m.gyro_bias = m.config.gyro_bias;
+    if (m.config.gyro_bias_from_still) {
+      const std::string imu_path = m.inputs.imu.empty() ? in.events : m.inputs.imu;
+      const StillSpan still = findFirstStill(imu);
+      if (!still.found)
+        throw std::runtime_error(imu_path + ": motion.gyro_bias_from_still: the IMU has no still second (" +
+                                 std::to_string(imu.size()) + " samples); set motion.gyro_bias instead");
+      if (still.gyro_mean.norm() > kMaxStillBias)
+        throw std::runtime_error(fmt::format(
+            "{}: motion.gyro_bias_from_still: the first still second ({:.2f}-{:.2f} s) turns at {:.3f} rad/s, "
+            "more than a bias ({:g} rad/s): a steadily turning camera, not one at rest",
+            imu_path, still.t0, still.t1, still.gyro_mean.norm(), kMaxStillBias));
+      m.gyro_bias = still.gyro_mean;
+    }
+    if (!m.gyro_bias.isZero(0.0))
+      for (ImuSample& sample : imu) sample.gyro -= m.gyro_bias;
     m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
   }
   if (!m.inputs.groundtruth.empty()) {
@@ -164,10 +180,11 @@ std::vector<std::string> SequenceRunner::describe() const {
     d.push_back("angular velocity: fixed by the configuration (motion.fixed_omega)");
   else {
     std::string g = "gyroscope: " + std::to_string(m.n_imu) + " samples";
-    if (!m.config.gyro_bias.isZero(0.0)) {
+    if (!m.gyro_bias.isZero(0.0)) {
       std::ostringstream b;
-      b << ", bias " << m.config.gyro_bias.x() << "," << m.config.gyro_bias.y() << ","
-        << m.config.gyro_bias.z() << " rad/s (IMU frame) subtracted";
+      b << ", bias " << m.gyro_bias.x() << "," << m.gyro_bias.y() << "," << m.gyro_bias.z()
+        << " rad/s (IMU frame" << (m.config.gyro_bias_from_still ? ", the first still second's mean" : "")
+        << ") subtracted";
       g += b.str();
     }
     d.push_back(g);

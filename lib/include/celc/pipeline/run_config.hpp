@@ -25,6 +25,11 @@ enum class OmegaSource {
 };
 std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
+/// The largest gyro bias taken from a still span [rad/s] (|mean| per the
+/// norm): MEMS gyros of event cameras have biases of a few mrad/s; a span
+/// whose mean rate is larger is a camera turning at a constant rate.
+inline constexpr double kMaxStillBias = 0.1;
+
 struct RunConfig {
   ReaderOptions reader;
   /// How windows are cut (pipeline/window_policy.hpp): by default each grows
@@ -47,6 +52,11 @@ struct RunConfig {
   /// (SequenceRunner, where the gyro track is built). `celc info` reports the
   /// mean rate over the recording's first still second, an estimate of it.
   Vec3 gyro_bias = Vec3::Zero();
+  /// Instead, take the bias as the mean gyro rate over the recording's first
+  /// still second (pipeline/imu_still.hpp, what `celc info` reports); the
+  /// run fails when the recording has none, or when that mean exceeds
+  /// kMaxStillBias (a camera turning steadily, not at rest).
+  bool gyro_bias_from_still = false;
   GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;
