@@ -321,8 +321,8 @@ TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
                     d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("motion.gyro_bias_from_still: the IMU has no still second"), std::string::npos) << r.err;
-  // A camera turning steadily at 0.3 rad/s for 1.5 s is not at rest.
-  writeImu(d / "seq" / "imu.txt", Vec3(0.3, 0.0, 0.0));
+  // A camera turning steadily at 0.5 rad/s for 1.5 s is not at rest.
+  writeImu(d / "seq" / "imu.txt", Vec3(0.5, 0.0, 0.0));
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "e").string() + "'" + common +
                         "--set motion.gyro_bias_from_still=true",
                     d);

@@ -25,10 +25,11 @@ enum class OmegaSource {
 };
 std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
-/// The largest gyro bias taken from a still span [rad/s] (|mean| per the
-/// norm): MEMS gyros of event cameras have biases of a few mrad/s; a span
-/// whose mean rate is larger is a camera turning at a constant rate.
-inline constexpr double kMaxStillBias = 0.1;
+/// The largest gyro bias taken from a still span [rad/s] (norm of the mean):
+/// the initial zero-rate offset of the InvenSense MPU-6x50 gyros in DAVIS
+/// cameras may reach 20 deg/s (0.35 rad/s) per axis; a span whose mean rate
+/// is larger is a camera turning at a constant rate, not one at rest.
+inline constexpr double kMaxStillBias = 0.35;
 
 struct RunConfig {
   ReaderOptions reader;
