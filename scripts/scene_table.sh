@@ -5,7 +5,8 @@
 # `celc synth` (cached under OUTDIR/seq), runs it, and prints a markdown table
 # of the median phi [rad] per method with ok windows / windows.
 #   scripts/scene_table.sh [OUTDIR] [-- extra celc run arguments]
-# Default OUTDIR out/scenes; about 5 minutes on 2 cores (rendering included).
+# Then the same over all windows of every scene. Default OUTDIR out/scenes;
+# about 8 minutes on 2 cores (rendering included).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 out="$root/out/scenes"
@@ -29,6 +30,9 @@ for h in "${heldout[@]}"; do
   IFS='|' read -r name base edits <<<"$h"
   scenes+=("$name|$root/config/scenes/$base.yaml|$edits")
 done
+# And the seeded random held-out set (scripts/heldout_scenes.py).
+/usr/bin/python3 "$root/scripts/heldout_scenes.py" "$out/heldout" --count 16 > /dev/null
+for f in "$out"/heldout/*.yaml; do scenes+=("$(basename "$f" .yaml)|$f|"); done
 
 methods="celc celc_opt celc_ml ce3lc npt"
 printf '| scene | events | seconds | celc | celc_opt | celc_ml | ce3lc | npt |\n|---|---|---|---|---|---|---|---|\n'
@@ -51,4 +55,15 @@ for s in "${scenes[@]}"; do
     row="$row ${cell:--} |"
   done
   echo "$row"
+done
+# Over every window of every scene: ok / windows, the median phi of the ok
+# windows and the shares within 0.05 and 0.1 rad.
+echo
+printf '| method | ok / windows | median phi [rad] | phi <= 0.05 | phi <= 0.1 |\n|---|---|---|---|---|\n'
+for m in $methods; do
+  cat "$out"/run/*/windows.csv | awk -F, -v m="$m" '$1 != "window" && $6 == m { n++; if ($7 == "ok" && $15 != "") print $15 }
+    END { print "n", n }' | sort -g | awk -v m="$m" '
+    $1 == "n" { n = $2; next } { p[++k] = $1; if ($1 <= 0.05) a++; if ($1 <= 0.1) b++ }
+    END { med = k ? (k % 2 ? p[(k + 1) / 2] : (p[k / 2] + p[k / 2 + 1]) / 2) : 0
+          printf "| %s | %d / %d | %.3f | %.2f | %.2f |\n", m, k, n, med, k ? a / k : 0, k ? b / k : 0 }'
 done
