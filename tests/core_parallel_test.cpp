@@ -1,6 +1,9 @@
 // The parallel utility (core/parallel.hpp) and the list splitter (core/text.hpp).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -236,4 +239,18 @@ TEST(SplitList, TrimBlanks) {
   EXPECT_EQ(trimBlanks("  a b\t\r"), "a b");
   EXPECT_EQ(trimBlanks(" \t"), "");
   EXPECT_EQ(trimBlanks(""), "");
+}
+
+// The HDF5 reader's messages print byte counts computed in double from sizes
+// in the file; the fuzz target found one beyond 2^64, whose conversion to an
+// integer was undefined behaviour (UBSan, float-cast-overflow).
+TEST(SplitList, ByteCountTextNeverOverflows) {
+  EXPECT_EQ(byteCountText(0.0), "0");
+  EXPECT_EQ(byteCountText(1952382976.0), "1952382976");
+  EXPECT_EQ(byteCountText(18446744073709549568.0), "18446744073709549568");  // the largest double below 2^64
+  EXPECT_EQ(byteCountText(18446744073709551616.0), "more than 2^64");        // 2^64
+  EXPECT_EQ(byteCountText(1e300), "more than 2^64");
+  EXPECT_EQ(byteCountText(std::numeric_limits<double>::infinity()), "more than 2^64");
+  EXPECT_EQ(byteCountText(-1.0), "an invalid number of");
+  EXPECT_EQ(byteCountText(std::nan("")), "an invalid number of");
 }

@@ -21,4 +21,10 @@ std::string trimBlanks(std::string_view text) {
   return std::string(text.substr(b, e - b + 1));
 }
 
+std::string byteCountText(double bytes) {
+  if (!(bytes >= 0.0)) return "an invalid number of";
+  if (!(bytes < 18446744073709551616.0)) return "more than 2^64";
+  return std::to_string(static_cast<unsigned long long>(bytes));
+}
+
 }  // namespace celc

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "celc/core/text.hpp"
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
 
@@ -56,13 +57,6 @@ struct Dataset {
   H5Id id, space;
   std::vector<hsize_t> dims;
 };
-
-/// A byte count computed in double (a product of sizes read from the file,
-/// possibly beyond 2^64) as decimal text.
-std::string byteCount(double bytes) {
-  if (!(bytes < 18446744073709551615.0)) return bytes > 0 ? "more than 2^64" : "an invalid number of";
-  return std::to_string(std::uint64_t(bytes));
-}
 
 enum class Layout { Dsec, Mvsec };
 
@@ -240,7 +234,7 @@ class Hdf5Reader final : public EventReader {
       const double stored = double(H5Dget_storage_size(d.id.get()));
       if (stored != need && !(layout == H5D_CONTIGUOUS && stored == 0.0))
         fail(name, std::string(layout == H5D_COMPACT ? "compact" : "contiguous") + " data of " +
-                       byteCount(stored) + " bytes for " + byteCount(need) +
+                       byteCountText(stored) + " bytes for " + byteCountText(need) +
                        " bytes of values (damaged file)");
     }
     if (plist.valid() && rank > 0 && layout == H5D_CHUNKED) {
@@ -250,7 +244,7 @@ class Hdf5Reader final : public EventReader {
       if (H5Pget_chunk(plist.get(), rank, chunk.data()) == rank)
         for (hsize_t c : chunk) bytes *= double(c);
       if (bytes > double(options_.max_packet_bytes))
-        fail(name, "chunks of " + byteCount(bytes) +
+        fail(name, "chunks of " + byteCountText(bytes) +
                        " bytes, more than input.max_packet_bytes = " + std::to_string(options_.max_packet_bytes));
       // An unfiltered chunk is stored whole: a stored size that differs from
       // the chunk's (a damaged layout or chunk index) makes the HDF5 library
@@ -270,7 +264,7 @@ class Hdf5Reader final : public EventReader {
         if (nf == 0 && double(stored) != bytes)
           fail(name, "chunk " + std::to_string(i) + " at byte " + std::to_string(addr) + " holds " +
                          std::to_string(stored) + " bytes, an unfiltered chunk of its layout " +
-                         byteCount(bytes) + " (damaged file)");
+                         byteCountText(bytes) + " (damaged file)");
         if (nf > 0 && stored > file_bytes_)
           fail(name, "compressed chunk " + std::to_string(i) + " at byte " + std::to_string(addr) + " claims " +
                          std::to_string(stored) + " bytes, more than the file's " + std::to_string(file_bytes_) +

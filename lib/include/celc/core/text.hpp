@@ -17,4 +17,10 @@ std::vector<std::string> splitList(std::string_view text, char separator = ',');
 /// `text` without leading and trailing blanks (space, tab, carriage return).
 std::string trimBlanks(std::string_view text);
 
+/// A byte count computed in floating point (a product of sizes read from a
+/// file, possibly beyond 2^64, or NaN) as decimal text for an error message:
+/// the integer below 2^64, else "more than 2^64" (positive) or "an invalid
+/// number of" (negative, NaN); never a float-to-integer overflow.
+std::string byteCountText(double bytes);
+
 }  // namespace celc
