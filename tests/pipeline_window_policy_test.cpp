@@ -138,17 +138,29 @@ TEST(WindowPolicy, JoinerGrowsEachWindowUntilTheTargetOrTheMaximum) {
   EXPECT_NEAR(fast[3].t0, fast[0].t0 + 0.15, 1e-9);
 }
 
+namespace {
+// n random events (~10 us apart from t = 1 s) in a text file, read in steps
+// of 0.025 s: what the parallax policy joins into windows.
+struct StepStream {
+  TempDir dir;
+  std::unique_ptr<EventReader> reader;
+  std::unique_ptr<WindowSource> source;
+  explicit StepStream(std::size_t n) {
+    writeEventsText(dir.file("e.txt"), celc::test::randomEvents(n, 240, 180, 5, 1.0));
+    reader = openEventSource(dir.file("e.txt"));
+    WindowOptions steps;
+    steps.seconds_per_window = 0.025;
+    steps.keep_partial = true;
+    source = std::make_unique<WindowSource>(*reader, steps);
+  }
+};
+}  // namespace
+
 // A camera that speeds up: a window started at the last one's length that
 // shows twice the target is shrunk once toward it.
 TEST(WindowPolicy, JoinerShrinksWhenTheMotionSpeedsUp) {
-  TempDir d;
-  const auto ev = celc::test::randomEvents(100000, 240, 180, 5, 1.0);  // ~1 s from t = 1 s
-  writeEventsText(d.file("e.txt"), ev);
-  auto reader = openEventSource(d.file("e.txt"));
-  WindowOptions steps;
-  steps.seconds_per_window = 0.025;
-  steps.keep_partial = true;
-  WindowSource source(*reader, steps);
+  StepStream stream(100000);  // ~1 s from t = 1 s
+  WindowSource& source = *stream.source;
   ParallaxWindowOptions o;
   // 100 px/s before t = 1.3 s (windows of 0.25 s), 1000 px/s after (0.025 s would do: min_seconds).
   ParallaxWindowJoiner joiner(source, o, 0.5, [](double t0, double t1, const std::vector<Event>&) {
@@ -170,14 +182,8 @@ TEST(WindowPolicy, JoinerShrinksWhenTheMotionSpeedsUp) {
 // it, and a warm start that cannot be measured is measured again from
 // min_seconds.
 TEST(WindowPolicy, JoinerStopsGrowingWhenALongerWindowCannotBeMeasured) {
-  TempDir d;
-  const auto ev = celc::test::randomEvents(60000, 240, 180, 5, 1.0);  // ~0.6 s
-  writeEventsText(d.file("e.txt"), ev);
-  auto reader = openEventSource(d.file("e.txt"));
-  WindowOptions steps;
-  steps.seconds_per_window = 0.025;
-  steps.keep_partial = true;
-  WindowSource source(*reader, steps);
+  StepStream stream(60000);  // ~0.6 s
+  WindowSource& source = *stream.source;
   ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s
   std::vector<double> probed;
   // 200 px/s, but nothing measurable beyond 0.1 s.
@@ -196,11 +202,8 @@ TEST(WindowPolicy, JoinerStopsGrowingWhenALongerWindowCannotBeMeasured) {
   EXPECT_NEAR(probed[2], 0.125, 1e-9);
   EXPECT_NEAR(probed[3], 0.05, 1e-9);
   // Never measurable: the window grows to max_seconds as before.
-  TempDir d2;
-  writeEventsText(d2.file("e.txt"), ev);
-  auto reader2 = openEventSource(d2.file("e.txt"));
-  WindowSource source2(*reader2, steps);
-  ParallaxWindowJoiner never(source2, o, 0.5, [](double, double, const std::vector<Event>&) { return NAN; });
+  StepStream stream2(60000);
+  ParallaxWindowJoiner never(*stream2.source, o, 0.5, [](double, double, const std::vector<Event>&) { return NAN; });
   ASSERT_TRUE(never.next(w));
   EXPECT_NEAR(w.t1 - w.t0, 0.3, 1e-9);
 }

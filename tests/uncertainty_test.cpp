@@ -20,7 +20,22 @@ using namespace celc;
 
 namespace {
 const std::string kSample = CELC_SOURCE_DIR "/data/sample_seq";
+
+// The windows.csv rows of two runs (folders a and b), which must have the
+// same windows, each with an angular velocity.
+std::vector<std::pair<WindowsCsvRow, WindowsCsvRow>> sameWindows(const fs::path& a, const fs::path& b) {
+  const auto ra = readWindowsCsv((a / "windows.csv").string(), false);
+  const auto rb = readWindowsCsv((b / "windows.csv").string(), false);
+  EXPECT_EQ(ra.size(), rb.size());
+  EXPECT_FALSE(ra.empty());
+  std::vector<std::pair<WindowsCsvRow, WindowsCsvRow>> out;
+  for (size_t i = 0; i < ra.size() && i < rb.size(); ++i) {
+    EXPECT_TRUE(ra[i].has_omega && rb[i].has_omega) << "window " << i;
+    out.emplace_back(ra[i], rb[i]);
+  }
+  return out;
 }
+}  // namespace
 
 // The paper's default scene, fixed seed: for the calibrated methods the share
 // of ok windows with phi <= 2 sigma_deg lies in 0.85-0.99.
@@ -252,14 +267,9 @@ TEST(Uncertainty, GyroBiasIsSubtractedInThePipeline) {
                         "--set 'motion.gyro_bias=[0.01, -0.02, 0.03]'",
                     d);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto a = readWindowsCsv((d / "a" / "windows.csv").string(), false);
-  const auto b = readWindowsCsv((d / "b" / "windows.csv").string(), false);
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_FALSE(a.empty());
-  for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].has_omega && b[i].has_omega);
-    EXPECT_NEAR((a[i].omega - b[i].omega - Vec3(0.01, -0.02, 0.03)).norm(), 0.0, 2e-6);
-    EXPECT_GE(a[i].n_lines, 0);
+  for (const auto& [a, b] : sameWindows(d / "a", d / "b")) {
+    EXPECT_NEAR((a.omega - b.omega - Vec3(0.01, -0.02, 0.03)).norm(), 0.0, 2e-6);
+    EXPECT_GE(a.n_lines, 0);
   }
 }
 
@@ -307,14 +317,8 @@ TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
                         "--set windows.t_end=1.55 --set motion.gyro_bias_from_still=true",
                     d);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto a = readWindowsCsv((d / "a" / "windows.csv").string(), false);
-  const auto b = readWindowsCsv((d / "b" / "windows.csv").string(), false);
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_FALSE(a.empty());
-  for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].has_omega && b[i].has_omega);
-    EXPECT_LT((a[i].omega - b[i].omega).norm(), 2e-4) << "window " << i;
-  }
+  for (const auto& [a, b] : sameWindows(d / "a", d / "b"))
+    EXPECT_LT((a.omega - b.omega).norm(), 2e-4) << "window " << a.window;
   // The sample's own IMU (0.3 s) has no still second.
   r = test::runCelc("run '" + kSample + "' -o '" + (d / "c").string() + "'" + common +
                         "--set motion.gyro_bias_from_still=true",
