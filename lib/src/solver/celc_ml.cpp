@@ -45,8 +45,10 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   std::vector<Start> starts;
   if (linear.ok()) starts.push_back({linear.v, &linear});
   if (npt && npt->ok()) starts.push_back({npt->v, npt});
-  if (starts.empty()) return linear;  // neither start: the linear stage's status
   const auto t0 = std::chrono::steady_clock::now();
+  // The profile's minima need no linear estimate: a window whose linear
+  // stage found its nullspace ambiguous (two near-equal singular values) is
+  // still answered from them.
   if (options.ml.profile_lattice > 0) {
     const LineProfile profile(obs, motion, frames.clusters(), options.ml.profile_events, event_seed);
     for (const ScreenMinimum& m : screenProfile(profile, options.ml.profile_lattice,
@@ -54,12 +56,15 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
                                                 options.ml.second_start_deg))
       starts.push_back({m.v, nullptr});
   }
+  if (starts.empty()) return linear;  // no start at all: the linear stage's status
+  // Without a refined start: the linear estimate, npt's, or the linear status.
+  auto fallback = [&]() -> SolverResult { return linear.ok() || !npt || !npt->ok() ? linear : *npt; };
   for (const Vec3& d : hemisphereDirections(options.ml.grid_starts)) starts.push_back({d, nullptr});
   const double time_us = linear.time_us + (npt ? npt->time_us : 0.0);
   JointProblem problem(obs, motion, frames, options.refine.max_events, options.refine.balance_clusters,
                        event_seed, options.refine.huber_px);
   const size_t events = problem.events();
-  if (events < 3) return linear.ok() ? linear : *npt;
+  if (events < 3) return fallback();
   // With several starts, each is refined on every stride-th event (the
   // basins are coarse; every start sees the same events, so the costs
   // compare) and only the winner on all of them, from its end point.
@@ -103,7 +108,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       best_start = &s;
     }
   }
-  if (!best_start) return linear.ok() ? linear : *npt;
+  if (!best_start) return fallback();
   if (stride > 1 || start_iterations < iterations) {
     JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
     if (r.ok) best = std::move(r);
