@@ -309,7 +309,10 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   EventWindow window;
   ParallaxWindowJoiner joiner(source, cfg.parallax, cfg.windows.partial_min_share,
                               [&](double t0, double t1, const std::vector<Event>& events) {
-                                return m.probeTranslation(t0, t1, events);
+                                const double d = m.probeTranslation(t0, t1, events);
+                                spdlog::debug("parallax window at {:.3f} s: {:.3f} s, {} events: D = {:.1f} px", t0,
+                                              t1 - t0, events.size(), d);
+                                return d;
                               });
   auto nextWindow = [&](EventWindow& w) { return parallax ? joiner.next(w) : source.next(w); };
   // By count the number of windows per second of data depends on the event

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
-#include <spdlog/spdlog.h>
 #include <sstream>
 #include <vector>
 
@@ -147,8 +145,6 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     }
     join(steps, window);
     translation_px_ = probe_(window.t0, window.t1, window.events);
-    spdlog::debug("parallax window at {:.3f} s: {} steps ({:.3f} s, {} events): D = {:.1f} px", window.t0, steps,
-                  window.t1 - window.t0, window.events.size(), translation_px_);
     if (may_shrink && translation_px_ >= 2.0 * o_.target_px) {
       may_shrink = false;
       steps = std::max(min_steps, static_cast<int>(std::ceil(steps * o_.target_px / translation_px_ - 1e-9)));
