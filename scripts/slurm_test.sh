@@ -251,6 +251,7 @@ sequences:
     path: $root/data/sample_seq
     config:
       windows: {policy: events, events: 20000}
+      motion: {model: constant_twist}
   - label: room_gyro
     path: $root/data/sample_seq
     t_end: 0.2

@@ -80,7 +80,7 @@ void describe(FieldVisitor& v, RunConfig& c) {
     describe(s, c.parallax);
   });
   v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) {
-    s.enumeration({"model", "", "constant_twist (paper) or gyro_integrated"}, c.motion,
+    s.enumeration({"model", "", "gyro_integrated: the gyro's rotation within the window; constant_twist: its mean (paper)"}, c.motion,
                   {MotionModelKind::ConstantTwist, MotionModelKind::GyroIntegrated});
     s.enumeration({"omega_source", "", "gyro: the recording's IMU; fixed: fixed_omega"}, c.omega_source,
                   {OmegaSource::Gyro, OmegaSource::Fixed});

@@ -45,7 +45,11 @@ struct RunConfig {
     return w;
   }();
   ParallaxWindowOptions parallax;
-  MotionModelKind motion = MotionModelKind::ConstantTwist;
+  /// The rotation within a window: the gyro's samples integrated
+  /// (gyro_integrated, the default: a hand-held camera's rate changes within
+  /// a window; docs/results.md) or the window's mean rate (constant_twist,
+  /// the paper's model). The velocity is constant in the body frame either way.
+  MotionModelKind motion = MotionModelKind::GyroIntegrated;
   OmegaSource omega_source = OmegaSource::Gyro;
   Vec3 fixed_omega = Vec3::Zero();  ///< [rad/s], camera frame, with OmegaSource::Fixed
   /// Constant gyroscope bias [rad/s], IMU frame: subtracted from every gyro
