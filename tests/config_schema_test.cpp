@@ -241,6 +241,10 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(c.solver.npt.min_lines, 4);
   applyRunSetting("methods=[npt, celc]", c);
   EXPECT_EQ(c.methods, (std::vector<Method>{Method::Npt, Method::Celc}));
+  // A method listed twice would give two identical rows per window: an error.
+  EXPECT_NE(errorOf([&] { applyRunSetting("methods=[celc, npt, celc]", c); }).find("methods: celc listed twice"),
+            std::string::npos);
+  EXPECT_EQ(c.methods, (std::vector<Method>{Method::Npt, Method::Celc}));  // unchanged
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.grid_start=3", c); }),
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, screen_events, profile_lattice, "

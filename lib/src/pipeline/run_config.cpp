@@ -52,6 +52,12 @@ std::string RunConfig::validate() const {
   std::string e = reader.validate() + inSection("windows", windowsValidate()) + gyro.validate() +
                   cluster.validate() + observations.validate() + solver.validate() + groundtruth.validate();
   if (methods.empty()) e += "methods: at least one; ";
+  for (size_t i = 0; i < methods.size(); ++i)
+    if (std::find(methods.begin(), methods.begin() + static_cast<std::ptrdiff_t>(i), methods[i]) !=
+        methods.begin() + static_cast<std::ptrdiff_t>(i)) {
+      e += "methods: " + toString(methods[i]) + " listed twice; ";
+      break;
+    }
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
   if (!gyro_bias.allFinite()) e += "motion.gyro_bias must be finite; ";
   if (gyro_bias_from_still && !gyro_bias.isZero(0.0))

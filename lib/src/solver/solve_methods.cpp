@@ -119,32 +119,27 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     r.sigma_deg = directionSigmaDeg(obs, motion, r.v, scale, u.max_events);
   }
   if (!u.enabled || !u.agreement) return out;
-  // The witnesses: one estimate per method of the celc family, with its Fisher sigma.
+  // The witnesses: the ok estimates of the celc family with their Fisher
+  // sigma, and the linear celc estimate when celc itself was not asked for.
   std::vector<SolverResult> witnesses;
   std::vector<int> witness_of(out.size(), -1);
-  bool celc_witness = false;
+  bool celc_asked = false;
   for (size_t i = 0; i < out.size(); ++i) {
     const Method m = methods[i];
-    if (m != Method::Celc && m != Method::CelcOpt && m != Method::CelcMl) continue;
-    if (!out[i].ok() || !std::isfinite(out[i].sigma_deg)) continue;
-    bool seen = false;
-    for (size_t k = 0; k < i; ++k) seen = seen || (methods[k] == m && witness_of[k] >= 0);
-    if (seen) continue;
+    celc_asked = celc_asked || m == Method::Celc;
+    if ((m != Method::Celc && m != Method::CelcOpt && m != Method::CelcMl) || !out[i].ok() ||
+        !std::isfinite(out[i].sigma_deg))
+      continue;
     witness_of[i] = static_cast<int>(witnesses.size());
     witnesses.push_back(out[i]);
-    celc_witness = celc_witness || m == Method::Celc;
   }
-  if (!celc_witness && have_linear && linear.ok()) {
+  if (!celc_asked && have_linear && linear.ok()) {
     SolverResult w = linear;
     w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
     if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
   }
-  for (size_t i = 0; i < out.size(); ++i) {
-    int self = witness_of[i];
-    for (size_t k = 0; k < i && self < 0; ++k)  // a repeated method is its first occurrence's witness
-      if (methods[k] == methods[i] && witness_of[k] >= 0) self = witness_of[k];
-    if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], self, witnesses);
-  }
+  for (size_t i = 0; i < out.size(); ++i)
+    if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], witness_of[i], witnesses);
   return out;
 }
 
