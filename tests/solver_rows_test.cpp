@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "celc/geometry/line_motion.hpp"
 #include "celc/sim/line_scene.hpp"
 #include "celc/solver/solver.hpp"
 #include "solver/constraint_rows.hpp"
@@ -75,10 +76,11 @@ TEST(GeneralizedEigen3, RejectsIndefiniteB) {
 
 namespace {
 // The sign test counting every vote (kSignVotesPerCluster per cluster), as resolveSign did
-// before it stopped counting once a cluster's majority is decided.
+// before it stopped counting once a cluster's majority is decided (votes weighted by the
+// line's motion as there).
 SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionModel& motion,
                                  const Vec3& v) {
-  int votes = 0, voters = 0;
+  double votes = 0.0, weights = 0.0;
   long event_balance = 0;
   for (int c : detail::usableClusters(obs, 2)) {
     const auto& cl = obs.clusters[c];
@@ -98,13 +100,15 @@ SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionMode
       else if (lambda < 0) ++neg;
     }
     if (pos == neg) continue;
-    ++voters;
-    votes += pos > neg ? 1 : -1;
+    const double w = std::min(lineMotionPx(cl, motion, obs.focal_px, detail::kSignCentroidEvents),
+                              detail::kSignFullWeightPx);
+    votes += pos > neg ? w : -w;
+    weights += w;
     event_balance += pos - neg;
   }
   SignDecision d;
-  if (voters == 0) return d;
-  d.margin = static_cast<double>(votes) / voters;
+  if (!(weights > 0.0)) return d;
+  d.margin = votes / weights;
   d.sign = votes > 0 || (votes == 0 && event_balance >= 0) ? 1 : -1;
   return d;
 }

@@ -106,14 +106,16 @@ void runSolve(const SolveArgs& a) {
   ObservationReport report;
   const WindowObservations obs =
       toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
+  auto listed = [](const std::vector<int>& ids, int id) { return std::find(ids.begin(), ids.end(), id) != ids.end(); };
   for (std::size_t k = 0; k < clusters.clusters.size(); ++k)
-    if (std::find(report.used_ids.begin(), report.used_ids.end(), clusters.clusters[k].id) ==
-        report.used_ids.end())
+    if (!listed(report.used_ids, clusters.clusters[k].id) && !listed(report.merged_ids, clusters.clusters[k].id))
       spdlog::warn("cluster {}: not used by the line methods (fewer than {} events, or its start and end "
                    "lines could not be fitted; npt uses it when it has the events)",
                    clusters.clusters[k].id, cfg.observations.min_events);
-  spdlog::info("solve: {} events, {} clusters with lines, {} without (npt only)", events.size(),
-               report.n_used, obs.clusters.size() - static_cast<std::size_t>(report.n_used));
+  spdlog::info("solve: {} events, {} clusters with lines ({} fragments of an edge joined into them, "
+               "observations.merge_px), {} without (npt only)",
+               events.size(), report.n_used, report.n_merged,
+               obs.clusters.size() - static_cast<std::size_t>(report.n_used));
   const auto& methods = cfg.methods;
   const auto results = solveMethods(obs, motion, methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
   std::cout << "method,status,vx,vy,vz,runtime_us\n";

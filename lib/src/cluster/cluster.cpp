@@ -42,6 +42,7 @@ std::string ClusterOptions::validate() const {
   if (!(c_px_per_s >= 0.0) || !std::isfinite(c_px_per_s)) err << "c_px_per_s must be >= 0 (0 = auto); ";
   if (!(c_min_px_per_s > 0.0 && c_max_px_per_s >= c_min_px_per_s && std::isfinite(c_max_px_per_s)))
     err << "need 0 < c_min_px_per_s <= c_max_px_per_s; ";
+  if (!(c_speed_factor >= 0.1 && c_speed_factor <= 100.0)) err << "c_speed_factor must be in [0.1, 100]; ";
   if (neighbours < 3 || neighbours > 1000) err << "neighbours must be in [3, 1000]; ";
   if (!(pcl_normal_radius_px >= 0.0 && pcl_normal_radius_px <= 50.0))
     err << "pcl_normal_radius_px must be in [0, 50]; ";
@@ -364,8 +365,8 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   double c = opt.c_px_per_s;
   if (c <= 0.0) {
     const double c0 = initialTimeScale(events, opt);
-    c = detail::estimateTimeScaleOnIndex(ptrs, c0, opt);
-    if (c <= 0.0) c = c0;
+    const double speed = detail::estimateTimeScaleOnIndex(ptrs, c0, opt);  // median normal speed
+    c = speed > 0.0 ? std::clamp(opt.c_speed_factor * speed, opt.c_min_px_per_s, opt.c_max_px_per_s) : c0;
   }
   res.c_px_per_s = c;
   res.ms_time_scale = msSince(t_c);

@@ -8,6 +8,7 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
   v.enumeration({"method", "", "grid: own region grower (fast); pcl: PCL region growing"}, o.method,
                 {ClusterMethod::Grid, ClusterMethod::Pcl});
   v.field({"c_px_per_s", "px/s", "time scale of (x, y, c*t); 0 = estimated per window"}, o.c_px_per_s);
+  v.field({"c_speed_factor", "", "automatic c = this factor x the median normal-flow speed"}, o.c_speed_factor);
   v.field({"c_min_px_per_s", "px/s", "lower clamp of the estimated time scale"}, o.c_min_px_per_s);
   v.field({"c_max_px_per_s", "px/s", "upper clamp of the estimated time scale"}, o.c_max_px_per_s);
   v.field({"separate_polarity", "", "cluster ON and OFF events separately (paper)"}, o.separate_polarity);
@@ -37,6 +38,8 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
 
 void describe(FieldVisitor& v, ObservationOptions& o) {
   v.field({"min_events", "events", "clusters with fewer usable events are skipped"}, o.min_events);
+  v.field({"merge_px", "px", "clusters within this median distance of each other's moving line become one (fragments of one edge); 0 = off"},
+          o.merge_px);
 }
 
 }  // namespace celc

@@ -3,13 +3,70 @@
 #include <algorithm>
 #include <numeric>
 #include <sstream>
+#include <utility>
+
+#include "merge_fragments.hpp"
 
 namespace celc {
+
+namespace {
+
+/// Stores the fitted lines in the cluster; has_lines says whether l1 and l3 are usable.
+void attachLines(ClusterObservation& obs, const ClusterLines& lines) {
+  obs.has_lines = lines.ok();
+  if (!obs.has_lines) return;
+  obs.l1 = lines.l1.line;
+  obs.l3 = lines.l3.line;
+  obs.has_l2 = lines.l2.status == LineFitStatus::Ok;
+  if (obs.has_l2) obs.l2 = lines.l2.line;
+}
+
+/// Joins the fragments of one edge (merge_fragments.hpp) into the group's
+/// first cluster, whose lines are fitted again on the joined events; a group
+/// whose joined lines cannot be fitted stays apart.
+void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterLines>& fits, double focal_px,
+                    const ObservationOptions& options, const MotionModel* motion, ObservationReport& rep) {
+  const auto groups = detail::fragmentGroups(built, focal_px, motion, options.merge_px);
+  std::vector<bool> gone(built.size(), false);
+  for (const auto& group : groups) {
+    if (group.size() < 2) continue;
+    ClusterObservation joined;
+    const int joined_id = built[group.front()].id;
+    joined.id = joined_id;
+    std::vector<std::pair<double, Vec3>> all;
+    for (std::size_t c : group)
+      for (std::size_t j = 0; j < built[c].size(); ++j) all.emplace_back(built[c].times[j], built[c].bearings[j]);
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [t, b] : all) joined.times.push_back(t), joined.bearings.push_back(b);
+    const ClusterLines lines = fitClusterLines(joined.times, joined.bearings, focal_px, options.lines, motion);
+    if (!lines.ok()) continue;
+    attachLines(joined, lines);
+    built[group.front()] = std::move(joined);
+    fits[group.front()] = lines;
+    for (std::size_t i = 1; i < group.size(); ++i) {
+      gone[group[i]] = true;
+      rep.merged_ids.push_back(built[group[i]].id);
+      rep.merged_into.push_back(joined_id);
+    }
+    rep.n_merged += static_cast<int>(group.size()) - 1;
+  }
+  std::size_t w = 0;
+  for (std::size_t c = 0; c < built.size(); ++c) {
+    if (gone[c]) continue;
+    if (w != c) built[w] = std::move(built[c]), fits[w] = std::move(fits[c]);
+    ++w;
+  }
+  built.resize(w);
+  fits.resize(w);
+}
+
+}  // namespace
 
 std::string ObservationOptions::validate() const {
   std::ostringstream err;
   err << lines.validate();
   if (min_events < 2) err << "min_events must be >= 2; ";
+  if (!(merge_px >= 0.0 && merge_px <= 20.0)) err << "merge_px must be in [0, 20]; ";
   return err.str();
 }
 
@@ -33,6 +90,9 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     const int l = clusters.labels[i];
     if (l >= 0 && static_cast<size_t>(l) < k) members[l].push_back(static_cast<int>(i));
   }
+  // Each cluster's events (sorted by time) and lines.
+  std::vector<ClusterObservation> built;
+  std::vector<ClusterLines> fits;
   for (size_t c = 0; c < k; ++c) {
     auto& idx = members[c];
     std::stable_sort(idx.begin(), idx.end(),
@@ -51,23 +111,22 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
       ++rep.n_too_few_events;
       continue;
     }
-    const ClusterLines lines = fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion);
-    if (!lines.ok()) {
+    fits.push_back(fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion));
+    attachLines(obs, fits.back());
+    built.push_back(std::move(obs));
+  }
+  if (options.merge_px > 0.0) mergeFragments(built, fits, focal_px, options, motion, rep);
+  for (size_t c = 0; c < built.size(); ++c) {
+    if (!built[c].has_lines) {
       // Kept for the methods that need no lines (npt).
       ++rep.n_line_fit_failed;
-      rep.failed_ids.push_back(obs.id);
-      rep.failed_lines.push_back(lines);
-      obs.has_lines = false;
-      out.clusters.push_back(std::move(obs));
-      continue;
+      rep.failed_ids.push_back(built[c].id);
+      rep.failed_lines.push_back(fits[c]);
+    } else {
+      rep.used_ids.push_back(built[c].id);
+      rep.lines.push_back(fits[c]);
     }
-    obs.l1 = lines.l1.line;
-    obs.l3 = lines.l3.line;
-    obs.has_l2 = lines.l2.status == LineFitStatus::Ok;
-    if (obs.has_l2) obs.l2 = lines.l2.line;
-    rep.used_ids.push_back(obs.id);
-    rep.lines.push_back(lines);
-    out.clusters.push_back(std::move(obs));
+    out.clusters.push_back(std::move(built[c]));
   }
   rep.n_used = static_cast<int>(rep.used_ids.size());
   if (report) *report = rep;

@@ -252,6 +252,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                   index, report.failed_ids[k], toString(l.l1.status), l.l1.n_events, l.l1.rms_px,
                   l.l1.length_px, toString(l.l3.status), l.l3.n_events, l.l3.rms_px, l.l3.length_px);
   }
+  if (report.n_merged > 0)
+    spdlog::debug("window {}: {} clusters joined into others as fragments of one edge (observations.merge_px)",
+                  index, report.n_merged);
   rec.times.lines = secondsSince(start);
   rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
 

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include "celc/geometry/line_motion.hpp"
+
 namespace celc {
 
 std::string toString(WindowPolicy policy) {
@@ -47,30 +49,11 @@ void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
 
 double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
                          int min_clusters) {
-  constexpr std::size_t kCentroidEvents = 64;  // events per cluster for its centroid
   std::vector<double> d;
   for (const ClusterObservation& c : obs.clusters) {
     const double span = c.l3.t - c.l1.t;
     if (!c.has_lines || c.size() == 0 || !(span >= kMinSpanShare * (t1 - t0))) continue;
-    const Vec3 m1 = motion.rotation(c.l1.t) * c.l1.normal;
-    Vec3 m3 = motion.rotation(c.l3.t) * c.l3.normal;
-    if (m1.dot(m3) < 0.0) m3 = -m3;  // the sign of a normal is free: orient l3 as l1
-    // The cluster's centroid in the reference image (events turned by R(t)).
-    Vec3 centroid = Vec3::Zero();
-    int n = 0;
-    const std::size_t step = std::max<std::size_t>(1, c.size() / kCentroidEvents);
-    for (std::size_t j = 0; j < c.size(); j += step) {
-      const Vec3 g = motion.rotation(c.times[j]) * c.bearings[j];
-      if (!(g.z() > 1e-9)) continue;
-      centroid += g / g.z();
-      ++n;
-    }
-    if (n == 0) continue;
-    centroid /= n;
-    // Signed distances of the centroid to both lines [normalised units].
-    auto distance = [&](const Vec3& m) { return m.dot(centroid) / m.head<2>().norm(); };
-    const double s1 = distance(m1), s3 = distance(m3);
-    const double px = obs.focal_px * std::abs(s1 - s3) * (t1 - t0) / span;
+    const double px = lineMotionPx(c, motion, obs.focal_px) * (t1 - t0) / span;
     if (std::isfinite(px)) d.push_back(px);
   }
   if (static_cast<int>(d.size()) < std::max(1, min_clusters)) return NAN;

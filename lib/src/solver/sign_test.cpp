@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "celc/geometry/line_motion.hpp"
+
 namespace celc {
 
 namespace detail {
@@ -73,17 +75,22 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
     s.stride = std::max<size_t>(1, s.cl->size() / kSignVotesPerCluster);
     s.count(motion, v, false);
   }
-  int votes = 0, voters = 0;
-  for (const auto& s : clusters) {
+  // A line that hardly moved (rotation removed) carries almost no depth:
+  // each cluster's vote counts by its line's motion, up to kSignFullWeightPx.
+  double votes = 0.0, weights = 0.0;
+  for (std::size_t i = 0; i < clusters.size(); ++i) {
+    const SignVotes& s = clusters[i];
     if (s.pos == s.neg) continue;
-    ++voters;
-    votes += s.pos > s.neg ? 1 : -1;
+    const double moved = lineMotionPx(*s.cl, motion, obs.focal_px, kSignCentroidEvents);
+    const double w = std::isfinite(moved) ? std::min(moved, kSignFullWeightPx) : 0.0;
+    votes += s.pos > s.neg ? w : -w;
+    weights += w;
   }
   SignDecision d;
-  if (voters == 0) return d;
-  d.margin = static_cast<double>(votes) / voters;
-  if (votes != 0) {
-    d.sign = votes > 0 ? 1 : -1;
+  if (!(weights > 0.0)) return d;
+  d.margin = votes / weights;
+  if (votes != 0.0) {
+    d.sign = votes > 0.0 ? 1 : -1;
     return d;
   }
   long event_balance = 0;

@@ -12,6 +12,11 @@ namespace celc::detail {
 /// decided after 7 of them.
 constexpr size_t kSignVotesPerCluster = 12;
 
+/// A cluster's vote weighs its line's rotation-free motion [px]
+/// (geometry/line_motion.hpp), up to this.
+constexpr double kSignFullWeightPx = 30.0;
+/// Events per cluster for the centroid at which that motion is measured.
+constexpr size_t kSignCentroidEvents = 16;
 /// resolveSign with the window's frames (frames of obs under motion).
 SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v,
                          const WindowFrames& frames);

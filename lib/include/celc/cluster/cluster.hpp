@@ -41,9 +41,14 @@ std::string toString(ClusterMethod method);
 
 struct ClusterOptions {
   ClusterMethod method = ClusterMethod::Grid;
-  /// Time scale c [px/s]: points are (x, y, c*t). 0 = automatic (median normal-flow
-  /// speed of a first pass, see ClusterResult::c_px_per_s).
+  /// Time scale c [px/s]: points are (x, y, c*t). 0 = automatic: c_speed_factor
+  /// times the median normal-flow speed of a first pass (ClusterResult::c_px_per_s).
   double c_px_per_s = 0.0;
+  /// Automatic c = this factor x the median normal-flow speed [-]: an edge at the
+  /// median speed leaves a surface steeper than 45 deg in (x, y, c*t), so its
+  /// time neighbourhoods (+-time_radius_px / c) span 1/factor of the time it
+  /// takes to move time_radius_px (docs/clustering.md, "Choosing c").
+  double c_speed_factor = 3.0;
   /// Automatic c is clamped to [c_min, c_max] [px/s].
   double c_min_px_per_s = 20.0;
   double c_max_px_per_s = 20000.0;
@@ -131,9 +136,9 @@ struct ClusterResult {
 /// non-finite fields or pixels outside [0, 4096) get label -1. Never throws on data; returns a status.
 ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptions& options);
 
-/// Estimates c [px/s] from the data: the median normal-flow speed of local
-/// planes fitted with a first guess of c (iterated twice). Returns 0 when
-/// there are too few events to say.
+/// The median normal-flow speed [px/s] of local planes fitted with a first
+/// guess of c (iterated up to 4 times); clusterEvents' automatic c is
+/// c_speed_factor times it. Returns 0 when there are too few events to say.
 double estimateTimeScale(const std::vector<Event>& events, const ClusterOptions& options);
 
 }  // namespace celc

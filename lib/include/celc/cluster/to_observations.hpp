@@ -20,6 +20,10 @@ using BearingFunction = std::function<Vec3(const Vec2&)>;
 struct ObservationOptions {
   LineFitOptions lines;      ///< l1 / l2 / l3 fitting (interval, minimum events, quality)
   int min_events = 20;       ///< clusters with fewer usable events are skipped
+  /// Clusters whose events lie within this median distance of each other's
+  /// moving line (both ways) are fragments of one edge and become one
+  /// cluster [px]; 0 = never joined.
+  double merge_px = 1.0;
   std::string validate() const;  ///< empty when valid
 };
 /// The schema of the `observations:` section; its `lines` are the top-level
@@ -35,6 +39,9 @@ struct ObservationReport {
   /// l1 or l3 not Ok (too few events, poor fit, l3 not after l1): kept with
   /// has_lines = false (npt uses them; the line methods skip them)
   int n_line_fit_failed = 0;
+  int n_merged = 0;           ///< clusters joined into another (fragments of one edge, merge_px)
+  std::vector<int> merged_ids;       ///< ClusterResult ids of the clusters joined into another
+  std::vector<int> merged_into;      ///< the id each of merged_ids was joined into
   std::vector<int> used_ids;         ///< ClusterResult ids of the clusters used, in output order
   std::vector<ClusterLines> lines;   ///< fitted lines of every used cluster (quality, timestamps)
   std::vector<int> failed_ids;              ///< ClusterResult ids of the clusters whose lines failed

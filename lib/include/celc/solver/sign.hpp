@@ -7,8 +7,8 @@
 
 namespace celc {
 
-/// The sign to apply to v (+1 or -1) and the clusters' vote margin for +v,
-/// (votes for - votes against) / voting clusters, in [-1, 1].
+/// The sign to apply to v (+1 or -1) and the clusters' weighted vote margin
+/// for +v, (weight for - weight against) / total weight, in [-1, 1].
 struct SignDecision {
   int sign = 1;
   double margin = 0.0;
@@ -18,7 +18,9 @@ struct SignDecision {
 /// depth along the event's ray where it meets the planes of l1 and l3,
 ///   lambda = sum_i (m_i.f')(m_i.(P_i v - P_k v)) / sum_i (m_i.f')^2,  f' = R_k f_k,
 /// is odd in v; each cluster votes for the sign its majority of events puts in
-/// front (lambda > 0), and when the clusters tie the balance of events decides.
+/// front (lambda > 0), weighted by how far its line moved once the rotation is
+/// removed (lineMotionPx, at most 30 px: a line that hardly moved gives a
+/// depth of noise); when the weights tie, the balance of events decides.
 SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v);
 
 }  // namespace celc
