@@ -79,11 +79,17 @@ struct SequenceRunner::Impl {
     if (!motionFor(t0, t1, motion, omega, status)) return NAN;
     std::size_t keep_every = std::max<std::size_t>(
         1, (events.size() + config.parallax.probe_events - 1) / config.parallax.probe_events);
+    // A k times sparser subset needs longer time neighbourhoods: the probe
+    // clusters at c = the median normal speed (factor 1), where the sparse
+    // subsets found their clusters before the default factor became 3;
+    // D is a median over clusters and needs no purity.
+    ClusterOptions cluster = config.cluster;
+    cluster.c_speed_factor = std::min(1.0, cluster.c_speed_factor);
     for (;;) {
       std::vector<Event> probe;
       probe.reserve(events.size() / keep_every + 1);
       for (std::size_t i = 0; i < events.size(); i += keep_every) probe.push_back(events[i]);
-      const ClusterResult clusters = clusterEvents(probe, config.cluster);
+      const ClusterResult clusters = clusterEvents(probe, cluster);
       double d = NAN;
       if (clusters.status == ClusterStatus::Ok) {
         const WindowObservations obs = toObservations(
