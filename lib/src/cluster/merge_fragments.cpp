@@ -14,10 +14,6 @@ constexpr int kTestEvents = 48;       // events of a cluster tested against anot
 constexpr double kTimeMargin = 0.1;   // a line is used this share of its span beyond its ends
 constexpr double kMinInside = 0.5;    // share of the tested events that must fall in that span
 
-Mat3 rotationAt(const MotionModel* motion, double t) {
-  return motion ? motion->rotation(t) : Mat3::Identity();
-}
-
 /// A cluster's events, sampled, as reference-frame bearings with their times.
 struct Sample {
   std::vector<double> t;
@@ -32,9 +28,7 @@ double medianDistance(const Sample& s, const MovingLine& line, double focal_px, 
   buffer.clear();
   for (std::size_t j = 0; j < s.t.size(); ++j) {
     if (s.t[j] < lo || s.t[j] > hi) continue;
-    // n and g are the camera's m and f turned by R(t): n.g = m.f, the
-    // normalised point-line distance (m's image part is about unit length).
-    buffer.push_back(std::abs(line.at(s.t[j]).dot(s.g[j])));
+    buffer.push_back(line.distance(s.t[j], s.g[j]));
   }
   if (buffer.size() < kMinInside * static_cast<double>(s.t.size()) || buffer.empty())
     return std::numeric_limits<double>::infinity();
@@ -61,20 +55,7 @@ std::vector<std::vector<std::size_t>> fragmentGroups(const std::vector<ClusterOb
   std::vector<std::size_t> with_lines;
   for (std::size_t c = 0; c < k; ++c) {
     const ClusterObservation& cl = clusters[c];
-    if (!cl.has_lines || cl.size() == 0 || !(cl.l3.t > cl.l1.t)) continue;
-    MovingLine& line = lines[c];
-    line.t1 = cl.l1.t;
-    line.t3 = cl.l3.t;
-    // Unit normals, the image-plane part of each scaled to one so that |n.g|
-    // of a bearing g = (x, y, 1) is a normalised point-line distance.
-    auto imageNormal = [&](const Vec3& m, double t) -> Vec3 {
-      const double s = std::hypot(m.x(), m.y());
-      return rotationAt(motion, t) * (m / s);
-    };
-    line.n1 = imageNormal(cl.l1.normal, line.t1);
-    line.n3 = imageNormal(cl.l3.normal, line.t3);
-    if (line.n3.dot(line.n1) < 0.0) line.n3 = -line.n3;
-    if (!line.n1.allFinite() || !line.n3.allFinite()) continue;
+    if (!movingLine(cl, motion, lines[c])) continue;
     Sample& s = samples[c];
     const std::size_t n = cl.size(), m = std::min<std::size_t>(n, kTestEvents);
     for (std::size_t j = 0; j < m; ++j) {
