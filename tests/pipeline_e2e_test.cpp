@@ -18,6 +18,21 @@
 namespace fs = std::filesystem;
 using namespace celc;
 
+namespace {
+/// A scene file of the repository with lines replaced: each key (the start
+/// of a line) gets the whole given line.
+std::string editedScene(const std::string& file, const std::vector<std::pair<std::string, std::string>>& lines) {
+  std::ifstream in(std::string(CELC_SOURCE_DIR "/config/scenes/") + file);
+  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [key, line] : lines) {
+    const auto at = scene.find(key);
+    if (at == std::string::npos) return "";
+    scene.replace(at, scene.find('\n', at) - at, line);
+  }
+  return scene;
+}
+}  // namespace
+
 // The stated setting (config/scenes/e2e_davis346_room_fast.yaml): a DAVIS346
 // crossing a room of three textured planes 1-2.5 m away at 4 m/s with a slow
 // rotation; 0.1 s windows (0.4 m of translation, 16-40% of the depth),
@@ -95,16 +110,10 @@ TEST(EndToEnd, DenseRecordingGetsWindowsShorterThanTheMaximum) {
 // sigma_deg below 10 deg (measured: every window degenerate, no_parallax).
 TEST(EndToEnd, RenderedPureRotationIsNeverConfident) {
   const fs::path d = test::freshTempDir("e2e_rotation");
-  std::ifstream in(CELC_SOURCE_DIR "/config/scenes/sample_davis346_room.yaml");
-  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto replaceLine = [&](const std::string& key, const std::string& line) {
-    const auto at = scene.find(key);
-    ASSERT_NE(at, std::string::npos) << key;
-    scene.replace(at, scene.find('\n', at) - at, line);
-  };
-  replaceLine("duration:", "duration: 0.6");
-  replaceLine("  v: [", "  v: [0.0, 0.0, 0.0]");
-  replaceLine("  w: [", "  w: [0.6, -1.2, 0.9]");
+  const std::string scene = editedScene("sample_davis346_room.yaml", {{"duration:", "duration: 0.6"},
+                                                                      {"  v: [", "  v: [0.0, 0.0, 0.0]"},
+                                                                      {"  w: [", "  w: [0.6, -1.2, 0.9]"}});
+  ASSERT_FALSE(scene.empty());
   std::ofstream((d / "scene.yaml").string()) << scene;
   const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
   ASSERT_EQ(synth.status, 0) << synth.err;
@@ -126,20 +135,6 @@ TEST(EndToEnd, RenderedPureRotationIsNeverConfident) {
   fs::remove_all(d);
 }
 
-namespace {
-/// A scene file of the repository with lines replaced: each key (the start
-/// of a line) gets the whole given line.
-std::string editedScene(const std::string& file, const std::vector<std::pair<std::string, std::string>>& lines) {
-  std::ifstream in(std::string(CELC_SOURCE_DIR "/config/scenes/") + file);
-  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const auto& [key, line] : lines) {
-    const auto at = scene.find(key);
-    if (at == std::string::npos) return "";
-    scene.replace(at, scene.find('\n', at) - at, line);
-  }
-  return scene;
-}
-}  // namespace
 
 // The automatic time scale (cluster.c_speed_factor, issue 12): on the shipped
 // chessboard (0.25 s: 144,000 events; every grid line a run of squares' edges

@@ -13,6 +13,7 @@ namespace {
 constexpr int kTestEvents = 48;       // events of a cluster tested against another's line
 constexpr double kTimeMargin = 0.1;   // a line is used this share of its span beyond its ends
 constexpr double kMinInside = 0.5;    // share of the tested events that must fall in that span
+constexpr double kMaxPlaneAngle = 0.05;  // [rad] (~3 deg) between the two planes at a common time
 
 /// A cluster's events, sampled, as reference-frame bearings with their times.
 struct Sample {
@@ -66,6 +67,7 @@ std::vector<std::vector<std::size_t>> fragmentGroups(const std::vector<ClusterOb
     with_lines.push_back(c);
   }
   std::vector<double> buffer;
+  const double min_cos = std::cos(kMaxPlaneAngle);
   for (std::size_t a = 0; a < with_lines.size(); ++a) {
     const std::size_t i = with_lines[a];
     for (std::size_t b = a + 1; b < with_lines.size(); ++b) {
@@ -74,7 +76,7 @@ std::vector<std::vector<std::size_t>> fragmentGroups(const std::vector<ClusterOb
       // Cheap test first: the two planes at a common time must nearly agree.
       const double tm = 0.5 * (std::max(lines[i].t1, lines[j].t1) + std::min(lines[i].t3, lines[j].t3));
       const Vec3 ni = lines[i].at(tm).normalized(), nj = lines[j].at(tm).normalized();
-      if (std::abs(ni.dot(nj)) < std::cos(0.05)) continue;  // planes more than ~3 deg apart
+      if (std::abs(ni.dot(nj)) < min_cos) continue;
       if (medianDistance(samples[j], lines[i], focal_px, buffer) > merge_px) continue;
       if (medianDistance(samples[i], lines[j], focal_px, buffer) > merge_px) continue;
       parent[findRoot(parent, static_cast<int>(j))] = findRoot(parent, static_cast<int>(i));

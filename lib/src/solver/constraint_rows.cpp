@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "celc/geometry/line_motion.hpp"
+#include "sign_test.hpp"
 #include "window_checks.hpp"
 
 namespace celc {
@@ -97,8 +99,12 @@ void ClusterRowTerms::row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) 
 }
 
 WindowFrames::WindowFrames(const WindowObservations& obs, const MotionModel& motion)
-    : clusters_(usableClusters(obs, 2)), frames_(obs.clusters.size()) {
-  for (int c : clusters_) frames_[static_cast<size_t>(c)] = makeClusterFrame(obs.clusters[c], motion);
+    : clusters_(usableClusters(obs, 2)), frames_(obs.clusters.size()), line_motion_px_(obs.clusters.size(), NAN) {
+  for (int c : clusters_) {
+    frames_[static_cast<size_t>(c)] = makeClusterFrame(obs.clusters[c], motion);
+    line_motion_px_[static_cast<size_t>(c)] =
+        celc::lineMotionPx(obs.clusters[c], motion, obs.focal_px, kSignCentroidEvents);
+  }
 }
 
 }  // namespace detail

@@ -103,10 +103,14 @@ class WindowFrames {
   const std::vector<int>& clusters() const { return clusters_; }
   /// The frame of cluster c, one of clusters().
   const ClusterFrame& operator[](int c) const { return frames_[static_cast<size_t>(c)]; }
+  /// How far cluster c's line moved, rotation removed [px] (lineMotionPx on
+  /// kSignCentroidEvents events; NaN without lines): the weight of its sign vote.
+  double lineMotionPx(int c) const { return line_motion_px_[static_cast<size_t>(c)]; }
 
  private:
   std::vector<int> clusters_;
   std::vector<ClusterFrame> frames_;  // by cluster index; set for clusters_
+  std::vector<double> line_motion_px_;  // by cluster index; set for clusters_
 };
 
 }  // namespace celc::detail

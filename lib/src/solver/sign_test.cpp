@@ -6,8 +6,6 @@
 #include <cstdlib>
 #include <vector>
 
-#include "celc/geometry/line_motion.hpp"
-
 namespace celc {
 
 namespace detail {
@@ -81,7 +79,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   for (std::size_t i = 0; i < clusters.size(); ++i) {
     const SignVotes& s = clusters[i];
     if (s.pos == s.neg) continue;
-    const double moved = lineMotionPx(*s.cl, motion, obs.focal_px, kSignCentroidEvents);
+    const double moved = frames.lineMotionPx(frames.clusters()[i]);
     const double w = std::isfinite(moved) ? std::min(moved, kSignFullWeightPx) : 0.0;
     votes += s.pos > s.neg ? w : -w;
     weights += w;
