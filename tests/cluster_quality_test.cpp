@@ -345,6 +345,16 @@ TEST(ClusterDegenerate, InvalidOptions) {
   const ClusterResult r = clusterEvents(window(1, 2000).events, opt);
   EXPECT_EQ(r.status, ClusterStatus::InvalidOptions);
   EXPECT_NE(r.message.find("smoothness_deg"), std::string::npos);
+  for (double factor : {0.0, -3.0, 1000.0, std::numeric_limits<double>::quiet_NaN()}) {
+    ClusterOptions bad;
+    bad.c_speed_factor = factor;
+    EXPECT_NE(bad.validate().find("c_speed_factor"), std::string::npos) << factor;
+  }
+  for (double merge : {-1.0, 50.0, std::numeric_limits<double>::quiet_NaN()}) {
+    ObservationOptions bad;
+    bad.merge_px = merge;
+    EXPECT_NE(bad.validate().find("merge_px"), std::string::npos) << merge;
+  }
   EXPECT_THROW(parseClusterMethod("kmeans"), std::invalid_argument);
   EXPECT_EQ(parseClusterMethod("pcl"), ClusterMethod::Pcl);
 }
