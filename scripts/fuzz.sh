@@ -6,6 +6,9 @@
 # peak RSS. Exit status 1 when any target crashed or timed out.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 30 s, every target)
 #   scripts/fuzz.sh --build-only                          (install, build, seeds; no run)
+#   scripts/fuzz.sh --ci [TARGET...]                      (CI: a fixed number of executions per
+#        target, about 20 s each on this machine, with libFuzzer's seed 1 unless CELC_FUZZ_SEED
+#        says otherwise: the same mutations every time, so that a CI run repeats)
 # Environment: CELC_FUZZ_BUILD_DIR (default build-fuzz), CELC_JOBS (default nproc),
 #   CELC_FUZZ_RSS_MB (default 1024), CELC_FUZZ_MALLOC_MB (default 64: no single
 #   allocation above 64 MB), CELC_FUZZ_TIMEOUT (default 10 s per input),
@@ -23,8 +26,16 @@ if [ "${1:-}" = "--build-only" ]; then
   build_only=1
   shift
 fi
-seconds="${1:-30}"
-shift || true
+ci_runs=0
+if [ "${1:-}" = "--ci" ]; then
+  ci_runs=1
+  shift
+  export CELC_FUZZ_SEED="${CELC_FUZZ_SEED:-1}"
+  seconds=0
+else
+  seconds="${1:-30}"
+  shift || true
+fi
 build="${CELC_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 rss="${CELC_FUZZ_RSS_MB:-1024}"
 malloc_mb="${CELC_FUZZ_MALLOC_MB:-64}"
@@ -96,6 +107,24 @@ max_len_of() {
   esac
 }
 
+# CI's executions per target: about 20 s each at the rates of a fresh corpus on
+# this machine (docs/fuzzing.md).
+ci_runs_of() {
+  case "$1" in
+    events_text) echo 20000 ;;
+    rpg_sequence) echo 25000 ;;
+    calibration) echo 15000 ;;
+    config_yaml) echo 16000 ;;
+    aedat2) echo 100000 ;;
+    aedat31) echo 80000 ;;
+    aedat4_none) echo 40000 ;;
+    aedat4_lz4) echo 80000 ;;
+    aedat4_zstd) echo 50000 ;;
+    rosbag) echo 6000 ;;
+    hdf5) echo 2500 ;;
+  esac
+}
+
 rows=()
 status=0
 for t in "${targets[@]}"; do
@@ -104,13 +133,19 @@ for t in "${targets[@]}"; do
   mkdir -p "$corpus" "$artifacts"
   before="$(ls "$artifacts" | wc -l)"
   log="$build/fuzz-$t.log"
-  echo "fuzz: $t for $seconds s" >&2
+  if [ "$ci_runs" -eq 1 ]; then
+    limit=(-runs="$(ci_runs_of "$t")")
+    echo "fuzz: $t for $(ci_runs_of "$t") executions" >&2
+  else
+    limit=(-max_total_time="$seconds")
+    echo "fuzz: $t for $seconds s" >&2
+  fi
   start=$(date +%s)
   set +e
   LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp}" \
   ASAN_OPTIONS="${ASAN_OPTIONS:-allocator_may_return_null=0:detect_leaks=1}" \
   UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
-    nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb="$rss" \
+    nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" "${limit[@]}" -rss_limit_mb="$rss" \
     -malloc_limit_mb="$malloc_mb" -timeout="$timeout_s" -max_len="$(max_len_of "$t")" -dict="$(dict_of "$t")" \
     -seed="${CELC_FUZZ_SEED:-0}" -print_final_stats=1 -artifact_prefix="$artifacts/" "$corpus" "$seeds/$t" >"$log" 2>&1
   rc=$?
@@ -132,6 +167,7 @@ done
 echo "| target        |   executions |  exec/s | crashes | timeouts | peak RSS    | wall s |"
 echo "|---------------|--------------|---------|---------|----------|-------------|--------|"
 printf '%s\n' "${rows[@]}"
-echo "($seconds s per target, -rss_limit_mb=$rss -malloc_limit_mb=$malloc_mb -timeout=$timeout_s -max_len 4096-32768;" \
+[ "$ci_runs" -eq 1 ] && per="a fixed number of executions per target, seed $CELC_FUZZ_SEED" || per="$seconds s per target"
+echo "($per, -rss_limit_mb=$rss -malloc_limit_mb=$malloc_mb -timeout=$timeout_s -max_len 4096-32768;" \
      "logs in $build/fuzz-<target>.log)"
 exit "$status"

@@ -2,11 +2,14 @@
 // hold the sequence `celc synth` rendered as text, and must read back as it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
 #include "celc/io/event_reader.hpp"
 #include "celc/io/text_io.hpp"
+#include "io/aedat_readers.hpp"
+#include "io/hdf5_object_header.hpp"
 #include "io_fixtures.hpp"
 #include "cli_util.hpp"
 #include "io_test_util.hpp"
@@ -122,4 +125,74 @@ TEST(IoHdf5, MissingFilterPluginIsNamed) {
   EXPECT_NE(err.find("hdf5-filter-plugin-blosc-serial"), std::string::npos) << err;
   EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
   fs::remove_all(d);
+}
+
+TEST(IoHdf5, NewestHeaderVersionsReadAsTheText) {
+  CELC_REQUIRE_IO_FIXTURES();
+  // superblock 3 after a user block, version 2 headers continued in OCHK chunks
+  auto r = openEventSource(fixture("seq_dsec_v2.h5"));
+  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
+  celc::detail::BinFile raw(fixture("seq_dsec_v2.h5"));
+  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+  EXPECT_EQ(sb.version, 3);
+  EXPECT_EQ(sb.base, 512u);
+  const auto messages = celc::detail::checkHdf5ObjectHeader(
+      raw, sb, celc::detail::hdf5LinkAddress(fixture("seq_dsec_v2.h5"), "/events/x"), "/events/x");
+  EXPECT_GE(std::count_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x10; }), 1);
+}
+
+namespace {
+
+/// `file` with the message `m` of an object header made a continuation
+/// message to `chunk_bytes` bytes at `chunk_address` (8-byte addresses and lengths).
+std::string withContinuation(std::string file, const celc::detail::Hdf5Message& m, int header_version,
+                             std::uint64_t chunk_address, std::uint64_t chunk_bytes) {
+  if (header_version == 1) {
+    file[m.data_byte - 8] = 0x10;  // type, u16
+    file[m.data_byte - 7] = 0;
+  } else {
+    file[m.data_byte - 4] = 0x10;  // type, u8 (no creation order)
+  }
+  for (int i = 0; i < 8; ++i) {
+    file[m.data_byte + i] = char((chunk_address >> (8 * i)) & 0xFF);
+    file[m.data_byte + 8 + i] = char((chunk_bytes >> (8 * i)) & 0xFF);
+  }
+  return file;
+}
+
+}  // namespace
+
+// The hdf5 fuzz target's finding: a dataset header's message turned into a
+// continuation to 4 GB at 1 MB of a small file made libhdf5 reserve 4 GB
+// before it compared the chunk with the file's end. Every header the reader
+// opens (the root group's, each group's and dataset's) is checked first.
+TEST(IoHdf5, HeaderChunksPastTheFileAreRefusedBeforeTheLibraryReadsThem) {
+  CELC_REQUIRE_IO_FIXTURES();
+  celc::test::TempDir dir;
+  for (const char* name : {"seq_dsec.h5", "seq_dsec_v2.h5"}) {
+    std::ifstream in(fixture(name), std::ios::binary);
+    const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    celc::detail::BinFile raw(fixture(name));
+    const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+    const int version = sb.version <= 1 ? 1 : 2;  // h5py: the earliest versions, or the newest
+    for (const std::string object : {"/", "/events", "/events/y"}) {
+      const std::uint64_t address =
+          object == "/" ? sb.root_header : celc::detail::hdf5LinkAddress(fixture(name), object);
+      const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, address, object);
+      auto m = std::find_if(messages.begin(), messages.end(), [](const auto& x) { return x.size >= 16; });
+      ASSERT_NE(m, messages.end()) << name << " " << object;
+      SCOPED_TRACE(std::string(name) + " " + object);
+      const std::string path = dir.file("patched.h5");
+      std::ofstream(path, std::ios::binary) << withContinuation(good, *m, version, 1u << 20, 0x100080005ull);
+      std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+      EXPECT_EQ(e, path + ": byte " + std::to_string(m->data_byte) + ": object header of " + object +
+                       ": continuation chunk of 4295491589 bytes at address 1048576 passes the file's end (" +
+                       std::to_string(good.size()) + " bytes)");
+      // a continuation that loops back to its own header is walked once and refused by the library
+      std::ofstream(path, std::ios::binary) << withContinuation(good, *m, version, address, 64);
+      e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+      EXPECT_EQ(e.rfind(path + ": ", 0), 0u) << e;
+      EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+  }
 }

@@ -15,11 +15,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
+#include <memory>
+#include <set>
 
 #include "celc/core/text.hpp"
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
+#include "io/hdf5_object_header.hpp"
 
 namespace celc::detail {
 namespace {
@@ -66,11 +68,15 @@ class Hdf5Reader final : public EventReader {
     path_ = path;
     options_ = o;
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures come back as return codes, reported here
+    // The library reads the root group's header (and the superblock
+    // extension's) when it opens the file: they are checked first.
+    raw_ = std::make_unique<BinFile>(path);
+    superblock_ = readHdf5Superblock(*raw_);
+    checkHeader(superblock_.root_header, "/");
+    if (superblock_.extension != ~0ull) checkHeader(superblock_.extension, "the superblock extension");
     file_ = H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!file_.valid()) throw IoError(path + ": byte 0: not a readable HDF5 file (damaged or truncated?)");
-    std::error_code size_error;
-    file_bytes_ = std::filesystem::file_size(path, size_error);
-    if (size_error) throw IoError(path + ": cannot read its size (" + size_error.message() + ")");
+    file_bytes_ = raw_->size();
     if (exists("/events/x") || exists("/events/t")) {
       layout_ = Layout::Dsec;
       for (const char* n : {"x", "y", "t", "p"}) {
@@ -199,11 +205,32 @@ class Hdf5Reader final : public EventReader {
     throw IoError(path_ + ": dataset " + dataset + ": " + what);
   }
 
+  /// Checks the object header at `address` once (hdf5_object_header.hpp).
+  void checkHeader(std::uint64_t address, const std::string& object) const {
+    if (checked_.insert(address).second) checkHdf5ObjectHeader(*raw_, superblock_, address, object);
+  }
+
+  /// Checks the header of the object `name` links to, before the library reads
+  /// it; only hard links are followed (a soft or external link would make the
+  /// library read an object, or a file, these checks never saw).
+  void checkLinkTarget(const std::string& name) const {
+    H5L_info_t info;
+    if (H5Lget_info(file_.get(), name.c_str(), &info, H5P_DEFAULT) < 0)
+      throw IoError(path_ + ": " + name + ": its link cannot be read (damaged file)");
+    if (info.type != H5L_TYPE_HARD)
+      throw IoError(path_ + ": " + name + " is a soft or external link; only hard links are followed");
+    checkHeader(std::uint64_t(info.u.address), name);
+  }
+
   bool exists(const std::string& name) const {
-    // Each link along the path must exist before the next is asked about.
+    // Each link along the path must exist, and its group's header be checked,
+    // before the next is asked about (asking reads the group's header).
     std::size_t p = 0;
-    while ((p = name.find('/', p + 1)) != std::string::npos)
-      if (H5Lexists(file_.get(), name.substr(0, p).c_str(), H5P_DEFAULT) <= 0) return false;
+    while ((p = name.find('/', p + 1)) != std::string::npos) {
+      const std::string group = name.substr(0, p);
+      if (H5Lexists(file_.get(), group.c_str(), H5P_DEFAULT) <= 0) return false;
+      checkLinkTarget(group);
+    }
     return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0;
   }
 
@@ -211,6 +238,7 @@ class Hdf5Reader final : public EventReader {
     Dataset d;
     d.name = name;
     if (!exists(name)) throw IoError(path_ + ": dataset " + name + " is missing");
+    checkLinkTarget(name);
     d.id = H5Id(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
     if (!d.id.valid()) fail(name, "cannot be opened (not a dataset?)");
     d.space = H5Id(H5Dget_space(d.id.get()), H5Sclose);
@@ -357,6 +385,9 @@ class Hdf5Reader final : public EventReader {
     }
   }
 
+  std::unique_ptr<BinFile> raw_;  ///< the same file, for the header checks
+  Hdf5Superblock superblock_;
+  mutable std::set<std::uint64_t> checked_;  ///< addresses of the object headers checked
   H5Id file_;
   Layout layout_ = Layout::Dsec;
   std::uintmax_t file_bytes_ = 0;  ///< the file's size [bytes]
@@ -375,6 +406,15 @@ class Hdf5Reader final : public EventReader {
 
 std::unique_ptr<EventReader> openHdf5(const std::string& path, const ReaderOptions& o) {
   return std::make_unique<Hdf5Reader>(path, o);
+}
+
+std::uint64_t hdf5LinkAddress(const std::string& path, const std::string& link) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  H5Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  H5L_info_t info;
+  if (!file.valid() || H5Lget_info(file.get(), link.c_str(), &info, H5P_DEFAULT) < 0 || info.type != H5L_TYPE_HARD)
+    throw IoError(path + ": " + link + ": no hard link");
+  return std::uint64_t(info.u.address);
 }
 
 }  // namespace celc::detail

@@ -1,0 +1,166 @@
+#include "io/hdf5_object_header.hpp"
+
+#include <cstring>
+#include <set>
+
+namespace celc::detail {
+namespace {
+
+constexpr char kSignature[] = "\x89HDF\r\n\x1a\n";
+constexpr int kContinuation = 0x10;
+constexpr std::size_t kMaxChunks = 4096;  ///< chunks walked per header (a loop of continuations ends here)
+
+/// Little-endian unsigned integer of `n` (1-8) bytes.
+std::uint64_t loadUnsigned(const unsigned char* p, int n) {
+  std::uint64_t v = 0;
+  for (int i = n - 1; i >= 0; --i) v = (v << 8) | p[i];
+  return v;
+}
+
+/// Bytes [at, at + n) of the file; throws when they are not all there.
+std::vector<unsigned char> bytesAt(BinFile& file, std::uint64_t at, std::uint64_t n, const std::string& what) {
+  if (at > file.size() || n > file.size() - at)
+    file.fail(at, what + ": " + std::to_string(n) + " bytes from here pass the file's end (" +
+                      std::to_string(file.size()) + " bytes)");
+  std::vector<unsigned char> b(static_cast<std::size_t>(n));
+  file.seek(at);
+  file.readExact(b.data(), b.size(), what.c_str());
+  return b;
+}
+
+/// The messages in `chunk` (the bytes of one chunk's message area, starting at
+/// absolute byte `start`) of a version 1 or 2 header.
+void collectMessages(const std::vector<unsigned char>& chunk, std::uint64_t start, int header_version,
+                     bool creation_order, std::vector<Hdf5Message>& out) {
+  const std::size_t head = header_version == 1 ? 8 : (creation_order ? 6 : 4);
+  std::size_t p = 0;
+  while (p + head <= chunk.size()) {
+    Hdf5Message m;
+    if (header_version == 1) {
+      m.type = int(loadUnsigned(&chunk[p], 2));
+      m.size = loadUnsigned(&chunk[p + 2], 2);
+    } else {
+      m.type = chunk[p];
+      m.size = loadUnsigned(&chunk[p + 1], 2);
+    }
+    m.data_byte = start + p + head;
+    if (p + head + m.size > chunk.size()) return;  // a damaged message: the library reports it
+    out.push_back(m);
+    p += head + std::size_t(m.size);
+  }
+}
+
+}  // namespace
+
+bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address) {
+  const std::uint64_t ones = sb.offset_bytes >= 8 ? ~0ull : (std::uint64_t(1) << (8 * sb.offset_bytes)) - 1;
+  return address == ones;
+}
+
+Hdf5Superblock readHdf5Superblock(BinFile& file) {
+  Hdf5Superblock sb;
+  std::uint64_t at = 0;
+  for (;; at = at == 0 ? 512 : at * 2) {
+    if (at + 8 > file.size()) file.fail(0, "no HDF5 superblock signature at byte 0, 512, 1024, ...");
+    unsigned char sig[8];
+    file.seek(at);
+    file.readExact(sig, 8, "HDF5 signature");
+    if (std::memcmp(sig, kSignature, 8) == 0) break;
+  }
+  sb.base = at;
+  const std::vector<unsigned char> h = bytesAt(file, at, std::min<std::uint64_t>(file.size() - at, 256), "superblock");
+  if (h.size() < 16) file.fail(at, "truncated HDF5 superblock");
+  sb.version = h[8];
+  std::size_t addresses = 0;  // offset of the base address field
+  if (sb.version == 0 || sb.version == 1) {
+    sb.offset_bytes = h[13];
+    sb.length_bytes = h[14];
+    addresses = sb.version == 0 ? 24 : 28;
+  } else if (sb.version == 2 || sb.version == 3) {
+    sb.offset_bytes = h[9];
+    sb.length_bytes = h[10];
+    addresses = 12;
+  } else {
+    file.fail(at + 8, "HDF5 superblock version " + std::to_string(sb.version) + " (this reader knows 0-3)");
+  }
+  for (int n : {sb.offset_bytes, sb.length_bytes})
+    if (n != 2 && n != 4 && n != 8)
+      file.fail(at + 9, "HDF5 addresses or lengths of " + std::to_string(n) + " bytes (2, 4 or 8 are read)");
+  const std::size_t o = std::size_t(sb.offset_bytes);
+  // v0/1: base, free space, end of file, driver info, then the root entry (link name offset, header address);
+  // v2/3: base, extension, end of file, root header address.
+  const std::size_t root_field = sb.version <= 1 ? addresses + 5 * o : addresses + 3 * o;
+  if (root_field + o > h.size()) file.fail(at, "truncated HDF5 superblock");
+  sb.root_header = loadUnsigned(&h[root_field], sb.offset_bytes);
+  if (sb.version >= 2) sb.extension = loadUnsigned(&h[addresses + o], sb.offset_bytes);
+  if (sb.version <= 1 || hdf5Undefined(sb, sb.extension)) sb.extension = ~0ull;
+  return sb;
+}
+
+std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address,
+                                               const std::string& object) {
+  const std::string what = "object header of " + object;
+  if (address > file.size() - std::min(file.size(), sb.base))
+    file.fail(sb.base, what + " at address " + std::to_string(address) + ", beyond the file's end (" +
+                           std::to_string(file.size()) + " bytes)");
+  const std::uint64_t at = sb.base + address;
+  const std::vector<unsigned char> prefix = bytesAt(file, at, std::min<std::uint64_t>(file.size() - at, 64), what);
+  int version = 0;
+  bool creation_order = false;
+  std::uint64_t first = 0, size = 0;  // message area of chunk 0: absolute byte, bytes
+  if (prefix.size() >= 16 && prefix[0] == 1) {
+    version = 1;
+    size = loadUnsigned(&prefix[8], 4);
+    first = at + 16;
+  } else if (prefix.size() >= 7 && std::memcmp(prefix.data(), "OHDR", 4) == 0 && prefix[4] == 2) {
+    version = 2;
+    const unsigned flags = prefix[5];
+    creation_order = (flags & 0x04) != 0;
+    std::size_t p = 6 + ((flags & 0x20) ? 16 : 0) + ((flags & 0x10) ? 4 : 0);
+    const int width = 1 << (flags & 0x03);
+    if (p + std::size_t(width) > prefix.size()) file.fail(at, what + ": truncated prefix");
+    size = loadUnsigned(&prefix[p], width);
+    first = at + p + std::size_t(width);
+  } else {
+    file.fail(at, what + ": neither a version 1 nor a version 2 (OHDR) object header");
+  }
+  std::vector<Hdf5Message> messages;
+  std::set<std::uint64_t> seen{at};
+  struct Chunk {
+    std::uint64_t start, bytes;
+  };
+  std::vector<Chunk> todo{{first, size}};
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    if (k >= kMaxChunks) file.fail(at, what + ": more than " + std::to_string(kMaxChunks) + " chunks");
+    const Chunk c = todo[k];
+    const std::uint64_t checksum = version == 2 ? 4 : 0;
+    if (c.bytes > file.size() || c.start > file.size() - c.bytes || file.size() - c.start - c.bytes < checksum)
+      file.fail(c.start, what + ": a chunk of " + std::to_string(c.bytes) + " bytes passes the file's end (" +
+                             std::to_string(file.size()) + " bytes)");
+    const std::size_t before = messages.size();
+    collectMessages(bytesAt(file, c.start, c.bytes, what), c.start, version, creation_order, messages);
+    for (std::size_t i = before; i < messages.size(); ++i) {
+      const Hdf5Message& m = messages[i];
+      if (m.type != kContinuation) continue;
+      const std::size_t o = std::size_t(sb.offset_bytes), l = std::size_t(sb.length_bytes);
+      if (m.size < o + l) file.fail(m.data_byte, what + ": a continuation message of " + std::to_string(m.size) + " bytes");
+      const std::vector<unsigned char> d = bytesAt(file, m.data_byte, o + l, what);
+      const std::uint64_t chunk_address = loadUnsigned(d.data(), sb.offset_bytes);
+      const std::uint64_t chunk_bytes = loadUnsigned(d.data() + o, sb.length_bytes);
+      const std::uint64_t in_file = file.size() - sb.base;
+      const std::uint64_t sig = version == 2 ? 4 : 0;
+      if (chunk_address > in_file || chunk_bytes > in_file - chunk_address || chunk_bytes < sig + checksum)
+        file.fail(m.data_byte, what + ": continuation chunk of " + std::to_string(chunk_bytes) + " bytes at address " +
+                                   std::to_string(chunk_address) + " passes the file's end (" +
+                                   std::to_string(file.size()) + " bytes)");
+      const std::uint64_t chunk_at = sb.base + chunk_address;
+      if (!seen.insert(chunk_at).second) continue;
+      if (version == 2 && std::memcmp(bytesAt(file, chunk_at, 4, what).data(), "OCHK", 4) != 0)
+        file.fail(chunk_at, what + ": continuation chunk without its OCHK signature");
+      todo.push_back({chunk_at + sig, chunk_bytes - sig - checksum});
+    }
+  }
+  return messages;
+}
+
+}  // namespace celc::detail

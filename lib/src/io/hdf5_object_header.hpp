@@ -1,0 +1,58 @@
+#pragma once
+// Checks of HDF5 object headers made before the HDF5 C library reads them.
+// The library sizes its metadata-cache buffers from fields of the file (an
+// object header's chunk sizes, a continuation message's length) before it
+// compares them with the file's end: a 14 KB file whose continuation message
+// claims 4 GB made it reserve 4 GB (found by the hdf5 fuzz target). The reader
+// checks every object header it is about to open with these functions: every
+// chunk of the header must lie inside the file.
+//
+// Format facts (HDF5 file format specification, version 3.0): the superblock
+// sits at byte 0, 512, 1024, 2048, ... and every file address is relative to
+// it; object header version 1 is a 16-byte prefix (version 1, message count,
+// reference count, chunk size) followed by 8-byte message headers (type u16,
+// size u16, flags, 3 reserved); version 2 starts with "OHDR" and its
+// continuation chunks with "OCHK", message headers are type u8, size u16,
+// flags and an optional u16 creation order, and every chunk ends with a
+// 4-byte checksum. A continuation message (type 0x10) holds a chunk's address
+// and length.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/binary_file.hpp"
+
+namespace celc::detail {
+
+/// What the checks need from the superblock.
+struct Hdf5Superblock {
+  std::uint64_t base = 0;           ///< byte of the superblock: addresses are relative to it
+  int version = 0;                  ///< 0-3
+  int offset_bytes = 8;             ///< size of a file address [bytes]
+  int length_bytes = 8;             ///< size of a length [bytes]
+  std::uint64_t root_header = 0;    ///< address of the root group's object header
+  std::uint64_t extension = ~0ull;  ///< address of the superblock extension's header (~0: none)
+};
+
+/// One message of an object header, as found in the file.
+struct Hdf5Message {
+  int type = 0;
+  std::uint64_t data_byte = 0;  ///< absolute byte of its data
+  std::uint64_t size = 0;       ///< its data [bytes]
+};
+
+/// Finds and reads the superblock; throws IoError naming the file and byte
+/// when there is none or its fields cannot be used.
+Hdf5Superblock readHdf5Superblock(BinFile& file);
+
+/// True for the all-ones "undefined address" of `sb`'s address size.
+bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address);
+
+/// Checks the object header of `object` at file address `address`: its
+/// prefix, and every chunk it reaches through continuation messages, must lie
+/// inside the file. Throws IoError "FILE: byte N: object header of OBJECT: ...".
+/// Returns the messages of every chunk (in chunk order).
+std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address,
+                                               const std::string& object);
+
+}  // namespace celc::detail
