@@ -196,3 +196,33 @@ TEST(IoHdf5, HeaderChunksPastTheFileAreRefusedBeforeTheLibraryReadsThem) {
     }
   }
 }
+
+// The hdf5 fuzz target's next finding: an old-style group's local heap whose
+// data segment claims 88 TB made libhdf5 size a buffer from it while looking
+// up a link. The heap of every group the reader walks is checked first.
+TEST(IoHdf5, LocalHeapPastTheFileIsRefusedBeforeTheLibraryReadsIt) {
+  CELC_REQUIRE_IO_FIXTURES();
+  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
+  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
+  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+  ASSERT_EQ(sb.offset_bytes, 8);
+  ASSERT_EQ(sb.length_bytes, 8);
+  const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, sb.root_header, "/");
+  const auto table = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x11; });
+  ASSERT_NE(table, messages.end());
+  std::uint64_t heap = 0;
+  for (int i = 7; i >= 0; --i) heap = (heap << 8) | std::uint8_t(file[table->data_byte + 8 + i]);
+  ASSERT_EQ(file.substr(heap, 4), "HEAP");
+  for (int i = 0; i < 8; ++i) file[heap + 8 + i] = char(i == 5 ? 0x50 : 0);  // 0x500000000000 bytes
+  celc::test::TempDir dir;
+  const std::string path = dir.file("heap.h5");
+  std::ofstream(path, std::ios::binary) << file;
+  const std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+  EXPECT_EQ(e.rfind(path + ": byte " + std::to_string(heap + 8) +
+                        ": object header of /: local heap data of 87960930222080 bytes at address ",
+                    0),
+            0u)
+      << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}

@@ -8,6 +8,7 @@ namespace {
 
 constexpr char kSignature[] = "\x89HDF\r\n\x1a\n";
 constexpr int kContinuation = 0x10;
+constexpr int kSymbolTable = 0x11;  ///< an old-style group: its B-tree's and local heap's addresses
 constexpr std::size_t kMaxChunks = 4096;  ///< chunks walked per header (a loop of continuations ends here)
 
 /// Little-endian unsigned integer of `n` (1-8) bytes.
@@ -48,6 +49,25 @@ void collectMessages(const std::vector<unsigned char>& chunk, std::uint64_t star
     out.push_back(m);
     p += head + std::size_t(m.size);
   }
+}
+
+/// The local heap of an old-style group (the names of its links): "HEAP",
+/// version 0, 3 reserved bytes, the data segment's size (a length), the free
+/// list's offset (a length), the data segment's address. Its data segment must
+/// lie inside the file: the library sizes its buffer from that field.
+void checkLocalHeap(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address, const std::string& what) {
+  const std::uint64_t in_file = file.size() - sb.base;
+  const std::size_t o = std::size_t(sb.offset_bytes), l = std::size_t(sb.length_bytes);
+  if (address > in_file) file.fail(sb.base, what + ": local heap at address " + std::to_string(address) +
+                                                ", beyond the file's end (" + std::to_string(file.size()) + " bytes)");
+  const std::vector<unsigned char> h = bytesAt(file, sb.base + address, 8 + 2 * l + o, what + ": local heap");
+  if (std::memcmp(h.data(), "HEAP", 4) != 0) file.fail(sb.base + address, what + ": local heap without its HEAP signature");
+  const std::uint64_t bytes = loadUnsigned(&h[8], sb.length_bytes);
+  const std::uint64_t data = loadUnsigned(&h[8 + 2 * l], sb.offset_bytes);
+  if (data > in_file || bytes > in_file - data)
+    file.fail(sb.base + address + 8, what + ": local heap data of " + std::to_string(bytes) + " bytes at address " +
+                                         std::to_string(data) + " passes the file's end (" +
+                                         std::to_string(file.size()) + " bytes)");
 }
 
 }  // namespace
@@ -141,8 +161,12 @@ std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblo
     collectMessages(bytesAt(file, c.start, c.bytes, what), c.start, version, creation_order, messages);
     for (std::size_t i = before; i < messages.size(); ++i) {
       const Hdf5Message& m = messages[i];
-      if (m.type != kContinuation) continue;
       const std::size_t o = std::size_t(sb.offset_bytes), l = std::size_t(sb.length_bytes);
+      if (m.type == kSymbolTable) {
+        if (m.size < 2 * o) file.fail(m.data_byte, what + ": a symbol table message of " + std::to_string(m.size) + " bytes");
+        checkLocalHeap(file, sb, loadUnsigned(bytesAt(file, m.data_byte + o, o, what).data(), sb.offset_bytes), what);
+      }
+      if (m.type != kContinuation) continue;
       if (m.size < o + l) file.fail(m.data_byte, what + ": a continuation message of " + std::to_string(m.size) + " bytes");
       const std::vector<unsigned char> d = bytesAt(file, m.data_byte, o + l, what);
       const std::uint64_t chunk_address = loadUnsigned(d.data(), sb.offset_bytes);

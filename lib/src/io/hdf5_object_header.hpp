@@ -15,7 +15,8 @@
 // continuation chunks with "OCHK", message headers are type u8, size u16,
 // flags and an optional u16 creation order, and every chunk ends with a
 // 4-byte checksum. A continuation message (type 0x10) holds a chunk's address
-// and length.
+// and length; a symbol table message (type 0x11) the addresses of an old-style
+// group's B-tree and local heap, whose data segment the library reads whole.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -49,8 +50,9 @@ Hdf5Superblock readHdf5Superblock(BinFile& file);
 bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address);
 
 /// Checks the object header of `object` at file address `address`: its
-/// prefix, and every chunk it reaches through continuation messages, must lie
-/// inside the file. Throws IoError "FILE: byte N: object header of OBJECT: ...".
+/// prefix, every chunk it reaches through continuation messages, and an
+/// old-style group's local heap (its symbol table message) must lie inside the
+/// file. Throws IoError "FILE: byte N: object header of OBJECT: ...".
 /// Returns the messages of every chunk (in chunk order).
 std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address,
                                                const std::string& object);
