@@ -226,3 +226,41 @@ TEST(IoHdf5, LocalHeapPastTheFileIsRefusedBeforeTheLibraryReadsIt) {
       << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
+
+// The hdf5 fuzz target's third finding: a chunked layout of rank 0 made
+// libhdf5 divide by zero (SIGFPE) when it opened the dataset. The layout
+// message of every dataset is checked before the library opens it.
+TEST(IoHdf5, ChunkedLayoutWithoutChunkSizesIsAnErrorNotADivisionByZero) {
+  CELC_REQUIRE_IO_FIXTURES();
+  celc::test::TempDir dir;
+  for (const char* name : {"seq_dsec.h5", "seq_dsec_v2.h5"}) {
+    SCOPED_TRACE(name);
+    std::ifstream in(fixture(name), std::ios::binary);
+    const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    celc::detail::BinFile raw(fixture(name));
+    const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+    const auto messages = celc::detail::checkHdf5ObjectHeader(
+        raw, sb, celc::detail::hdf5LinkAddress(fixture(name), "/events/t"), "/events/t");
+    const auto layout = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x08; });
+    ASSERT_NE(layout, messages.end());
+    const std::size_t at = layout->data_byte;
+    const int version = good[at];
+    ASSERT_EQ(int(good[at + 1]), 2) << "a chunked layout";
+    // version 3: rank at 2, sizes (u32) after the 8-byte address; version 4: rank at 3, sizes at 5
+    const std::size_t rank_at = at + (version == 3 ? 2 : 3), first_size = at + (version == 3 ? 11 : 5);
+    ASSERT_TRUE(version == 3 || version == 4) << version;
+    const std::string path = dir.file("layout.h5");
+    std::string bad = good;
+    bad[rank_at] = 0;
+    std::ofstream(path, std::ios::binary) << bad;
+    std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+    EXPECT_EQ(e, path + ": byte " + std::to_string(at) + ": object header of /events/t: a chunked layout of rank 0 (at least 2)");
+    bad = good;
+    const int width = version == 3 ? 4 : int(good[at + 4]);
+    for (int i = 0; i < width; ++i) bad[first_size + std::size_t(i)] = 0;
+    std::ofstream(path, std::ios::binary) << bad;
+    e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+    EXPECT_EQ(e, path + ": byte " + std::to_string(first_size) +
+                     ": object header of /events/t: chunk size 0 in dimension 0");
+  }
+}

@@ -8,6 +8,7 @@ namespace {
 
 constexpr char kSignature[] = "\x89HDF\r\n\x1a\n";
 constexpr int kContinuation = 0x10;
+constexpr int kLayout = 0x08;       ///< a dataset's storage: compact, contiguous or chunked (and its chunk's sizes)
 constexpr int kSymbolTable = 0x11;  ///< an old-style group: its B-tree's and local heap's addresses
 constexpr std::size_t kMaxChunks = 4096;  ///< chunks walked per header (a loop of continuations ends here)
 
@@ -68,6 +69,45 @@ void checkLocalHeap(BinFile& file, const Hdf5Superblock& sb, std::uint64_t addre
     file.fail(sb.base + address + 8, what + ": local heap data of " + std::to_string(bytes) + " bytes at address " +
                                          std::to_string(data) + " passes the file's end (" +
                                          std::to_string(file.size()) + " bytes)");
+}
+
+/// A chunked layout's chunk sizes must be positive and its rank (the dataset's
+/// plus one, for the element size) at least 2: the library divides the
+/// dataset's sizes by them. Layout message versions 1-2: version, rank, class,
+/// 5 reserved, an address unless compact, then rank u32 sizes; version 3:
+/// version, class, then for chunked rank, address, rank u32 sizes; version 4:
+/// version, class, then for chunked flags, rank, the sizes' width (1-8), the sizes.
+void checkLayout(BinFile& file, const Hdf5Superblock& sb, const Hdf5Message& m, const std::string& what) {
+  if (m.size < 2) return;  // the library reports a message this short
+  const std::vector<unsigned char> d = bytesAt(file, m.data_byte, m.size, what);
+  const int version = d[0];
+  const std::size_t o = std::size_t(sb.offset_bytes);
+  std::size_t first = 0, rank = 0, width = 4;
+  if (version == 1 || version == 2) {
+    if (d.size() < 8 || d[2] != 2) return;
+    rank = d[1];
+    first = 8 + o;
+  } else if (version == 3) {
+    if (d[1] != 2 || d.size() < 3) return;
+    rank = d[2];
+    first = 3 + o;
+  } else if (version == 4) {
+    if (d[1] != 2 || d.size() < 5) return;
+    rank = d[3];
+    width = d[4];
+    first = 5;
+    if (width < 1 || width > 8) file.fail(m.data_byte + 4, what + ": chunk sizes of " + std::to_string(width) + " bytes");
+  } else {
+    return;
+  }
+  // the rank counts the dataset's dimensions and the element size: a chunked dataset has at least one
+  if (rank < 2) file.fail(m.data_byte, what + ": a chunked layout of rank " + std::to_string(rank) + " (at least 2)");
+  for (std::size_t k = 0; k < rank; ++k) {
+    const std::size_t at = first + k * width;
+    if (at + width > d.size()) file.fail(m.data_byte, what + ": a chunked layout message too short for its rank");
+    if (loadUnsigned(&d[at], int(width)) == 0)
+      file.fail(m.data_byte + at, what + ": chunk size 0 in dimension " + std::to_string(k));
+  }
 }
 
 }  // namespace
@@ -166,6 +206,7 @@ std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblo
         if (m.size < 2 * o) file.fail(m.data_byte, what + ": a symbol table message of " + std::to_string(m.size) + " bytes");
         checkLocalHeap(file, sb, loadUnsigned(bytesAt(file, m.data_byte + o, o, what).data(), sb.offset_bytes), what);
       }
+      if (m.type == kLayout) checkLayout(file, sb, m, what);
       if (m.type != kContinuation) continue;
       if (m.size < o + l) file.fail(m.data_byte, what + ": a continuation message of " + std::to_string(m.size) + " bytes");
       const std::vector<unsigned char> d = bytesAt(file, m.data_byte, o + l, what);

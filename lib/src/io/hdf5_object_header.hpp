@@ -15,7 +15,8 @@
 // continuation chunks with "OCHK", message headers are type u8, size u16,
 // flags and an optional u16 creation order, and every chunk ends with a
 // 4-byte checksum. A continuation message (type 0x10) holds a chunk's address
-// and length; a symbol table message (type 0x11) the addresses of an old-style
+// and length; a layout message (type 0x08) a chunked dataset's chunk sizes,
+// by which the library divides; a symbol table message (type 0x11) the addresses of an old-style
 // group's B-tree and local heap, whose data segment the library reads whole.
 #include <cstdint>
 #include <string>
@@ -52,7 +53,7 @@ bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address);
 /// Checks the object header of `object` at file address `address`: its
 /// prefix, every chunk it reaches through continuation messages, and an
 /// old-style group's local heap (its symbol table message) must lie inside the
-/// file. Throws IoError "FILE: byte N: object header of OBJECT: ...".
+/// file; a chunked layout's chunk sizes must be positive. Throws IoError "FILE: byte N: object header of OBJECT: ...".
 /// Returns the messages of every chunk (in chunk order).
 std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address,
                                                const std::string& object);
