@@ -106,6 +106,10 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
     });
     EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    // cut inside the root group's header (at byte 96 of h5py's files): said before the library reads it
+    if (keep == 100) {
+      EXPECT_NE(m.find(": object header of /: the file ends inside it (truncated?)"), std::string::npos) << m;
+    }
   }
 }
 

@@ -181,6 +181,8 @@ std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblo
     if (p + std::size_t(width) > prefix.size()) file.fail(at, what + ": truncated prefix");
     size = loadUnsigned(&prefix[p], width);
     first = at + p + std::size_t(width);
+  } else if (prefix.size() < 16) {
+    file.fail(at, what + ": the file ends inside it (truncated?)");
   } else {
     file.fail(at, what + ": neither a version 1 nor a version 2 (OHDR) object header");
   }
