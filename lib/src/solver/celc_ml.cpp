@@ -113,10 +113,22 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
     if (r.ok) best = std::move(r);
   }
+  // The residual reported is the Huber cost's (the starts' competition).
+  const double residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));
+  // A last refinement under a redescending loss (ml.cauchy_scale), from the
+  // winner (the basin is chosen under Huber, whose cost has fewer minima),
+  // where the residuals have a heavier tail than Gaussian noise gives.
+  const JointProblem::Spread spread = problem.spread(best.state);
+  const double cauchy_px = options.ml.cauchy_scale * spread.scale;
+  if (cauchy_px > 0.0 && std::isfinite(cauchy_px) && spread.tail_share > options.ml.cauchy_min_tail) {
+    problem.setLoss(JointProblem::Loss::Cauchy, cauchy_px);
+    JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
+    if (r.ok) best = std::move(r);
+  }
   SolverResult out;
   out.status = SolveStatus::Ok;
   out.v = best.state.v.dot(best_start->v) < 0 ? Vec3(-best.state.v) : best.state.v;  // keep the start's sign
-  out.residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));
+  out.residual_px = residual_px;
   out.iterations = best.iterations;
   out.rows_used = best.events;
   // The winner keeps its start's singular values and sign margin; a start

@@ -35,7 +35,7 @@ std::vector<EventTerm>& threadBuffer() {
 JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& motion,
                            const WindowFrames& frames, int max_events, bool balance_clusters,
                            std::uint64_t event_seed, double huber_px)
-    : focal_(obs.focal_px), huber_(huber_px) {
+    : focal_(obs.focal_px), scale_(huber_px) {
   const std::vector<int>& usable = frames.clusters();
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
@@ -72,14 +72,40 @@ JointProblem::~JointProblem() {
 
 size_t JointProblem::events() const { return terms_.size(); }
 
-double JointProblem::robustScale(const State& s) const {
+double JointProblem::rho(double d) const {
+  if (loss_ == Loss::Cauchy) {
+    const double q = d / scale_;
+    return scale_ * scale_ * std::log1p(q * q);
+  }
+  double slope;
+  const double r = sqrtHuber(d, scale_, &slope);
+  return r * r;
+}
+
+double JointProblem::weighted(double d, double* slope) const {
+  if (loss_ == Loss::Cauchy) {
+    const double q = d / scale_;
+    *slope = 1.0 / std::sqrt(1.0 + q * q);
+    return *slope * d;
+  }
+  return sqrtHuber(d, scale_, slope);
+}
+
+JointProblem::Spread JointProblem::spread(const State& s) const {
   std::vector<double> d;
   d.reserve(terms_.size());
   for (size_t c = 0; c + 1 < begin_.size(); ++c)
     for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
       d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
-  return 1.4826 * medianAbs(d);
+  Spread out;
+  size_t beyond = 0;
+  out.scale = 1.4826 * medianAbs(d);  // reorders d
+  for (double x : d) beyond += !(std::abs(x) <= 3.0 * out.scale);
+  out.tail_share = d.empty() ? 0.0 : static_cast<double>(beyond) / static_cast<double>(d.size());
+  return out;
 }
+
+double JointProblem::robustScale(const State& s) const { return spread(s).scale; }
 
 JointProblem::State JointProblem::start(const Vec3& v) const { return {v.normalized(), m1_, m3_}; }
 
@@ -89,9 +115,7 @@ double JointProblem::cost(const State& s, int stride) const {
     for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
       const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr);
       if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
-      double slope;
-      const double r = sqrtHuber(d, huber_, &slope);
-      total += r * r;
+      total += rho(d);
     }
   return 0.5 * total;
 }
@@ -112,7 +136,8 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
   State trial = s;
   for (int it = 0; it < max_iterations; ++it) {
     out.iterations = it + 1;
-    // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s.
+    // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s (Huber),
+    // or of r = sqrt(w(d_s)) d with the weights frozen at s (Cauchy: IRLS).
     const Mat32 Bv = tangentBasis(s.v);
     Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
     Eigen::Vector2d bv = Eigen::Vector2d::Zero();
@@ -127,7 +152,7 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
         const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, &gv, &g1, &g3);
         if (!std::isfinite(d)) continue;  // not at s: its cost is finite
         double slope;
-        const double r = sqrtHuber(d, huber_, &slope);
+        const double r = weighted(d, &slope);
         const Eigen::Vector2d jv = slope * (Bv.transpose() * gv);
         Vec4 jc;
         jc.head<2>() = slope * (B1[c].transpose() * g1);

@@ -70,6 +70,12 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
                                 "refine.huber_px (0 = off)"},
           o.huber_scale);
+  v.field({"cauchy_scale", "-", "then a last refinement under a Cauchy loss at this times the residuals' robust "
+                                 "scale: other edges' events in a cluster stop pulling (0 = off)"},
+          o.cauchy_scale);
+  v.field({"cauchy_min_tail", "-", "... only when more than this share of the residuals lie beyond 3 robust "
+                                    "scales (Gaussian noise: 0.0027)"},
+          o.cauchy_min_tail);
 }
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {
