@@ -129,6 +129,18 @@ TEST(Pipeline, ShardsUnionEqualsSingleRun) {
   EXPECT_EQ(t_single.out, t_merged.out);
   EXPECT_NE(t_single.out.find("| seq | eps (unit-vector distance) |"), std::string::npos) << t_single.out;
   EXPECT_NE(t_single.out.find("**"), std::string::npos);  // best in bold
+  EXPECT_EQ(t_merged.err.find("rows missing"), std::string::npos) << t_merged.err;
+  // A shard that lost a row (cut or edited) is flagged: its methods would
+  // be summarised over different windows.
+  {
+    const fs::path csv = d / "s2" / "seq" / "windows.csv";
+    std::string text = readAll(csv);
+    text.erase(text.find_last_of('\n', text.size() - 2) + 1);  // drop the last row
+    std::ofstream(csv, std::ios::trunc) << text;
+  }
+  const auto t_cut = test::runCelc("table '" + (d / "s1").string() + "' '" + (d / "s2").string() + "'", d);
+  ASSERT_EQ(t_cut.status, 0) << t_cut.err;
+  EXPECT_NE(t_cut.err.find("'seq': 1 (window, method) rows missing"), std::string::npos) << t_cut.err;
   fs::remove_all(d);
 }
 

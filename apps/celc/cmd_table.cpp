@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include "celc/eval/run_tables.hpp"
 #include "celc/io/labelled_events.hpp"
@@ -156,6 +157,23 @@ void runTable(const TableArgs& a) {
         rows.push_back(r);
       }
       if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", s.csv.string(), dup, g.label);
+    }
+    // Every window has a row per method of the run: a missing one means a
+    // file (a shard) was cut or edited, and the methods' columns would
+    // summarise different windows.
+    std::set<std::int64_t> windows;
+    std::set<std::string> methods;
+    for (const auto& [w, m] : seen) windows.insert(w), methods.insert(m);
+    if (const std::size_t missing = windows.size() * methods.size() - seen.size(); missing > 0) {
+      const auto first = [&]() -> std::pair<std::int64_t, std::string> {
+        for (std::int64_t w : windows)
+          for (const auto& m : methods)
+            if (!seen.count({w, m})) return {w, m};
+        return {};
+      }();
+      spdlog::warn("'{}': {} (window, method) rows missing, e.g. window {} of {}: a file of this run was cut or "
+                   "edited, so its methods are summarised over different windows",
+                   g.label, missing, first.first, first.second);
     }
     if (a.max_sigma_deg >= 0.0) {
       // Only the windows a user would keep: ok rows above the threshold (or
