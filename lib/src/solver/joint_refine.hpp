@@ -6,7 +6,8 @@
 // normal equations have a 2x2 block for v (tangent of the unit sphere),
 // a 4x4 block per cluster (the tangents of m1 and m3) and their coupling,
 // so one step costs O(events) and a 2x2 solve. The same cost as the Ceres
-// refinement (refine.hpp), without its per-problem set-up.
+// refinement (refine.hpp), without its per-problem set-up; or, after
+// setLoss(Cauchy), the Cauchy cost by iteratively reweighted steps.
 #include <cstdint>
 #include <vector>
 
