@@ -1,11 +1,13 @@
 // CELC, CE3LC and the refinements on the paper's synthetic scenes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 #include "celc/geometry/so3.hpp"
 #include "celc/sim/line_scene.hpp"
+#include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
 #include "solver/constraint_rows.hpp"
 #include "solver/refine_costs.hpp"
@@ -156,6 +158,34 @@ TEST(Solvers, ErrorFallsWithNumberOfLines) {
 TEST(Solvers, SignRightOnNoiseFreeData) {
   const auto s = runTrials(noiseFree(), 200, 5, {Method::Celc, Method::Ce3lc});
   for (const auto& m : s) EXPECT_GE(m.sign_right, 0.99 * 200);
+}
+
+// Where the direction is weakly determined (the peers' scene at V = 2 m/s,
+// 1 px: the two smallest generalised eigenvalues within ~10%), the IRLS's
+// fixed-point step overshot into a 2-cycle 9-15 deg wide and ran all its
+// iterations, its answer set by their parity: 5 of these 20 fixed-seed
+// trials ran to max_iterations. With the relaxed step at most one may (a
+// slow creep along a valley whose eigenvalues are within 3% can still use
+// them all; measured: one).
+TEST(Solvers, LinearIrlsSettlesWhereTheDirectionIsWeak) {
+  PeerSceneOptions o;
+  std::mt19937_64 rng(42);
+  const LinearOptions opt;
+  int trials = 0, at_limit = 0;
+  double phi_sum = 0.0;
+  while (trials < 20) {
+    const PeerSceneTrial tr = generatePeerScene(o, rng);
+    if (!tr.ok) continue;
+    ++trials;
+    const SolverResult r = solveCelcLinear(tr.observations, tr.given_motion, opt);
+    ASSERT_TRUE(r.ok()) << r.message;
+    at_limit += r.iterations >= opt.max_iterations;
+    phi_sum += std::acos(std::min(1.0, std::abs(tr.true_direction.dot(r.v.normalized()))));
+  }
+  EXPECT_LE(at_limit, 1);
+  // Still the estimator it was: the mean sign-agnostic error stays near the
+  // study's figures for celc in this cell (median 5 deg, docs/peers.md).
+  EXPECT_LT(phi_sum / trials * 180.0 / M_PI, 15.0);
 }
 
 TEST(Degeneracy, ZeroVelocityIsDegenerate) {

@@ -44,6 +44,9 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   };
   std::vector<Start> starts;
   if (linear.ok()) starts.push_back({linear.v, &linear});
+  // An ambiguous nullspace still points into a valley of the cost.
+  else if (linear.degeneracy == Degeneracy::NullspaceNotUnique && linear.v.norm() > 0.5)
+    starts.push_back({linear.v, nullptr});
   if (npt && npt->ok()) starts.push_back({npt->v, npt});
   const auto t0 = std::chrono::steady_clock::now();
   // The profile's minima need no linear estimate: a window whose linear

@@ -52,6 +52,7 @@ SolverResult nullspaceResult(const NullspaceSolution& ns, const WindowObservatio
     r.degeneracy = Degeneracy::NullspaceNotUnique;
     r.message = "two smallest singular values too close (ratio " + std::to_string(ratio) + " over " +
                 std::to_string(rows) + " rows: direction std about " + std::to_string(implied_deg) + " deg)";
+    if (ns.v.allFinite() && ns.v.norm() > 0.0) r.v = ns.v.normalized();
     return r;
   }
   r.v = ns.v.normalized();

@@ -113,11 +113,20 @@ double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::
 //
 // An iteration is the scale from a strided sample of rows, then one fused
 // pass over every row for the weights and the weighted sums (irls_kernel).
+//
+// Where the two smallest generalised eigenvalues are close (a weakly
+// determined direction) the fixed-point step can overshoot and settle into a
+// 2-cycle, whose end point then depends on the iteration count's parity. So
+// the step is relaxed: v moves by a share of the fixed-point step, 1 at
+// first and halved whenever a step reverses the previous one (negative dot
+// product); the fixed points are unchanged.
 NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt) {
   NullspaceSolution out;
   std::vector<double> sample;
   Vec3 lambda;
   Mat3 X;
+  Vec3 last_step = Vec3::Zero();
+  double relax = 1.0;  // share of the fixed-point step taken, halved at every reversal
   for (int it = 0; it < std::max(1, opt.max_iterations); ++it) {
     const double scale = sampledMad(P, v, 0.0, sample);
     const double thr = opt.huber_k * std::max(scale, 1e-15);
@@ -131,6 +140,10 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
     out.sigma_min = std::sqrt(std::max(0.0, lambda(0)));
     out.sigma_second = std::sqrt(std::max(0.0, lambda(1)));
     out.iterations = it + 1;
+    const Vec3 step = next - v;
+    if (step.dot(last_step) < 0.0) relax *= 0.5;
+    next = (v + relax * step).normalized();
+    last_step = next - v;
     const double delta = std::acos(std::min(1.0, next.dot(v)));
     v = next;
     if (delta < opt.tolerance) break;

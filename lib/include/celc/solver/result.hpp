@@ -20,7 +20,11 @@ struct SolverResult {
   SolveStatus status = SolveStatus::Failed;
   Degeneracy degeneracy = Degeneracy::None;
   std::string message;            ///< human-readable detail when not ok
-  Vec3 v = Vec3::Zero();          ///< unit linear velocity direction, reference camera frame
+  /// Unit linear velocity direction, reference camera frame. Not an estimate
+  /// unless ok(): a linear method whose nullspace is not unique
+  /// (Degeneracy::NullspaceNotUnique) leaves its ambiguous direction here, sign
+  /// unresolved, which celc_ml still tries as a start.
+  Vec3 v = Vec3::Zero();
   double sigma_min = 0.0;         ///< smallest singular value of the final weighted system
   double sigma_second = 0.0;      ///< second smallest
   int iterations = 0;             ///< IRLS or Levenberg-Marquardt iterations
