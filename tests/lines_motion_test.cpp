@@ -110,10 +110,11 @@ TEST(LinesMotion, SparseClustersKeepEveryLineAndEveryMethodAnswers) {
     EXPECT_EQ(r.lines_rejected, 0) << events << " events per line";
     for (size_t k = 0; k < methods.size(); ++k) {
       const auto not_ok = std::count(r.deg[k].begin(), r.deg[k].end(), 180.0);
-      if (methods[k] != Method::Ce3lc)
+      if (methods[k] != Method::Ce3lc) {
         EXPECT_EQ(not_ok, 0) << toString(methods[k]) << " with " << events << " events per line";
-      else if (events == 200)
+      } else if (events == 200) {
         EXPECT_LE(not_ok, 2) << "ce3lc with 200 events per line";
+      }
     }
   }
 }
