@@ -79,6 +79,29 @@ TEST(LineProfile, VanishesAtTheTruthWithoutNoiseUnderAConstantTwist) {
   }
 }
 
+// With noise the screen's descent ends at a local minimum of J to its
+// tolerance: no point of a ring of 8 directions at twice the tolerance
+// around it is lower.
+TEST(LineProfile, ScreenEndsAtLocalMinima) {
+  for (std::uint64_t seed : {11, 12, 13}) {
+    const PeerSceneTrial tr = peerTrial(seed, 2.0, 1.0, 100);
+    ASSERT_TRUE(tr.ok);
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const detail::LineProfile profile(tr.observations, tr.given_motion, frames.clusters(), 0, 1);
+    const double tol_deg = 0.1;
+    const auto minima = detail::screenProfile(profile, 100, 3, tol_deg, 2.0);
+    ASSERT_FALSE(minima.empty());
+    for (const auto& m : minima) {
+      const Vec3 e1 = m.v.unitOrthogonal(), e2 = m.v.cross(e1);
+      for (int k = 0; k < 8; ++k) {
+        const double a = k * M_PI / 4.0, r = 2.0 * tol_deg / kDeg;
+        const Vec3 c = (m.v + r * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+        EXPECT_GE(profile(c), m.cost) << "seed " << seed << " direction " << k;
+      }
+    }
+  }
+}
+
 // The joint Levenberg-Marquardt minimises the same cost as the Ceres
 // refinement (refine.hpp): from the same start both end at the same point.
 TEST(JointProblem, ReachesTheCeresRefinementsMinimum) {
@@ -113,6 +136,29 @@ TEST(JointProblem, ConvergesToTheTruthWithoutNoise) {
   const auto r = problem.refine(problem.start(start), 100, 1e-14);
   ASSERT_TRUE(r.ok);
   EXPECT_LT(angleBetweenSignAgnostic(r.state.v, tr.true_direction) * kDeg, 1e-4);
+}
+
+// A start that comes within merge_rad of an earlier end point stops there
+// (merged) after fewer steps than its full descent; an end point elsewhere
+// does not stop it.
+TEST(JointProblem, StopsWhereAnEarlierEndIs) {
+  const PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
+  ASSERT_TRUE(tr.ok);
+  const detail::WindowFrames frames(tr.observations, tr.given_motion);
+  const detail::JointProblem problem(tr.observations, tr.given_motion, frames, 0, false, 1, 1.5);
+  const Vec3 axis = tr.true_direction.cross(Vec3::UnitZ()).normalized();
+  const Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
+  const auto full = problem.refine(problem.start(start), 100, 1e-14);
+  ASSERT_TRUE(full.ok);
+  const double merge_rad = 1.0 / kDeg;
+  const auto merged = problem.refine(problem.start(start), 100, 1e-14, 1, {-tr.true_direction}, merge_rad);
+  ASSERT_TRUE(merged.ok);
+  EXPECT_TRUE(merged.merged);
+  EXPECT_LT(merged.iterations, full.iterations);
+  EXPECT_LT(angleBetweenSignAgnostic(merged.state.v, tr.true_direction), merge_rad);
+  const auto apart = problem.refine(problem.start(start), 100, 1e-14, 1, {axis}, merge_rad);
+  EXPECT_FALSE(apart.merged);
+  EXPECT_EQ(apart.iterations, full.iterations);
 }
 
 // The default celc_ml beside the bound on fixed trials of the peers' scene

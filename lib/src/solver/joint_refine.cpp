@@ -121,7 +121,9 @@ double JointProblem::cost(const State& s, int stride) const {
 }
 
 JointProblem::Result JointProblem::refine(State s, int max_iterations, double function_tolerance,
-                                          int stride) const {
+                                          int stride, const std::vector<Vec3>& merge_into,
+                                          double merge_rad) const {
+  const double merge_cos = std::cos(merge_rad);
   Result out;
   const size_t nc = begin_.size() - 1;
   for (size_t c = 0; c < nc; ++c)
@@ -205,6 +207,11 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
         // Converged: the cost or v no longer moves (v's step below
         // kStepTolerance rad, as Ceres' parameter tolerance).
         if (decrease < function_tolerance || dv.norm() < kStepTolerance) it = max_iterations;
+        for (const Vec3& e : merge_into)
+          if (merge_rad > 0.0 && std::abs(e.dot(s.v)) >= merge_cos * e.norm()) {
+            out.merged = true;
+            it = max_iterations;
+          }
       } else {
         lambda *= 4.0;
       }

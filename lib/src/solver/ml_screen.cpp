@@ -83,6 +83,48 @@ double LineProfile::operator()(const Vec3& v) const {
   return total;
 }
 
+namespace {
+
+/// Damped Newton descent of J on the tangent plane at s.v, from the 6-point
+/// finite-difference quadratic model (gradient and Hessian at spacing h);
+/// steps at most max_step [rad], halved until J falls, until a step is
+/// below tol [rad]. Where the model is not convex the step follows the
+/// negative gradient. (A pattern search of 8 tangent directions needed
+/// several times as many evaluations of J; docs/peers.md.)
+void descend(const LineProfile& profile, ScreenMinimum& s, double max_step, double tol) {
+  const double h = std::max(tol, 1e-4);
+  for (int it = 0; it < 20; ++it) {
+    const Mat32 B = tangentBasis(s.v);
+    auto at = [&](double a, double b) { return profile((s.v + a * B.col(0) + b * B.col(1)).normalized()); };
+    const double jp1 = at(h, 0), jm1 = at(-h, 0), jp2 = at(0, h), jm2 = at(0, -h), jpp = at(h, h);
+    const Eigen::Vector2d g((jp1 - jm1) / (2 * h), (jp2 - jm2) / (2 * h));
+    Eigen::Matrix2d H;
+    H(0, 0) = (jp1 - 2 * s.cost + jm1) / (h * h);
+    H(1, 1) = (jp2 - 2 * s.cost + jm2) / (h * h);
+    H(0, 1) = H(1, 0) = (jpp - jp1 - jp2 + s.cost) / (h * h);
+    Eigen::Vector2d step;
+    const bool convex = H(0, 0) > 0 && H.determinant() > 0;
+    if (convex) step = -H.ldlt().solve(g);
+    else step = -g.normalized() * max_step;
+    if (!step.allFinite()) return;
+    if (step.norm() > max_step) step *= max_step / step.norm();
+    // Halve until J falls; a step below tol ends the descent.
+    bool moved = false;
+    for (; step.norm() >= tol; step *= 0.5) {
+      const Vec3 c = (s.v + B * step).normalized();
+      const double j = profile(c);
+      if (j < s.cost) {
+        s = {c, j};
+        moved = true;
+        break;
+      }
+    }
+    if (!moved || step.norm() < tol) return;
+  }
+}
+
+}  // namespace
+
 std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice, int keep,
                                          double tolerance_deg, double separation_deg) {
   std::vector<ScreenMinimum> out;
@@ -93,8 +135,8 @@ std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice
   for (const Vec3& d : dirs) grid.push_back({d, profile(d)});
   std::sort(grid.begin(), grid.end(),
             [](const ScreenMinimum& a, const ScreenMinimum& b) { return a.cost < b.cost; });
-  // Lattice spacing on the hemisphere (2 pi sr): the first pattern step, and
-  // the suppression radius among lattice starts.
+  // Lattice spacing on the hemisphere (2 pi sr): the longest descent step,
+  // and the suppression radius among lattice starts.
   const double spacing = std::sqrt(2.0 * M_PI / static_cast<double>(dirs.size()));
   std::vector<ScreenMinimum> starts;
   for (const ScreenMinimum& g : grid) {
@@ -105,26 +147,7 @@ std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice
   }
   const double tol = tolerance_deg * M_PI / 180.0;
   for (ScreenMinimum s : starts) {
-    // Pattern search on the tangent plane: 8 directions, step halved when
-    // none is lower.
-    double step = spacing;
-    Vec3 e1 = tangentBasis(s.v).col(0), e2 = s.v.cross(e1);
-    while (step > tol) {
-      ScreenMinimum best = s;
-      for (int k = 0; k < 8; ++k) {
-        const double a = k * M_PI / 4.0;
-        const Vec3 c = (s.v + step * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
-        const double j = profile(c);
-        if (j < best.cost) best = {c, j};
-      }
-      if (best.cost < s.cost) {
-        s = best;
-        e1 = (e1 - e1.dot(s.v) * s.v).normalized();
-        e2 = s.v.cross(e1);
-      } else {
-        step *= 0.5;
-      }
-    }
+    descend(profile, s, spacing, tol);
     bool merged = false;
     for (ScreenMinimum& o : out)
       if (angleBetweenSignAgnostic(o.v, s.v) * 180.0 / M_PI < separation_deg) {

@@ -60,9 +60,9 @@ struct ScreenMinimum {
 };
 
 /// Local minima of J over the hemisphere: J on a lattice of `lattice`
-/// directions, then a pattern search (tangent steps halving down to
-/// `tolerance_deg`) from the lattice's `keep` lowest points that are local
-/// minima of the lattice; minima closer than `separation_deg` merge.
+/// directions, then a damped Newton descent on the tangent plane (steps
+/// down to `tolerance_deg`) from the lattice's `keep` lowest separated
+/// points; minima closer than `separation_deg` merge.
 std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice, int keep,
                                          double tolerance_deg, double separation_deg);
 
