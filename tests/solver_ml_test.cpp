@@ -138,9 +138,9 @@ TEST(JointProblem, ConvergesToTheTruthWithoutNoise) {
   EXPECT_LT(angleBetweenSignAgnostic(r.state.v, tr.true_direction) * kDeg, 1e-4);
 }
 
-// A start that comes within merge_rad of an earlier end point stops there
-// (merged) after fewer steps than its full descent; an end point elsewhere
-// does not stop it.
+// A start that comes within merge_rad of an earlier end point (in v and in
+// every line) stops there (merged) after fewer steps than its full descent;
+// an end point apart in v, or in one line, does not stop it.
 TEST(JointProblem, StopsWhereAnEarlierEndIs) {
   const PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
   ASSERT_TRUE(tr.ok);
@@ -150,15 +150,24 @@ TEST(JointProblem, StopsWhereAnEarlierEndIs) {
   const Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
   const auto full = problem.refine(problem.start(start), 100, 1e-14);
   ASSERT_TRUE(full.ok);
+  ASSERT_GT(full.iterations, 3);
   const double merge_rad = 1.0 / kDeg;
-  const auto merged = problem.refine(problem.start(start), 100, 1e-14, 1, {-tr.true_direction}, merge_rad);
+  detail::JointProblem::State end = full.state;
+  end.v = -end.v;  // sign-agnostic
+  const auto merged = problem.refine(problem.start(start), 100, 1e-14, 1, {end}, merge_rad);
   ASSERT_TRUE(merged.ok);
   EXPECT_TRUE(merged.merged);
   EXPECT_LT(merged.iterations, full.iterations);
   EXPECT_LT(angleBetweenSignAgnostic(merged.state.v, tr.true_direction), merge_rad);
-  const auto apart = problem.refine(problem.start(start), 100, 1e-14, 1, {axis}, merge_rad);
+  detail::JointProblem::State elsewhere = full.state;
+  elsewhere.v = axis;
+  const auto apart = problem.refine(problem.start(start), 100, 1e-14, 1, {elsewhere}, merge_rad);
   EXPECT_FALSE(apart.merged);
   EXPECT_EQ(apart.iterations, full.iterations);
+  detail::JointProblem::State other_line = full.state;
+  other_line.m3.back() = other_line.m3.back().unitOrthogonal();
+  const auto line_apart = problem.refine(problem.start(start), 100, 1e-14, 1, {other_line}, merge_rad);
+  EXPECT_FALSE(line_apart.merged);
 }
 
 // The default celc_ml beside the bound on fixed trials of the peers' scene

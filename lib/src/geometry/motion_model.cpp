@@ -56,7 +56,7 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   }
   // Re-anchor so that R(t_ref) = I and P(t_ref) = 0.
   Mat3 R0_ref, Q_ref;
-  m.samplePose(t_ref, R0_ref, Q_ref);
+  m.samplePose(t_ref, R0_ref, &Q_ref);
   for (size_t i = 0; i < times.size(); ++i) {
     m.rotations_[i] = R0_ref.transpose() * m.rotations_[i];
     m.positions_[i] = R0_ref.transpose() * (m.positions_[i] - Q_ref);
@@ -64,7 +64,7 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   return m;
 }
 
-void MotionModel::samplePose(double t, Mat3& R, Mat3& P) const {
+void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
   // The step [t_i, t] holding t turns at the mean of the rates at its ends
   // (clamped at the ends of the samples, holding the end rate).
   size_t i = 0;
@@ -82,14 +82,14 @@ void MotionModel::samplePose(double t, Mat3& R, Mat3& P) const {
   const double dt = t - times_[i];
   Mat3 step_R, step_J;
   so3::expAndLeftJacobian(rate * dt, step_R, step_J);
-  P = positions_[i] + rotations_[i] * step_J * dt;
+  if (P) *P = positions_[i] + rotations_[i] * step_J * dt;
   R = rotations_[i] * step_R;
 }
 
 Mat3 MotionModel::rotation(double t) const {
   if (kind_ == MotionModelKind::ConstantTwist) return so3::exp(omega_ * (t - t_ref_));
-  Mat3 R, P;
-  samplePose(t, R, P);
+  Mat3 R;
+  samplePose(t, R, nullptr);
   return R;
 }
 
@@ -98,7 +98,7 @@ Mat3 MotionModel::positionMatrix(double t) const {
   if (kind_ == MotionModelKind::ConstantTwist) return so3::leftJacobian(omega_ * tau) * tau;
   if (frame_ == VelocityFrame::Reference) return Mat3::Identity() * tau;
   Mat3 R, P;
-  samplePose(t, R, P);
+  samplePose(t, R, &P);
   return P;
 }
 
@@ -109,8 +109,12 @@ void MotionModel::pose(double t, Mat3& R, Mat3& P) const {
     P *= tau;
     return;
   }
-  samplePose(t, R, P);
-  if (frame_ == VelocityFrame::Reference) P = Mat3::Identity() * tau;
+  if (frame_ == VelocityFrame::Reference) {
+    samplePose(t, R, nullptr);
+    P = Mat3::Identity() * tau;
+    return;
+  }
+  samplePose(t, R, &P);
 }
 
 Vec3 MotionModel::meanOmega(double t0, double t1) const {

@@ -16,14 +16,11 @@ namespace celc::detail {
 
 namespace {
 // The profile's minima only need to land in the joint cost's basin: the
-// pattern search stops at this step [deg].
+// descent stops at this step [deg].
 constexpr double kProfileToleranceDeg = 0.5;
-// A start whose v comes this close to an earlier start's end point [deg]
-// stops: it would end there.
+// A start this close to an earlier start's end point [deg], in v and in
+// every line normal, stops: it would end there.
 constexpr double kMergeDeg = 1.0;
-// Steps of the first start before its residuals give the noise's scale
-// (their spread is near its end value after a few steps).
-constexpr int kScaleProbeIterations = 3;
 }  // namespace
 
 bool nptStartApplies(const WindowObservations& obs, const MotionModel& motion,
@@ -90,6 +87,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   JointProblem::Result best;
   const Start* best_start = nullptr;
   std::vector<Vec3> ends;
+  std::vector<JointProblem::State> end_states;
   for (const Start& s : starts) {
     bool seen = false;
     for (const Vec3& e : ends)
@@ -97,24 +95,25 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     if (seen) continue;
     // Every start begins at the fitted lines (measured: the profile's own
     // lines for its minima did worse at parallax 0.125, RMS 6.2 -> 10.1 deg).
-    // A start that comes within kMergeDeg of an earlier end point is in its
-    // basin and stops there (docs/peers.md).
-    // The first start measures the noise's scale after a few steps: the
-    // Huber threshold becomes ml.huber_scale times the residuals' robust
-    // scale there, never below refine.huber_px, for it and every later start.
-    const bool probe = options.ml.huber_scale > 0.0 && ends.empty();
-    const int first_iterations = probe ? std::min(kScaleProbeIterations, start_iterations) : start_iterations;
-    JointProblem::Result r = problem.refine(problem.start(s.v), first_iterations, tolerance, stride, ends,
-                                            kMergeDeg * M_PI / 180.0);
+    // A start that comes within kMergeDeg of an earlier end point, in v and
+    // in every line, would follow its descent and stops there (docs/peers.md).
+    JointProblem::Result r = problem.refine(problem.start(s.v), start_iterations, tolerance, stride,
+                                            end_states, kMergeDeg * M_PI / 180.0);
     if (!r.ok || r.merged) continue;
-    if (probe) {
+    if (options.ml.huber_scale > 0.0 && ends.empty()) {
+      // The first end point's residuals give the noise's scale; the Huber
+      // threshold becomes ml.huber_scale times it, never below
+      // refine.huber_px, for every start.
       const double scaled = options.ml.huber_scale * problem.robustScale(r.state);
-      if (scaled > options.refine.huber_px) problem.setHuber(scaled);
-      JointProblem::Result again = problem.refine(r.state, start_iterations, tolerance, stride);
-      if (!again.ok) continue;
-      r = std::move(again);
+      if (scaled > options.refine.huber_px) {
+        problem.setHuber(scaled);
+        JointProblem::Result again = problem.refine(r.state, start_iterations, tolerance, stride);
+        if (!again.ok) continue;
+        r = std::move(again);
+      }
     }
     ends.push_back(r.state.v);
+    end_states.push_back(r.state);
     if (!best_start || r.cost < best.cost) {
       best = std::move(r);
       best_start = &s;

@@ -30,6 +30,15 @@ std::vector<EventTerm>& threadBuffer() {
   return buffer;
 }
 
+/// a and b within the angle of cosine min_cos in v and in every line
+/// normal (unit vectors, sign-agnostic).
+bool near(const JointProblem::State& a, const JointProblem::State& b, double min_cos) {
+  if (std::abs(a.v.dot(b.v)) < min_cos || a.m1.size() != b.m1.size()) return false;
+  for (size_t c = 0; c < a.m1.size(); ++c)
+    if (std::abs(a.m1[c].dot(b.m1[c])) < min_cos || std::abs(a.m3[c].dot(b.m3[c])) < min_cos) return false;
+  return true;
+}
+
 }  // namespace
 
 JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& motion,
@@ -121,7 +130,7 @@ double JointProblem::cost(const State& s, int stride) const {
 }
 
 JointProblem::Result JointProblem::refine(State s, int max_iterations, double function_tolerance,
-                                          int stride, const std::vector<Vec3>& merge_into,
+                                          int stride, const std::vector<State>& merge_into,
                                           double merge_rad) const {
   const double merge_cos = std::cos(merge_rad);
   Result out;
@@ -207,8 +216,8 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
         // Converged: the cost or v no longer moves (v's step below
         // kStepTolerance rad, as Ceres' parameter tolerance).
         if (decrease < function_tolerance || dv.norm() < kStepTolerance) it = max_iterations;
-        for (const Vec3& e : merge_into)
-          if (merge_rad > 0.0 && std::abs(e.dot(s.v)) >= merge_cos * e.norm()) {
+        for (const State& e : merge_into)
+          if (merge_rad > 0.0 && near(e, s, merge_cos)) {
             out.merged = true;
             it = max_iterations;
           }

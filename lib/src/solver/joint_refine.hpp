@@ -45,14 +45,15 @@ class JointProblem {
     int iterations = 0;
     int events = 0;     ///< events used
     bool ok = false;
-    bool merged = false;  ///< stopped early: v came within merge_rad of an earlier end
+    bool merged = false;  ///< stopped early at one of merge_into
   };
   /// Levenberg-Marquardt from s over every stride-th event, until the
   /// relative cost decrease is below function_tolerance or max_iterations,
-  /// or (merged) until v is within merge_rad [rad] of one of merge_into
-  /// (sign-agnostic): a start that has entered an earlier start's basin.
+  /// or (merged) until the state is within merge_rad [rad] of one of
+  /// merge_into in v and in every line normal (sign-agnostic): from there
+  /// it would follow that state's descent.
   Result refine(State s, int max_iterations, double function_tolerance, int stride = 1,
-                const std::vector<Vec3>& merge_into = {}, double merge_rad = 0.0) const;
+                const std::vector<State>& merge_into = {}, double merge_rad = 0.0) const;
 
   /// Events in the problem.
   size_t events() const;

@@ -73,8 +73,9 @@ class MotionModel {
   std::vector<Mat3> rotations_;
   std::vector<Mat3> positions_;  ///< P at each sample time
   /// GyroIntegrated: R(t) and P(t) from the samples (rotations_ / positions_
-  /// anchored at t_ref, or from the first sample while they are being built).
-  void samplePose(double t, Mat3& R, Mat3& P) const;
+  /// anchored at t_ref, or from the first sample while they are being built);
+  /// P is skipped when null.
+  void samplePose(double t, Mat3& R, Mat3* P) const;
 };
 
 }  // namespace celc

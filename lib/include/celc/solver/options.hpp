@@ -136,9 +136,8 @@ struct MlOptions {
   /// convergence.
   int start_iterations = 8;
   /// The Huber threshold of the joint cost becomes huber_scale times the
-  /// robust scale (1.4826 MAD) of the residuals after the first start's
-  /// first 3 steps when that exceeds refine.huber_px (0 = refine.huber_px
-  /// always).
+  /// robust scale (1.4826 MAD) of the residuals at the first start's end
+  /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
   /// Huber's estimator keeps ~95% of least squares' efficiency under Gaussian
   /// noise at 1.345 sigma, ~99% at 2 sigma.
   double huber_scale = 2.0;  ///< [-]
