@@ -55,6 +55,16 @@ void expectProfileZeroAtTruth(const WindowObservations& obs, const MotionModel& 
   EXPECT_LT(angleBetweenSignAgnostic(minima[0].v, truth) * kDeg, 0.05);
 }
 
+/// A noise-free trial of the peers' scene (V = 2 m/s, 100 events per line),
+/// its joint problem, and a start 10 deg off the truth about `axis`.
+struct StartTenDegreesOff {
+  PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
+  detail::WindowFrames frames{tr.observations, tr.given_motion};
+  detail::JointProblem problem{tr.observations, tr.given_motion, frames, 0, false, 1, 1.5};
+  Vec3 axis = tr.true_direction.cross(Vec3::UnitZ()).normalized();
+  Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
+};
+
 }  // namespace
 
 // The peers' model (P = tau I, reference frame), where H(v) is singular along v.
@@ -127,47 +137,41 @@ TEST(JointProblem, ReachesTheCeresRefinementsMinimum) {
 
 // Without noise the refinement from 10 deg off returns to the truth.
 TEST(JointProblem, ConvergesToTheTruthWithoutNoise) {
-  const PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
-  ASSERT_TRUE(tr.ok);
-  const detail::WindowFrames frames(tr.observations, tr.given_motion);
-  const detail::JointProblem problem(tr.observations, tr.given_motion, frames, 0, false, 1, 1.5);
-  const Vec3 axis = tr.true_direction.cross(Vec3::UnitZ()).normalized();
-  const Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
-  const auto r = problem.refine(problem.start(start), 100, 1e-14);
+  const StartTenDegreesOff s;
+  ASSERT_TRUE(s.tr.ok);
+  const auto r = s.problem.refine(s.problem.start(s.start), 100, 1e-14);
   ASSERT_TRUE(r.ok);
-  EXPECT_LT(angleBetweenSignAgnostic(r.state.v, tr.true_direction) * kDeg, 1e-4);
+  EXPECT_LT(angleBetweenSignAgnostic(r.state.v, s.tr.true_direction) * kDeg, 1e-4);
 }
 
 // A start that comes within merge_rad of an earlier end point (in v and in
 // every line) stops there (merged) after fewer steps than its full descent;
 // an end point apart in v, or in one line, does not stop it.
 TEST(JointProblem, StopsWhereAnEarlierEndIs) {
-  const PeerSceneTrial tr = peerTrial(3, 2.0, 0.0, 100);
-  ASSERT_TRUE(tr.ok);
-  const detail::WindowFrames frames(tr.observations, tr.given_motion);
-  const detail::JointProblem problem(tr.observations, tr.given_motion, frames, 0, false, 1, 1.5);
-  const Vec3 axis = tr.true_direction.cross(Vec3::UnitZ()).normalized();
-  const Vec3 start = Eigen::AngleAxisd(10.0 / kDeg, axis) * tr.true_direction;
-  const auto full = problem.refine(problem.start(start), 100, 1e-14);
+  const StartTenDegreesOff s;
+  ASSERT_TRUE(s.tr.ok);
+  const auto full = s.problem.refine(s.problem.start(s.start), 100, 1e-14);
   ASSERT_TRUE(full.ok);
   ASSERT_GT(full.iterations, 3);
   const double merge_rad = 1.0 / kDeg;
+  auto from = [&](const detail::JointProblem::State& end) {
+    return s.problem.refine(s.problem.start(s.start), 100, 1e-14, 1, {end}, merge_rad);
+  };
   detail::JointProblem::State end = full.state;
   end.v = -end.v;  // sign-agnostic
-  const auto merged = problem.refine(problem.start(start), 100, 1e-14, 1, {end}, merge_rad);
+  const auto merged = from(end);
   ASSERT_TRUE(merged.ok);
   EXPECT_TRUE(merged.merged);
   EXPECT_LT(merged.iterations, full.iterations);
-  EXPECT_LT(angleBetweenSignAgnostic(merged.state.v, tr.true_direction), merge_rad);
+  EXPECT_LT(angleBetweenSignAgnostic(merged.state.v, s.tr.true_direction), merge_rad);
   detail::JointProblem::State elsewhere = full.state;
-  elsewhere.v = axis;
-  const auto apart = problem.refine(problem.start(start), 100, 1e-14, 1, {elsewhere}, merge_rad);
+  elsewhere.v = s.axis;
+  const auto apart = from(elsewhere);
   EXPECT_FALSE(apart.merged);
   EXPECT_EQ(apart.iterations, full.iterations);
   detail::JointProblem::State other_line = full.state;
   other_line.m3.back() = other_line.m3.back().unitOrthogonal();
-  const auto line_apart = problem.refine(problem.start(start), 100, 1e-14, 1, {other_line}, merge_rad);
-  EXPECT_FALSE(line_apart.merged);
+  EXPECT_FALSE(from(other_line).merged);
 }
 
 // The default celc_ml beside the bound on fixed trials of the peers' scene
