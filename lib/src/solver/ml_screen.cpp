@@ -119,7 +119,7 @@ void descend(const LineProfile& profile, ScreenMinimum& s, double max_step, doub
         break;
       }
     }
-    if (!moved || step.norm() < tol) return;
+    if (!moved) return;
   }
 }
 
