@@ -86,19 +86,18 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
                                                            : iterations;
   JointProblem::Result best;
   const Start* best_start = nullptr;
-  std::vector<Vec3> ends;
-  std::vector<JointProblem::State> end_states;
+  std::vector<JointProblem::State> ends;  // the refined starts' end points
   for (const Start& s : starts) {
     bool seen = false;
-    for (const Vec3& e : ends)
-      seen = seen || angleBetweenSignAgnostic(s.v, e) * 180.0 / M_PI < options.ml.second_start_deg;
+    for (const JointProblem::State& e : ends)
+      seen = seen || angleBetweenSignAgnostic(s.v, e.v) * 180.0 / M_PI < options.ml.second_start_deg;
     if (seen) continue;
     // Every start begins at the fitted lines (measured: the profile's own
     // lines for its minima did worse at parallax 0.125, RMS 6.2 -> 10.1 deg).
     // A start that comes within kMergeDeg of an earlier end point, in v and
     // in every line, would follow its descent and stops there (docs/peers.md).
     JointProblem::Result r = problem.refine(problem.start(s.v), start_iterations, tolerance, stride,
-                                            end_states, kMergeDeg * M_PI / 180.0);
+                                            ends, kMergeDeg * M_PI / 180.0);
     if (!r.ok || r.merged) continue;
     if (options.ml.huber_scale > 0.0 && ends.empty()) {
       // The first end point's residuals give the noise's scale; the Huber
@@ -112,8 +111,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
         r = std::move(again);
       }
     }
-    ends.push_back(r.state.v);
-    end_states.push_back(r.state);
+    ends.push_back(r.state);
     if (!best_start || r.cost < best.cost) {
       best = std::move(r);
       best_start = &s;
