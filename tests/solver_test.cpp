@@ -319,6 +319,16 @@ TEST(Refinement, AnalyticJacobianMatchesNumeric) {
     const double numeric = (detail::sqrtHuber(d + 1e-7, 1.5, &s2) - detail::sqrtHuber(d - 1e-7, 1.5, &s2)) / 2e-7;
     EXPECT_NEAR(slope, numeric, 1e-6);
   }
+  // The square-rooted Cauchy: r^2 = c^2 log(1 + d^2 / c^2), slope = dr/dd.
+  for (double d : {-5.0, -1.0, -1e-8, 0.3, 1.5, 7.0}) {
+    double slope = 0.0;
+    const double r = detail::sqrtCauchy(d, 0.8, &slope);
+    EXPECT_NEAR(r * r, 0.64 * std::log1p(d * d / 0.64), 1e-12);
+    EXPECT_EQ(r < 0, d < 0);
+    double s2 = 0.0;
+    const double numeric = (detail::sqrtCauchy(d + 1e-7, 0.8, &s2) - detail::sqrtCauchy(d - 1e-7, 0.8, &s2)) / 2e-7;
+    EXPECT_NEAR(slope, numeric, 1e-6);
+  }
 }
 
 TEST(MethodNames, RoundTrip) {

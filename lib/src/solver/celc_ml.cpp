@@ -127,10 +127,11 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   // A last refinement under a redescending loss (ml.cauchy_scale), from the
   // winner (the basin is chosen under Huber, whose cost has fewer minima),
   // where the residuals have a heavier tail than Gaussian noise gives.
-  const JointProblem::Spread spread =
-      options.ml.cauchy_scale > 0.0 ? problem.spread(best.state) : JointProblem::Spread{};
-  const double cauchy_px = options.ml.cauchy_scale * spread.scale;
-  if (cauchy_px > 0.0 && std::isfinite(cauchy_px) && spread.tail_share > options.ml.cauchy_min_tail) {
+  const double cauchy_px = options.ml.cauchy_scale > 0.0
+                               ? problem.spread(best.state).cauchyScale(options.ml.cauchy_scale,
+                                                                        options.ml.cauchy_min_tail)
+                               : 0.0;
+  if (cauchy_px > 0.0) {
     problem.setLoss(JointProblem::Loss::Cauchy, cauchy_px);
     JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
     if (r.ok) best = std::move(r);

@@ -100,18 +100,13 @@ double JointProblem::weighted(double d, double* slope) const {
   return sqrtHuber(d, scale_, slope);
 }
 
-JointProblem::Spread JointProblem::spread(const State& s) const {
+ResidualSpread JointProblem::spread(const State& s) const {
   std::vector<double> d;
   d.reserve(terms_.size());
   for (size_t c = 0; c + 1 < begin_.size(); ++c)
     for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
       d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
-  Spread out;
-  size_t beyond = 0;
-  out.scale = 1.4826 * medianAbs(d);  // reorders d
-  for (double x : d) beyond += !(std::abs(x) <= 3.0 * out.scale);
-  out.tail_share = d.empty() ? 0.0 : static_cast<double>(beyond) / static_cast<double>(d.size());
-  return out;
+  return residualSpread(std::move(d));
 }
 
 double JointProblem::robustScale(const State& s) const { return spread(s).scale; }

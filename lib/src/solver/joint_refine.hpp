@@ -15,6 +15,7 @@
 #include "celc/core/observations.hpp"
 #include "celc/solver/celc_residual.hpp"
 #include "constraint_rows.hpp"
+#include "sampling.hpp"
 
 namespace celc::detail {
 
@@ -57,14 +58,8 @@ class JointProblem {
 
   /// Events in the problem.
   size_t events() const;
-  /// The residuals' spread at s: their robust scale 1.4826 median |d| [px],
-  /// and the share of events with |d| beyond 3 times it (Gaussian noise:
-  /// 0.27%).
-  struct Spread {
-    double scale = 0.0;
-    double tail_share = 0.0;
-  };
-  Spread spread(const State& s) const;
+  /// The spread of the residuals at s (sampling.hpp).
+  ResidualSpread spread(const State& s) const;
   double robustScale(const State& s) const;  ///< spread(s).scale
   /// The loss of the cost: Huber with threshold scale [px] (sum of Huber
   /// rho(d^2)), or Cauchy with scale c [px], rho = c^2 log(1 + d^2 / c^2),

@@ -31,6 +31,8 @@ std::string RefineOptions::validate() const {
   if (max_events < 0) e << "max_events must be >= 0; ";
   if (!(function_tolerance > 0.0)) e << "function_tolerance must be > 0; ";
   if (num_threads < 1) e << "num_threads must be >= 1; ";
+  if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e << "cauchy_scale must be finite and >= 0; ";
+  if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e << "cauchy_min_tail must be in [0, 1]; ";
   return e.str();
 }
 

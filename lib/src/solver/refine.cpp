@@ -65,6 +65,7 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   ceres::Problem problem(problem_options);
   ceres::SphereManifold<3> sphere;
   int n_res = 0;
+  std::vector<EventChunkCost*> costs;
   for (size_t c = 0; c < terms.size(); ++c) {
     for (size_t b = 0; b < terms[c].size(); b += kChunk) {
       std::vector<EventTerm> chunk(
@@ -73,6 +74,7 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
       n_res += static_cast<int>(chunk.size());
       auto* cost = new EventChunkCost(std::move(chunk), obs.focal_px, opt.huber_px,
                                               refine_lines);
+      costs.push_back(cost);
       if (refine_lines) {
         problem.AddResidualBlock(cost, nullptr, v.data(), m1[c].data(), m3[c].data());
       } else {
@@ -108,9 +110,30 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  // The residual reported is the Huber cost's.
+  const double huber_cost = summary.final_cost;
+  // celc_opt: a last solve under the Cauchy loss (refine.cauchy_scale) where
+  // the residuals at the Huber solution have a heavier tail than Gaussian
+  // noise gives (other edges' events, a line's stub): they stop pulling.
+  if (opt.cauchy_scale > 0.0 && !refine_lines && summary.IsSolutionUsable()) {
+    const Vec3 huber_v = v, vh = v.normalized();
+    std::vector<double> d;
+    d.reserve(static_cast<size_t>(n_res));
+    for (size_t c = 0; c < terms.size(); ++c)
+      for (const EventTerm& e : terms[c])
+        d.push_back(eventDistance(e, vh, m1[c], m3[c], obs.focal_px, nullptr, nullptr, nullptr));
+    const double cauchy_px = residualSpread(std::move(d)).cauchyScale(opt.cauchy_scale, opt.cauchy_min_tail);
+    if (cauchy_px > 0.0) {
+      for (EventChunkCost* cost : costs) cost->setCauchy(cauchy_px);
+      ceres::Solver::Summary cauchy;
+      ceres::Solve(so, &problem, &cauchy);
+      result.iterations += static_cast<int>(cauchy.iterations.size());
+      if (!cauchy.IsSolutionUsable() || !v.allFinite()) v = huber_v;
+    }
+  }
 
   const Vec3 vr = v.normalized();
-  result.iterations = static_cast<int>(summary.iterations.size());
+  result.iterations += static_cast<int>(summary.iterations.size());
   result.rows_used = n_res;
   if (!summary.IsSolutionUsable() || !vr.allFinite()) {
     result.status = SolveStatus::Failed;
@@ -118,7 +141,7 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   } else {
     result.status = SolveStatus::Ok;
     result.v = vr.dot(initial) < 0 ? Vec3(-vr) : vr;  // keep the resolved sign
-    result.residual_px = std::sqrt(2.0 * summary.final_cost / std::max(1, n_res));
+    result.residual_px = std::sqrt(2.0 * huber_cost / std::max(1, n_res));
   }
   result.time_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();

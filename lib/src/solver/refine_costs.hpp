@@ -28,6 +28,19 @@ inline double sqrtHuber(double d, double delta, double* slope) {
   return d < 0 ? -r : r;
 }
 
+/// Cauchy in square-root form: r = sign(d) c sqrt(log(1 + d^2 / c^2)), so that
+/// sum r^2 = sum c^2 log(1 + d^2 / c^2); returns r and dr/dd.
+inline double sqrtCauchy(double d, double c, double* slope) {
+  const double q2 = (d / c) * (d / c);
+  if (q2 < 1e-12) {
+    *slope = 1.0;
+    return d;
+  }
+  const double r = c * std::sqrt(std::log1p(q2));
+  *slope = std::abs(d) / (r * (1.0 + q2));
+  return d < 0 ? -r : r;
+}
+
 /// A chunk of one cluster's events. Parameters: v (3), and with joint lines
 /// also m1 (3), m3 (3) of the cluster.
 class EventChunkCost final : public ceres::CostFunction {
@@ -41,6 +54,9 @@ class EventChunkCost final : public ceres::CostFunction {
       mutable_parameter_block_sizes()->push_back(3);
     }
   }
+
+  /// The loss from here on: Cauchy with scale c [px] instead of Huber.
+  void setCauchy(double c) { cauchy_ = c; }
 
   /// With joint == false, m1 and m3 are the cluster's fixed lines.
   void setFixedLines(const Vec3& m1, const Vec3& m3) {
@@ -59,7 +75,7 @@ class EventChunkCost final : public ceres::CostFunction {
                                      want && joint_ ? &g1 : nullptr, want && joint_ ? &g3 : nullptr);
       if (!std::isfinite(d)) return false;
       double slope = 1.0;
-      residuals[i] = sqrtHuber(d, huber_, &slope);
+      residuals[i] = cauchy_ > 0.0 ? sqrtCauchy(d, cauchy_, &slope) : sqrtHuber(d, huber_, &slope);
       if (!want) continue;
       const Vec3* grads[3] = {&gv, &g1, &g3};
       for (int b = 0; b < (joint_ ? 3 : 1); ++b)
@@ -72,6 +88,7 @@ class EventChunkCost final : public ceres::CostFunction {
  private:
   std::vector<EventTerm> terms_;
   double focal_, huber_;
+  double cauchy_ = 0.0;  // > 0: the Cauchy loss replaces Huber
   bool joint_;
   Vec3 m1_ = Vec3::Zero(), m3_ = Vec3::Zero();
 };

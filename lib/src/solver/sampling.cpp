@@ -58,4 +58,20 @@ double medianAbs(std::vector<double>& x) {
   return *mid;
 }
 
+ResidualSpread residualSpread(std::vector<double> d) {
+  ResidualSpread out;
+  if (d.empty()) return out;
+  const std::vector<double> values = d;
+  out.scale = 1.4826 * medianAbs(d);
+  size_t beyond = 0;
+  for (double x : values) beyond += !(std::abs(x) <= 3.0 * out.scale);
+  out.tail_share = static_cast<double>(beyond) / static_cast<double>(values.size());
+  return out;
+}
+
+double ResidualSpread::cauchyScale(double factor, double min_tail) const {
+  const double c = factor * scale;
+  return c > 0.0 && std::isfinite(c) && tail_share > min_tail ? c : 0.0;
+}
+
 }  // namespace celc::detail

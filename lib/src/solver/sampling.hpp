@@ -17,4 +17,17 @@ std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bo
 /// Median of |x| (upper median for an even count; x is overwritten and reordered). 0 when empty.
 double medianAbs(std::vector<double>& x);
 
+/// The spread of residuals d [px]: their robust scale 1.4826 median |d|, and
+/// the share of them with |d| beyond 3 times it (Gaussian noise: 0.27%; a
+/// non-finite d counts as beyond).
+struct ResidualSpread {
+  double scale = 0.0;
+  double tail_share = 0.0;
+  /// The scale c [px] of a last refinement under the Cauchy loss: factor
+  /// times the robust scale when more than min_tail of the residuals lie
+  /// beyond 3 scales; 0 (no such refinement) otherwise.
+  double cauchyScale(double factor, double min_tail) const;
+};
+ResidualSpread residualSpread(std::vector<double> d);
+
 }  // namespace celc::detail

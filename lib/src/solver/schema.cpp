@@ -37,6 +37,12 @@ void describe(FieldVisitor& v, RefineOptions& o) {
   v.field({"seed", "", "seed of the event subset"}, o.seed);
   v.field({"function_tolerance", "-", "Ceres' relative cost change to stop"}, o.function_tolerance);
   v.field({"num_threads", "", "Ceres threads per solve"}, o.num_threads);
+  v.field({"cauchy_scale", "-", "celc_opt: then a last refinement under a Cauchy loss at this times the residuals' "
+                                 "robust scale (0 = off)"},
+          o.cauchy_scale);
+  v.field({"cauchy_min_tail", "-", "... only when more than this share of the residuals lie beyond 3 robust "
+                                    "scales (Gaussian noise: 0.0027)"},
+          o.cauchy_min_tail);
 }
 
 void describe(FieldVisitor& v, NptOptions& o) {

@@ -65,6 +65,11 @@ struct RefineOptions {
   std::uint64_t seed = 1;         ///< seed of the event subset (solveMethods' SampleSeeds override it per window)
   double function_tolerance = 1e-10;
   int num_threads = 1;
+  /// celc_opt: then a last refinement under a Cauchy loss with c = cauchy_scale
+  /// times the residuals' robust scale (1.4826 median |d|), when more than
+  /// cauchy_min_tail of them lie beyond 3 robust scales (0 = off).
+  double cauchy_scale = 1.0;      ///< [-]
+  double cauchy_min_tail = 0.01;  ///< [-]
   std::string validate() const;
 };
 
