@@ -29,6 +29,19 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"resolve_sign", "", "cheirality test; else the sign is arbitrary"}, o.resolve_sign);
 }
 
+namespace {
+
+/// The keys of a last refinement under the Cauchy loss (celc_opt's in
+/// `refine`, celc_ml's in `ml`): its scale and the residual tail it needs.
+void describeCauchyStage(FieldVisitor& v, const char* scale_doc, double& scale, double& min_tail) {
+  v.field({"cauchy_scale", "-", scale_doc}, scale);
+  v.field({"cauchy_min_tail", "-", "... only when more than this share of the residuals lie beyond 3 robust "
+                                    "scales (Gaussian noise: 0.0027)"},
+          min_tail);
+}
+
+}  // namespace
+
 void describe(FieldVisitor& v, RefineOptions& o) {
   v.field({"huber_px", "px", "Huber threshold on the point-line distance"}, o.huber_px);
   v.field({"max_iterations", "", "Levenberg-Marquardt iterations"}, o.max_iterations);
@@ -37,12 +50,10 @@ void describe(FieldVisitor& v, RefineOptions& o) {
   v.field({"seed", "", "seed of the event subset"}, o.seed);
   v.field({"function_tolerance", "-", "Ceres' relative cost change to stop"}, o.function_tolerance);
   v.field({"num_threads", "", "Ceres threads per solve"}, o.num_threads);
-  v.field({"cauchy_scale", "-", "celc_opt: then a last refinement under a Cauchy loss at this times the residuals' "
-                                 "robust scale (0 = off)"},
-          o.cauchy_scale);
-  v.field({"cauchy_min_tail", "-", "... only when more than this share of the residuals lie beyond 3 robust "
-                                    "scales (Gaussian noise: 0.0027)"},
-          o.cauchy_min_tail);
+  describeCauchyStage(v,
+                      "celc_opt: then a last refinement under a Cauchy loss at this times the residuals' robust "
+                      "scale: a cluster whose line is off stops pulling (0 = off)",
+                      o.cauchy_scale, o.cauchy_min_tail);
 }
 
 void describe(FieldVisitor& v, NptOptions& o) {
@@ -76,12 +87,10 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
                                 "refine.huber_px (0 = off)"},
           o.huber_scale);
-  v.field({"cauchy_scale", "-", "then a last refinement under a Cauchy loss at this times the residuals' robust "
-                                 "scale: other edges' events in a cluster stop pulling (0 = off)"},
-          o.cauchy_scale);
-  v.field({"cauchy_min_tail", "-", "... only when more than this share of the residuals lie beyond 3 robust "
-                                    "scales (Gaussian noise: 0.0027)"},
-          o.cauchy_min_tail);
+  describeCauchyStage(v,
+                      "then a last refinement under a Cauchy loss at this times the residuals' robust scale: "
+                      "other edges' events in a cluster stop pulling (0 = off)",
+                      o.cauchy_scale, o.cauchy_min_tail);
 }
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {
