@@ -61,11 +61,10 @@ double medianAbs(std::vector<double>& x) {
 ResidualSpread residualSpread(std::vector<double> d) {
   ResidualSpread out;
   if (d.empty()) return out;
-  const std::vector<double> values = d;
-  out.scale = 1.4826 * medianAbs(d);
+  out.scale = 1.4826 * medianAbs(d);  // d now holds |d|, reordered
   size_t beyond = 0;
-  for (double x : values) beyond += !(std::abs(x) <= 3.0 * out.scale);
-  out.tail_share = static_cast<double>(beyond) / static_cast<double>(values.size());
+  for (double x : d) beyond += !(x <= 3.0 * out.scale);
+  out.tail_share = static_cast<double>(beyond) / static_cast<double>(d.size());
   return out;
 }
 
