@@ -253,6 +253,14 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
             "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");
   EXPECT_EQ(c.windows.overlap, 0.0);
+  // celc_opt's Cauchy solve: its two keys, set and refused out of range.
+  applyRunSetting("solver.refine.cauchy_scale=0", c);
+  EXPECT_EQ(c.solver.refine.cauchy_scale, 0.0);
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.cauchy_scale=-1", c); }),
+            "--set solver.refine.cauchy_scale=-1: cauchy_scale must be finite and >= 0");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.cauchy_min_tail=2", c); }),
+            "--set solver.refine.cauchy_min_tail=2: cauchy_min_tail must be in [0, 1]");
+  EXPECT_EQ(c.solver.refine.cauchy_min_tail, RefineOptions{}.cauchy_min_tail);  // unchanged
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
   EXPECT_EQ(s.scene.camera.fx, 100.0);
