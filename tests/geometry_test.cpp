@@ -1,6 +1,7 @@
 // Property tests of SO(3), the motion models and the camera model.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "celc/geometry/camera.hpp"
@@ -77,6 +78,72 @@ TEST(So3, SmallAngleSeriesIsContinuous) {
     EXPECT_LT((so3::exp(phi) - exp_series).norm(), 1e-13);
     // Reference series truncated after th^3: next term th^4/120 ~ 1e-14 at th = 1e-3.
     EXPECT_LT((so3::leftJacobian(phi) - jl_series).norm(), 5e-14);
+  }
+}
+
+// The coefficients' three forms (short series, long series, closed form)
+// against the closed forms in long double, either side of each switch
+// (x = th^2 = 0.1 and 2.25) and far from them. The closed forms lose digits
+// at small angles ((th - sin th) / th^3 cancels), so the reference there is
+// the long-double series.
+TEST(So3, CoefficientsMatchTheirClosedFormsInEveryBranch) {
+  const auto reference = [](long double x, long double& A, long double& B, long double& C) {
+    if (x < 0.5L) {  // 30 terms of the series, in long double
+      long double term_b = 0.5L, term_c = 1.0L / 6.0L;
+      B = C = 0.0L;
+      for (int k = 0; k < 30; ++k) {
+        B += term_b, C += term_c;
+        term_b *= -x / ((2 * k + 3) * (2 * k + 4));
+        term_c *= -x / ((2 * k + 4) * (2 * k + 5));
+      }
+    } else {
+      const long double th = std::sqrt(x);
+      B = (1.0L - std::cos(th)) / x, C = (th - std::sin(th)) / (x * th);
+    }
+    A = 1.0L - x * C;
+  };
+  for (double x : {0.0, 1e-12, 1e-6, 0.01, 0.0999, 0.1001, 0.5, 1.0, 2.2499, 2.2501, 4.0, 9.0}) {
+    double A, B, C;
+    so3::coefficients(x, A, B, C);
+    long double a, b, c;
+    reference(x, a, b, c);
+    EXPECT_NEAR(A, static_cast<double>(a), 4e-16) << x;
+    EXPECT_NEAR(B, static_cast<double>(b), 4e-16) << x;
+    EXPECT_NEAR(C, static_cast<double>(c), 4e-16) << x;
+  }
+}
+
+// transposedActions gives R(t)^T x and P(t)^T x as pose() does, for every
+// model: the constant twist, and the gyro (a rate varying by sample, beyond
+// the ends of its samples, with steps whose angle exceeds the series' range)
+// with the velocity in the body or the reference frame.
+TEST(MotionModel, TransposedActionsMatchThePose) {
+  std::mt19937 rng(7);
+  std::vector<double> times;
+  std::vector<Vec3> rates;
+  for (int i = 0; i <= 12; ++i) {
+    times.push_back(0.05 * i);
+    rates.push_back(Vec3(1.0, -2.0, 0.5) + randomVec(rng, 1.0));
+  }
+  // One long step of 0.4 s at ~40 rad/s: its angle is far beyond 1.5 rad.
+  times.push_back(1.0);
+  rates.push_back(Vec3(30.0, -25.0, 10.0));
+  const std::vector<MotionModel> models = {
+      MotionModel::constantTwist(Vec3(0.4, -1.2, 2.0), 0.3),
+      MotionModel::constantTwist(Vec3(4.0, -3.0, 2.5), 0.3),
+      MotionModel::gyroIntegrated(times, rates, 0.3),
+      MotionModel::gyroIntegrated(times, rates, 0.3, VelocityFrame::Reference)};
+  const Vec3 a = randomVec(rng, 1.0), b = randomVec(rng, 2.0);
+  for (const auto& model : models) {
+    for (double t : {-0.2, 0.0, 0.03, 0.3, 0.31, 0.47, 0.6, 0.75, 0.99, 1.4}) {
+      Mat3 R, P;
+      model.pose(t, R, P);
+      const auto act = model.transposedActions(t, a, b);
+      EXPECT_LT((act.Rt_a - R.transpose() * a).norm(), 1e-13) << t;
+      EXPECT_LT((act.Rt_b - R.transpose() * b).norm(), 1e-13) << t;
+      EXPECT_LT((act.Pt_a - P.transpose() * a).norm(), 1e-13) << t;
+      EXPECT_LT((act.Pt_b - P.transpose() * b).norm(), 1e-13) << t;
+    }
   }
 }
 

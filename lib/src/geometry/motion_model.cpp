@@ -64,10 +64,10 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   return m;
 }
 
-void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
+void MotionModel::sampleStep(double t, size_t& i, Vec3& phi, double& dt) const {
   // The step [t_i, t] holding t turns at the mean of the rates at its ends
   // (clamped at the ends of the samples, holding the end rate).
-  size_t i = 0;
+  i = 0;
   Vec3 rate;
   if (times_.size() == 1 || t <= times_.front()) {
     rate = rates_.front();
@@ -79,11 +79,57 @@ void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
     const double s = (t - times_[i]) / (times_[i + 1] - times_[i]);
     rate = 0.5 * (rates_[i] + (1.0 - s) * rates_[i] + s * rates_[i + 1]);
   }
-  const double dt = t - times_[i];
+  dt = t - times_[i];
+  phi = rate * dt;
+}
+
+void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
+  size_t i;
+  Vec3 phi;
+  double dt;
+  sampleStep(t, i, phi, dt);
+  if (!P) {
+    R = rotations_[i] * so3::exp(phi);
+    return;
+  }
   Mat3 step_R, step_J;
-  so3::expAndLeftJacobian(rate * dt, step_R, step_J);
-  if (P) *P = positions_[i] + rotations_[i] * step_J * dt;
+  so3::expAndLeftJacobian(phi, step_R, step_J);
+  *P = positions_[i] + rotations_[i] * step_J * dt;
   R = rotations_[i] * step_R;
+}
+
+MotionModel::TransposedActions MotionModel::transposedActions(double t, const Vec3& a,
+                                                              const Vec3& b) const {
+  const double tau = t - t_ref_;
+  TransposedActions out;
+  // y - k1 phi x y + k2 phi x (phi x y).
+  const auto act = [](const Vec3& phi, const Vec3& y, double k1, double k2) {
+    const Vec3 py = phi.cross(y);
+    return Vec3(y - k1 * py + k2 * phi.cross(py));
+  };
+  double A, B, C;
+  if (kind_ == MotionModelKind::ConstantTwist) {
+    const Vec3 phi = omega_ * tau;
+    so3::coefficients(phi.squaredNorm(), A, B, C);
+    out.Rt_a = act(phi, a, A, B), out.Rt_b = act(phi, b, A, B);
+    out.Pt_a = tau * act(phi, a, B, C), out.Pt_b = tau * act(phi, b, B, C);
+    return out;
+  }
+  size_t i;
+  Vec3 phi;
+  double dt;
+  sampleStep(t, i, phi, dt);
+  so3::coefficients(phi.squaredNorm(), A, B, C);
+  const Vec3 ai = rotations_[i].transpose() * a, bi = rotations_[i].transpose() * b;
+  out.Rt_a = act(phi, ai, A, B), out.Rt_b = act(phi, bi, A, B);
+  if (frame_ == VelocityFrame::Reference) {
+    out.Pt_a = tau * a, out.Pt_b = tau * b;
+  } else {
+    // P = P_i + R_i J_l(phi) dt.
+    out.Pt_a = positions_[i].transpose() * a + dt * act(phi, ai, B, C);
+    out.Pt_b = positions_[i].transpose() * b + dt * act(phi, bi, B, C);
+  }
+  return out;
 }
 
 Mat3 MotionModel::rotation(double t) const {

@@ -16,30 +16,32 @@ Mat3 hat(const Vec3& w) {
 
 Vec3 vee(const Mat3& W) { return Vec3(W(2, 1), W(0, 2), W(1, 0)); }
 
-namespace {
-// Coefficients a = sin(th)/th, b = (1-cos th)/th^2, c = (th - sin th)/th^3,
-// with Taylor series below a small angle where the closed forms lose digits.
-struct Coeffs {
-  double a, b, c;
-};
-Coeffs coefficients(double th2) {
-  if (th2 < 1e-6) {
-    // Series to the th^4 term: errors below 1e-19 for th^2 < 1e-6.
-    return {1.0 - th2 / 6.0 + th2 * th2 / 120.0,  //
-            0.5 - th2 / 24.0 + th2 * th2 / 720.0,  //
-            1.0 / 6.0 - th2 / 120.0 + th2 * th2 / 5040.0};
+void coefficients(double x, double& A, double& B, double& C) {
+  if (x < 0.1) {
+    // Seven terms (the next is below 1e-20 relative, x^7 / 16!), as even and
+    // odd polynomials in y = x^2: four short chains instead of two long ones.
+    const double y = x * x;
+    const double b_even = 1.0 / 2 + y * (1.0 / 720 + y * (1.0 / 3628800 + y * (1.0 / 87178291200.0)));
+    const double b_odd = 1.0 / 24 + y * (1.0 / 40320 + y * (1.0 / 479001600));
+    const double c_even = 1.0 / 6 + y * (1.0 / 5040 + y * (1.0 / 39916800 + y * (1.0 / 1307674368000.0)));
+    const double c_odd = 1.0 / 120 + y * (1.0 / 362880 + y * (1.0 / 6227020800.0));
+    B = b_even - x * b_odd;
+    C = c_even - x * c_odd;
+    A = 1.0 - x * C;
+    return;
   }
-  const double th = std::sqrt(th2);
+  if (x < kSeriesLimit) return seriesCoefficients(x, A, B, C);
+  const double th = std::sqrt(x);
   const double s = std::sin(th), sh = std::sin(0.5 * th) / th;
-  // 1 - cos th = 2 sin^2(th/2): no cancellation at small angles.
-  return {s / th, 2.0 * sh * sh, (th - s) / (th2 * th)};
+  // 1 - cos th = 2 sin^2(th/2).
+  A = s / th, B = 2.0 * sh * sh, C = (th - s) / (x * th);
 }
-}  // namespace
 
 Mat3 exp(const Vec3& phi) {
-  const Coeffs k = coefficients(phi.squaredNorm());
+  double a, b, c;
+  coefficients(phi.squaredNorm(), a, b, c);
   const Mat3 W = hat(phi);
-  return Mat3::Identity() + k.a * W + k.b * W * W;
+  return Mat3::Identity() + a * W + b * W * W;
 }
 
 Vec3 log(const Mat3& R) {
@@ -55,17 +57,19 @@ Vec3 log(const Mat3& R) {
 }
 
 Mat3 leftJacobian(const Vec3& phi) {
-  const Coeffs k = coefficients(phi.squaredNorm());
+  double a, b, c;
+  coefficients(phi.squaredNorm(), a, b, c);
   const Mat3 W = hat(phi);
-  return Mat3::Identity() + k.b * W + k.c * W * W;
+  return Mat3::Identity() + b * W + c * W * W;
 }
 
 void expAndLeftJacobian(const Vec3& phi, Mat3& R, Mat3& J) {
-  const Coeffs k = coefficients(phi.squaredNorm());
+  double a, b, c;
+  coefficients(phi.squaredNorm(), a, b, c);
   const Mat3 W = hat(phi);
   const Mat3 W2 = W * W;
-  R = Mat3::Identity() + k.a * W + k.b * W2;
-  J = Mat3::Identity() + k.b * W + k.c * W2;
+  R = Mat3::Identity() + a * W + b * W2;
+  J = Mat3::Identity() + b * W + c * W2;
 }
 
 Mat3 leftJacobianInverse(const Vec3& phi) {

@@ -61,13 +61,7 @@ EventLineTerms ClusterRowTerms::at(double t) const {
   if (twist_) {
     const double tau = t - k_.t_ref, tau2 = tau * tau, x = k_.w2 * tau2;
     double A, B, C;
-    if (x < kTwistSeriesLimit) {
-      twistSeriesCoefficients(x, A, B, C);
-    } else {
-      const double th = std::sqrt(x);
-      const double sn = std::sin(th), sh = std::sin(0.5 * th) / th;
-      A = sn / th, B = 2.0 * sh * sh, C = (th - sn) / (x * th);
-    }
+    so3::coefficients(x, A, B, C);
     const double ra = A * tau, rb = B * tau2, pc = C * tau2 * tau;
     e.g1 = k_.m1 - ra * k_.wm1 + rb * k_.wwm1;
     e.g3 = k_.m3 - ra * k_.wm3 + rb * k_.wwm3;
@@ -75,23 +69,14 @@ EventLineTerms ClusterRowTerms::at(double t) const {
     e.s = k_.s0 - (tau * k_.m1 - rb * k_.wm1 + pc * k_.wwm1);
     return e;
   }
-  Mat3 Rk, Pk;
-  motion_->pose(t, Rk, Pk);
-  e.g1 = Rk.transpose() * k_.m1;
-  e.g3 = Rk.transpose() * k_.m3;
-  e.u = k_.u0 - Pk.transpose() * k_.m3;
-  e.s = k_.s0 - Pk.transpose() * k_.m1;
+  const MotionModel::TransposedActions pa = motion_->transposedActions(t, k_.m1, k_.m3);
+  e.g1 = pa.Rt_a, e.g3 = pa.Rt_b;
+  e.u = k_.u0 - pa.Pt_b;
+  e.s = k_.s0 - pa.Pt_a;
   return e;
 }
 
 void ClusterRowTerms::row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) const {
-  if (!twist_) {
-    // The pose dominates here; celcRow's order of operations keeps these rows
-    // bit-identical to the former ones.
-    const ConstraintRow r = celcRow(*frame_, *motion_, t, f);
-    a = r.a, n0 = r.N.row(0).transpose(), n1 = r.N.row(1).transpose();
-    return;
-  }
   const EventLineTerms e = at(t);
   a = e.g1.dot(f) * e.u - e.g3.dot(f) * e.s;
   n0 = e.g1.x() * e.u - e.g3.x() * e.s;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "celc/geometry/motion_model.hpp"
+#include "celc/geometry/so3.hpp"
 #include "celc/solver/celc_residual.hpp"
 #include "celc/core/observations.hpp"
 
@@ -46,31 +47,14 @@ struct TwistRowConstants {
   Vec3 m1, m3, u0, s0, wm1, wm3, wwm1, wwm3;
 };
 
-/// B and C by their Taylor series in x = |phi|^2 <= kTwistSeriesLimit, to the
-/// x^10 term (truncation below 1e-19 relative; no cancellation, unlike the
-/// closed form of C at small angles); A = 1 - x C. Inline: the row kernel
-/// evaluates it across events.
-constexpr double kTwistSeriesLimit = 2.25;  // |phi| <= 1.5 rad
-inline void twistSeriesCoefficients(double x, double& A, double& B, double& C) {
-  // 1 / (2k + 2)! and 1 / (2k + 3)!, k = 0..10.
-  constexpr double kB[11] = {1.0 / 2, 1.0 / 24, 1.0 / 720, 1.0 / 40320, 1.0 / 3628800,
-                             1.0 / 479001600, 1.0 / 87178291200.0, 1.0 / 20922789888000.0,
-                             1.0 / 6402373705728000.0, 1.0 / 2432902008176640000.0,
-                             1.0 / 1124000727777607680000.0};
-  constexpr double kC[11] = {1.0 / 6, 1.0 / 120, 1.0 / 5040, 1.0 / 362880, 1.0 / 39916800,
-                             1.0 / 6227020800.0, 1.0 / 1307674368000.0, 1.0 / 355687428096000.0,
-                             1.0 / 121645100408832000.0, 1.0 / 51090942171709440000.0,
-                             1.0 / 25852016738884976640000.0};
-  B = kB[10], C = kC[10];
-  for (int k = 9; k >= 0; --k) B = kB[k] - x * B, C = kC[k] - x * C;
-  A = 1.0 - x * C;
-}
+/// |phi|^2 up to which a constant twist's rows use so3::seriesCoefficients.
+constexpr double kTwistSeriesLimit = so3::kSeriesLimit;
 
 /// The EventLineTerms of one cluster's events without 3x3 products: the
 /// cluster's constants are formed once (TwistRowConstants for a constant
-/// twist; other motion models take R_k and P_k from the model). row() equals
-/// celcRow up to rounding under a constant twist, and is celcRow otherwise
-/// (the pose costs most there). Keeps references to frame and motion.
+/// twist; other motion models take R_k, and P_k unless it is tau I, from the
+/// model). row() equals celcRow up to rounding. Keeps references to frame and
+/// motion.
 class ClusterRowTerms {
  public:
   ClusterRowTerms(const ClusterFrame& frame, const MotionModel& motion);

@@ -125,7 +125,7 @@ CELC_ISA_CLONES void twistRows(const double* q, const double* t, const double* f
   for (size_t i = 0; i < m; ++i) {
     const double tau = t[i] - t_ref, tau2 = tau * tau, x = w2 * tau2;
     double A, B, C;
-    twistSeriesCoefficients(x, A, B, C);
+    so3::seriesCoefficients(x, A, B, C);
     const double ra = A * tau, rb = B * tau2, pc = C * tau2 * tau;
     double g1[3], g3[3], u[3], sv[3];
     for (int j = 0; j < 3; ++j) {

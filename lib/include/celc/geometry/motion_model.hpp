@@ -58,6 +58,17 @@ class MotionModel {
   /// R(t) and P(t) together (one sin/cos for the constant twist).
   void pose(double t, Mat3& R, Mat3& P) const;
 
+  /// R(t)^T x and P(t)^T x for two reference-frame vectors x = a, b.
+  struct TransposedActions {
+    Vec3 Rt_a, Rt_b, Pt_a, Pt_b;
+  };
+  /// The same numbers as pose() then R^T x, P^T x (up to rounding), without
+  /// forming R and P: with the step exp(phi) that pose() composes (phi = w tau
+  /// for the constant twist; R_i exp(phi) from the sample i before t for the
+  /// gyro), exp(phi)^T y = y - A phi x y + B phi x (phi x y) and
+  /// J_l(phi)^T y = y - B phi x y + C phi x (phi x y) (so3::coefficients).
+  TransposedActions transposedActions(double t, const Vec3& a, const Vec3& b) const;
+
   /// The same model with a different constant rate (ConstantTwist) or with all
   /// rate samples shifted by delta (GyroIntegrated): used to perturb the gyroscope.
   MotionModel withOmegaOffset(const Vec3& delta) const;
@@ -76,6 +87,9 @@ class MotionModel {
   /// anchored at t_ref, or from the first sample while they are being built);
   /// P is skipped when null.
   void samplePose(double t, Mat3& R, Mat3* P) const;
+  /// GyroIntegrated: the sample i whose step holds t, and that step's
+  /// rotation vector phi (R(t) = rotations_[i] exp(phi)) and length dt [s].
+  void sampleStep(double t, size_t& i, Vec3& phi, double& dt) const;
 };
 
 }  // namespace celc
