@@ -6,6 +6,7 @@
 #include <random>
 
 #include "solver/irls_kernel.hpp"
+#include "solver/sampling.hpp"
 
 using namespace celc;
 using detail::ConstraintRow;
@@ -122,4 +123,36 @@ TEST(IrlsKernel, ScaleSampleAndStridedRows) {
   packed.squaredResiduals(v, 1.0, all);
   sub.squaredResiduals(v, 1.0, some);
   for (size_t k = 0; k < some.size(); ++k) EXPECT_EQ(some[k], all[10 * k]) << "row " << 10 * k;
+}
+
+// The IRLS's median of squared residuals with a guess of where it lies
+// (detail::kthSmallest) is the value std::nth_element gives, whether the guess
+// brackets it, misses it on either side, is empty, NaN, or a single value;
+// with ties, below and above the size where the guess is used.
+TEST(IrlsKernel, KthSmallestEqualsNthElementWhateverTheGuess) {
+  std::mt19937_64 rng(11);
+  std::chi_squared_distribution<double> chi2(1.0);
+  std::vector<double> band;
+  int checked = 0;
+  for (size_t n : {1u, 10u, 255u, 256u, 334u, 1000u}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      std::vector<double> x(n);
+      // Trials 2 and 3: values rounded to 0.1, so many are tied.
+      for (double& v : x) v = trial < 2 ? chi2(rng) : std::round(10.0 * chi2(rng)) / 10.0;
+      for (size_t k : {size_t{0}, n / 2, n - 1}) {
+        std::vector<double> ref = x;
+        std::nth_element(ref.begin(), ref.begin() + static_cast<long>(k), ref.end());
+        const double want = ref[k];
+        const double guesses[][2] = {{want / 1.5, want * 1.5}, {want, want}, {want * 2 + 1, want * 3 + 2},
+                                     {want / 3 - 1, want / 2 - 0.5}, {2.0, 1.0}, {NAN, NAN}};
+        for (const auto& guess : guesses) {
+          std::vector<double> y = x;
+          EXPECT_EQ(detail::kthSmallest(y, k, guess[0], guess[1], band), want)
+              << "n " << n << " k " << k << " guess [" << guess[0] << ", " << guess[1] << "]";
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 6 * 4 * 3 * 6);
 }

@@ -194,3 +194,72 @@ TEST(ConstraintRows, BuilderMatchesCelcRow) {
   }
   EXPECT_GE(packed_clusters, 20);  // the kernel ran (twists up to 2 rad/s: 30 clusters)
 }
+
+// The rows formed across events per piece of a gyro-integrated model
+// (PackedRows::appendGyroRows) equal celcRow to rounding, with the velocity
+// in the body and in the reference frame: a rate that changes at every
+// sample (100 Hz), events spread over several pieces and beyond the samples.
+// A run whose rotation leaves the series' range is refused whole.
+TEST(ConstraintRows, GyroPiecesMatchCelcRow) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<double> times;
+  std::vector<Vec3> rates;
+  for (int i = 0; i <= 40; ++i) {
+    times.push_back(0.01 * i);
+    rates.push_back(Vec3(0.8, -1.5, 2.0) + Vec3(g(rng), g(rng), g(rng)));
+  }
+  LineSceneOptions o;
+  o.events_per_line = 200;
+  const LineSceneTrial tr = generateLineScene(o, rng);
+  int runs = 0, first_and_last[2] = {0, 0};
+  for (const VelocityFrame frame_kind : {VelocityFrame::Body, VelocityFrame::Reference}) {
+    const MotionModel motion = MotionModel::gyroIntegrated(times, rates, 0.2, frame_kind);
+    for (const auto& cl : tr.observations.clusters) {
+      const ClusterFrame frame = makeClusterFrame(cl, motion);
+      const detail::ClusterRowTerms terms(frame, motion);
+      ASSERT_EQ(terms.twist(), nullptr);
+      // The cluster's events spread over [-0.05, 0.45] s, so that the pieces
+      // before the first sample (0 s) and after the last (0.4 s) hold events too.
+      std::vector<double> t, fx, fy, fz;
+      const double span = cl.times.back() - cl.times.front();
+      for (size_t k = 0; k < cl.size(); ++k) {
+        t.push_back(-0.05 + 0.5 * (cl.times[k] - cl.times.front()) / span);
+        fx.push_back(cl.bearings[k].x()), fy.push_back(cl.bearings[k].y()), fz.push_back(cl.bearings[k].z());
+      }
+      for (size_t begin = 0, end; begin < t.size(); begin = end) {
+        const size_t piece = motion.pieceIndex(t[begin]);
+        for (end = begin + 1; end < t.size() && motion.pieceIndex(t[end]) == piece;) ++end;
+        first_and_last[0] += piece == 0, first_and_last[1] += piece == times.size();
+        detail::PackedRows packed(end - begin, 2);
+        ASSERT_TRUE(packed.appendGyroRows(terms.gyroPiece(piece), &t[begin], &fx[begin], &fy[begin],
+                                          &fz[begin], end - begin));
+        ++runs;
+        const size_t s = packed.stride();
+        for (size_t k = begin; k < end; ++k) {
+          const detail::ConstraintRow ref = detail::celcRow(frame, motion, t[k], Vec3(fx[k], fy[k], fz[k]));
+          const double* c = packed.data() + (k - begin);
+          const Vec3 pa(c[0], c[s], c[2 * s]), p0(c[3 * s], c[4 * s], c[5 * s]), p1(c[6 * s], c[7 * s], c[8 * s]);
+          const double scale = std::max(ref.a.norm(), ref.N.norm());
+          EXPECT_LT((pa - ref.a).norm(), 1e-12 * scale) << "event " << k;
+          EXPECT_LT((p0 - ref.N.row(0).transpose()).norm(), 1e-12 * scale) << "event " << k;
+          EXPECT_LT((p1 - ref.N.row(1).transpose()).norm(), 1e-12 * scale) << "event " << k;
+        }
+      }
+    }
+    // An event 2 s after the last sample turns by about 5 rad in its piece:
+    // beyond the series, the run is refused and nothing is appended.
+    const auto& cl = tr.observations.clusters.front();
+    const ClusterFrame frame = makeClusterFrame(cl, motion);
+    const detail::ClusterRowTerms terms(frame, motion);
+    const double late[2] = {0.45, 2.4}, x[2] = {0.1, 0.1}, y[2] = {0.0, 0.0}, z[2] = {1.0, 1.0};
+    detail::PackedRows packed(2, 2);
+    EXPECT_FALSE(packed.appendGyroRows(terms.gyroPiece(motion.pieceIndex(2.4)), late, x, y, z, 2));
+    EXPECT_EQ(packed.size(), 0u);
+  }
+  // 5 clusters x 2 frames, each over 42 pieces (200 random times: about 0.4
+  // of a piece empty per cluster), the first and the last among them.
+  EXPECT_GE(runs, 5 * 2 * 38);
+  EXPECT_EQ(first_and_last[0], 10);
+  EXPECT_EQ(first_and_last[1], 10);
+}

@@ -112,6 +112,32 @@ static void BM_CelcLinearPeers(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
+// The same cycling over 16 trials of the peers' scene (the IRLS's iteration
+// count, and so the time, depends on the trial): the mean time per solve, and
+// the mean iteration count.
+static void BM_CelcLinearPeers16(benchmark::State& state) {
+  PeerSceneOptions o;
+  o.events_per_line = static_cast<int>(state.range(0));
+  std::vector<PeerSceneTrial> trials;
+  std::mt19937_64 rng(42);
+  while (trials.size() < 16) {
+    auto tr = generatePeerScene(o, rng);
+    if (tr.ok) trials.push_back(std::move(tr));
+  }
+  const LinearOptions opt;
+  size_t i = 0;
+  double iterations = 0.0;
+  for (auto _ : state) {
+    const auto& tr = trials[i++ % trials.size()];
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
+    iterations += r.iterations;
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["irls_iterations"] = iterations / static_cast<double>(std::max<size_t>(1, i));
+}
+BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
 // celc_ml with the default options on the peers' scene (V = 2 m/s, 1 px
 // noise), as solveMethods runs it: its linear and npt starts, the line
 // profile's screen, the joint refinements. Cycles over 16 trials (the time

@@ -64,23 +64,31 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   return m;
 }
 
+Vec3 MotionModel::rateSlope(size_t i) const {
+  return (rates_[i + 1] - rates_[i]) / (2.0 * (times_[i + 1] - times_[i]));
+}
+
+size_t MotionModel::pieceIndex(double t) const {
+  if (kind_ == MotionModelKind::ConstantTwist || times_.size() == 1 || t <= times_.front()) return 0;
+  if (t >= times_.back()) return times_.size();
+  return static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin());
+}
+
+MotionModel::RotationPiece MotionModel::piece(size_t index) const {
+  RotationPiece p;
+  if (kind_ == MotionModelKind::ConstantTwist || times_.empty()) return p;
+  const size_t n = times_.size();
+  const size_t i = index == 0 ? 0 : std::min(index, n) - 1;  // the sample the piece starts at
+  p.t0 = times_[i], p.w0 = rates_[i], p.R0 = rotations_[i], p.P0 = positions_[i];
+  if (index >= 1 && index < n) p.h = rateSlope(i);
+  return p;
+}
+
 void MotionModel::sampleStep(double t, size_t& i, Vec3& phi, double& dt) const {
-  // The step [t_i, t] holding t turns at the mean of the rates at its ends
-  // (clamped at the ends of the samples, holding the end rate).
-  i = 0;
-  Vec3 rate;
-  if (times_.size() == 1 || t <= times_.front()) {
-    rate = rates_.front();
-  } else if (t >= times_.back()) {
-    i = times_.size() - 1;
-    rate = rates_.back();
-  } else {
-    i = static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin()) - 1;
-    const double s = (t - times_[i]) / (times_[i + 1] - times_[i]);
-    rate = 0.5 * (rates_[i] + (1.0 - s) * rates_[i] + s * rates_[i + 1]);
-  }
+  const size_t index = pieceIndex(t), n = times_.size();
+  i = index == 0 ? 0 : std::min(index, n) - 1;
   dt = t - times_[i];
-  phi = rate * dt;
+  phi = (index >= 1 && index < n ? Vec3(rates_[i] + rateSlope(i) * dt) : rates_[i]) * dt;
 }
 
 void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
@@ -96,6 +104,22 @@ void MotionModel::samplePose(double t, Mat3& R, Mat3* P) const {
   so3::expAndLeftJacobian(phi, step_R, step_J);
   *P = positions_[i] + rotations_[i] * step_J * dt;
   R = rotations_[i] * step_R;
+}
+
+Vec3 MotionModel::rotate(double t, const Vec3& x) const {
+  // exp(phi) x = x + A phi x x + B phi x (phi x x).
+  const auto act = [](const Vec3& phi, const Vec3& y) {
+    double A, B, C;
+    so3::coefficients(phi.squaredNorm(), A, B, C);
+    const Vec3 py = phi.cross(y);
+    return Vec3(y + A * py + B * phi.cross(py));
+  };
+  if (kind_ == MotionModelKind::ConstantTwist) return act(omega_ * (t - t_ref_), x);
+  size_t i;
+  Vec3 phi;
+  double dt;
+  sampleStep(t, i, phi, dt);
+  return rotations_[i] * act(phi, x);
 }
 
 MotionModel::TransposedActions MotionModel::transposedActions(double t, const Vec3& a,

@@ -35,9 +35,10 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
   size_t capacity = 0;
   for (size_t q : quota) capacity += q;
   PackedRows rows(capacity, 2);
-  // Per cluster: the sampled finite events; under a constant twist within
-  // the series' range their rows are formed across events (appendTwistRows),
-  // else (and when a row is not finite) one by one.
+  // Per cluster: the sampled finite events; their rows are formed across
+  // events, under a constant twist within the series' range
+  // (appendTwistRows) or per piece of a gyro-integrated model
+  // (appendGyroRows), else (and when a row is not finite) one by one.
   std::vector<double> t, fx, fy, fz;
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
@@ -54,12 +55,25 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
         in_series_range = in_series_range && twist->w2 * tau * tau < kTwistSeriesLimit;
       }
     }
-    if (in_series_range && rows.appendTwistRows(*twist, t.data(), fx.data(), fy.data(), fz.data(), t.size()))
+    const auto appendOneByOne = [&](size_t begin, size_t end) {
+      Vec3 a, n0, n1;
+      for (size_t k = begin; k < end; ++k) {
+        terms.row(t[k], Vec3(fx[k], fy[k], fz[k]), a, n0, n1);
+        if (a.allFinite() && n0.allFinite() && n1.allFinite()) rows.append(a, n0, n1);
+      }
+    };
+    if (twist) {
+      if (!in_series_range || !rows.appendTwistRows(*twist, t.data(), fx.data(), fy.data(), fz.data(), t.size()))
+        appendOneByOne(0, t.size());
       continue;
-    Vec3 a, n0, n1;
-    for (size_t k = 0; k < t.size(); ++k) {
-      terms.row(t[k], Vec3(fx[k], fy[k], fz[k]), a, n0, n1);
-      if (a.allFinite() && n0.allFinite() && n1.allFinite()) rows.append(a, n0, n1);
+    }
+    // A gyro-integrated model: across each run of events in one piece.
+    for (size_t begin = 0, end; begin < t.size(); begin = end) {
+      const size_t piece = motion.pieceIndex(t[begin]);
+      for (end = begin + 1; end < t.size() && motion.pieceIndex(t[end]) == piece;) ++end;
+      if (!rows.appendGyroRows(terms.gyroPiece(piece), &t[begin], &fx[begin], &fy[begin], &fz[begin],
+                               end - begin))
+        appendOneByOne(begin, end);
     }
   }
   rows.seal();

@@ -76,6 +76,23 @@ EventLineTerms ClusterRowTerms::at(double t) const {
   return e;
 }
 
+GyroRowConstants ClusterRowTerms::gyroPiece(size_t index) const {
+  const MotionModel::RotationPiece p = motion_->piece(index);
+  GyroRowConstants g;
+  g.body = motion_->velocityFrame() == VelocityFrame::Body;
+  g.t0 = p.t0, g.w0 = p.w0, g.h = p.h;
+  g.m1 = k_.m1, g.m3 = k_.m3;
+  g.m1r = p.R0.transpose() * k_.m1, g.m3r = p.R0.transpose() * k_.m3;
+  if (g.body) {
+    g.U = k_.u0 - p.P0.transpose() * k_.m3;
+    g.S = k_.s0 - p.P0.transpose() * k_.m1;
+  } else {
+    g.U = k_.u0 - (p.t0 - k_.t_ref) * k_.m3;
+    g.S = k_.s0 - (p.t0 - k_.t_ref) * k_.m1;
+  }
+  return g;
+}
+
 void ClusterRowTerms::row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) const {
   const EventLineTerms e = at(t);
   a = e.g1.dot(f) * e.u - e.g3.dot(f) * e.s;

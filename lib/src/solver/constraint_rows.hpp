@@ -47,6 +47,21 @@ struct TwistRowConstants {
   Vec3 m1, m3, u0, s0, wm1, wm3, wwm1, wwm3;
 };
 
+/// A cluster's terms of its CELC rows over one piece of a gyro-integrated
+/// model (MotionModel::RotationPiece: R = R0 exp(phi), phi = (w0 + h dt) dt,
+/// dt = t - t0). With m_i' = R0^T m_i, the SO(3) coefficients A, B, C of phi
+/// and y x z the cross product:
+///   g_i = m_i' - A phi x m_i' + B phi x (phi x m_i'),
+///   u = U - dt p3,  s = S - dt p1, where
+///   body velocity:      p_i = m_i' - B phi x m_i' + C phi x (phi x m_i'),
+///                       U = u0 - P0^T m3, S = s0 - P0^T m1;
+///   reference velocity: p_i = m_i, U = u0 - (t0 - t_ref) m3, S = s0 - (t0 - t_ref) m1.
+struct GyroRowConstants {
+  bool body = true;
+  double t0 = 0.0;
+  Vec3 w0, h, m1r, m3r, U, S, m1, m3;
+};
+
 /// |phi|^2 up to which a constant twist's rows use so3::seriesCoefficients.
 constexpr double kTwistSeriesLimit = so3::kSeriesLimit;
 
@@ -63,6 +78,9 @@ class ClusterRowTerms {
   void row(double t, const Vec3& f, Vec3& a, Vec3& n0, Vec3& n1) const;
   /// The constant twist's constants; null for other motion models.
   const TwistRowConstants* twist() const { return twist_ ? &k_ : nullptr; }
+  /// A gyro-integrated model's constants over its piece `index`
+  /// (MotionModel::pieceIndex).
+  GyroRowConstants gyroPiece(size_t index) const;
   const ClusterFrame& frame() const { return *frame_; }
 
  private:

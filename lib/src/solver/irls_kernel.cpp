@@ -144,6 +144,54 @@ CELC_ISA_CLONES void twistRows(const double* q, const double* t, const double* f
   }
 }
 
+// The CELC rows of m events in one piece of a gyro-integrated model
+// (constants q: t0, w0, h, m1', m3', U, S, m1, m3, 3 each after t0), into
+// columns c (stride s) from row 0: ClusterRowTerms::row, one event per lane.
+template <bool kBody>
+CELC_PASS_INLINE void gyroRows(const double* q, const double* t, const double* fx, const double* fy,
+                     const double* fz, size_t m, double* c, size_t s) {
+  const double t0 = q[0];
+  const double* w0 = q + 1; const double* h = q + 4;
+  const double* m1r = q + 7; const double* m3r = q + 10; const double* U = q + 13;
+  const double* S = q + 16; const double* m1 = q + 19; const double* m3 = q + 22;
+#pragma omp simd
+  for (size_t i = 0; i < m; ++i) {
+    const double dt = t[i] - t0;
+    const double px = (w0[0] + h[0] * dt) * dt, py = (w0[1] + h[1] * dt) * dt, pz = (w0[2] + h[2] * dt) * dt;
+    double A, B, C;
+    so3::seriesCoefficients(px * px + py * py + pz * pz, A, B, C);
+    // c1 = phi x m1', c2 = phi x c1; d1, d2 the same for m3'.
+    const double c1[3] = {py * m1r[2] - pz * m1r[1], pz * m1r[0] - px * m1r[2], px * m1r[1] - py * m1r[0]};
+    const double c2[3] = {py * c1[2] - pz * c1[1], pz * c1[0] - px * c1[2], px * c1[1] - py * c1[0]};
+    const double d1[3] = {py * m3r[2] - pz * m3r[1], pz * m3r[0] - px * m3r[2], px * m3r[1] - py * m3r[0]};
+    const double d2[3] = {py * d1[2] - pz * d1[1], pz * d1[0] - px * d1[2], px * d1[1] - py * d1[0]};
+    double g1[3], g3[3], u[3], sv[3];
+    for (int j = 0; j < 3; ++j) {
+      g1[j] = m1r[j] - A * c1[j] + B * c2[j];
+      g3[j] = m3r[j] - A * d1[j] + B * d2[j];
+      const double p1 = kBody ? m1r[j] - B * c1[j] + C * c2[j] : m1[j];
+      const double p3 = kBody ? m3r[j] - B * d1[j] + C * d2[j] : m3[j];
+      u[j] = U[j] - dt * p3;
+      sv[j] = S[j] - dt * p1;
+    }
+    const double al = g1[0] * fx[i] + g1[1] * fy[i] + g1[2] * fz[i];
+    const double be = g3[0] * fx[i] + g3[1] * fy[i] + g3[2] * fz[i];
+    for (int j = 0; j < 3; ++j) {
+      c[static_cast<size_t>(j) * s + i] = al * u[j] - be * sv[j];
+      c[static_cast<size_t>(3 + j) * s + i] = g1[0] * u[j] - g3[0] * sv[j];
+      c[static_cast<size_t>(6 + j) * s + i] = g1[1] * u[j] - g3[1] * sv[j];
+    }
+  }
+}
+CELC_ISA_CLONES void gyroRowsBody(const double* q, const double* t, const double* fx, const double* fy,
+                                  const double* fz, size_t m, double* c, size_t s) {
+  gyroRows<true>(q, t, fx, fy, fz, m, c, s);
+}
+CELC_ISA_CLONES void gyroRowsReference(const double* q, const double* t, const double* fx,
+                                       const double* fy, const double* fz, size_t m, double* c, size_t s) {
+  gyroRows<false>(q, t, fx, fy, fz, m, c, s);
+}
+
 // 0 when the m rows of the first `columns` columns (stride s) are all
 // finite, else NaN (x * 0 is NaN exactly for an infinite or NaN x).
 CELC_ISA_CLONES double zeroUnlessNotFinite(const double* c, size_t columns, size_t m, size_t s) {
@@ -219,6 +267,24 @@ bool PackedRows::appendTwistRows(const TwistRowConstants& k, const double* t, co
     for (int i = 0; i < 3; ++i) q[2 + 3 * j + i] = (*vectors[j])(i);
   double* c = data_.get() + n_;
   twistRows(q, t, fx, fy, fz, m, c, stride_);
+  if (!std::isfinite(zeroUnlessNotFinite(c, 9, m, stride_))) return false;
+  n_ += m;
+  return true;
+}
+
+bool PackedRows::appendGyroRows(const GyroRowConstants& k, const double* t, const double* fx,
+                                const double* fy, const double* fz, size_t m) {
+  if (normal_rows_ != 2 || m > capacity_ - n_) return false;
+  double q[25] = {k.t0};
+  const Vec3* vectors[8] = {&k.w0, &k.h, &k.m1r, &k.m3r, &k.U, &k.S, &k.m1, &k.m3};
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 3; ++i) q[1 + 3 * j + i] = (*vectors[j])(i);
+  for (size_t i = 0; i < m; ++i) {
+    const double dt = t[i] - k.t0;
+    if (!(((k.w0 + k.h * dt) * dt).squaredNorm() < kTwistSeriesLimit)) return false;
+  }
+  double* c = data_.get() + n_;
+  (k.body ? gyroRowsBody : gyroRowsReference)(q, t, fx, fy, fz, m, c, stride_);
   if (!std::isfinite(zeroUnlessNotFinite(c, 9, m, stride_))) return false;
   n_ += m;
   return true;

@@ -44,6 +44,11 @@ class PackedRows {
   /// nothing appended) when a row is not finite.
   bool appendTwistRows(const TwistRowConstants& k, const double* t, const double* fx,
                        const double* fy, const double* fz, size_t m);
+  /// The same for m events inside one piece of a gyro-integrated model
+  /// (GyroRowConstants), with |phi|^2 < kTwistSeriesLimit for every event;
+  /// false (and nothing appended) otherwise or when a row is not finite.
+  bool appendGyroRows(const GyroRowConstants& k, const double* t, const double* fx,
+                      const double* fy, const double* fz, size_t m);
   /// Pads, forms the plain sums and the scale sample: once, after the last
   /// append and before any pass.
   void seal();

@@ -39,7 +39,7 @@ LineProfile::LineProfile(const WindowObservations& obs, const MotionModel& motio
       const double t = cl.times[k];
       const Vec3& f = cl.bearings[k];
       if (!std::isfinite(t) || !f.allFinite() || !(f.norm() > 0.0)) continue;
-      const Vec3 b = motion.rotation(t) * f.normalized();
+      const Vec3 b = motion.rotate(t, f.normalized());
       const Mat3 K = -skew(b) * motion.positionMatrix(t);  // h = K v
       if (!b.allFinite() || !K.allFinite()) continue;
       s.S += b * b.transpose();

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "irls_kernel.hpp"
+#include "sampling.hpp"
 
 namespace celc::detail {
 
@@ -93,14 +94,16 @@ Mat3 unpack(const double* q) {
 
 // The MAD scale 1.4826 * median |r| of r = a.v / |N v| over the scale sample
 // of the rows (median of r^2: no square root per row). Rows with |N v| = 0
-// count as r = r_degenerate.
-double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::vector<double>& r2) {
+// count as r = r_degenerate. median_r2 carries the median r^2 from one call
+// to the next (NaN at first): the next median is looked for within a factor
+// 1.5 of it first (kthSmallest), the same value either way.
+double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::vector<double>& r2,
+                  std::vector<double>& band, double& median_r2) {
   P.scaleSample().squaredResiduals(v, r_degenerate, r2);
   if (r2.empty()) return 0.0;
-  auto mid = r2.begin() + static_cast<long>(r2.size() / 2);
-  std::nth_element(r2.begin(), mid, r2.end());
+  median_r2 = kthSmallest(r2, r2.size() / 2, median_r2 / 1.5, median_r2 * 1.5, band);
   const double r2_degenerate = std::min(r_degenerate * r_degenerate, std::numeric_limits<double>::max());
-  return 1.4826 * (*mid == r2_degenerate ? r_degenerate : std::sqrt(*mid));
+  return 1.4826 * (median_r2 == r2_degenerate ? r_degenerate : std::sqrt(median_r2));
 }
 
 // IRLS from a starting direction. Each step solves the generalised
@@ -122,13 +125,14 @@ double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::
 // product); the fixed points are unchanged.
 NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt) {
   NullspaceSolution out;
-  std::vector<double> sample;
+  std::vector<double> sample, band;
+  double median_r2 = NAN;
   Vec3 lambda;
   Mat3 X;
   Vec3 last_step = Vec3::Zero();
   double relax = 1.0;  // share of the fixed-point step taken, halved at every reversal
   for (int it = 0; it < std::max(1, opt.max_iterations); ++it) {
-    const double scale = sampledMad(P, v, 0.0, sample);
+    const double scale = sampledMad(P, v, 0.0, sample, band, median_r2);
     const double thr = opt.huber_k * std::max(scale, 1e-15);
     const PackedSums s = huberWeightedSums(P, v, thr);
     const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
@@ -150,7 +154,7 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
   }
   out.v = v;
   // Robust scale at the end point (rows with |N v| = 0 count as outliers).
-  out.scale = sampledMad(P, v, 1e300, sample);
+  out.scale = sampledMad(P, v, 1e300, sample, band, median_r2);
   out.ok = v.allFinite() && v.norm() > 0.5;
   return out;
 }

@@ -50,6 +50,32 @@ std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bo
   return q;
 }
 
+namespace {
+constexpr size_t kBandSelectionMin = 256;
+}  // namespace
+
+double kthSmallest(std::vector<double>& x, size_t k, double lo, double hi, std::vector<double>& band) {
+  // Below a few hundred values the full selection is as quick.
+  if (x.size() >= kBandSelectionMin && lo <= hi) {
+    band.resize(x.size());
+    size_t below = 0, inside = 0;
+    for (double v : x) {
+      below += v < lo;
+      band[inside] = v;
+      inside += (v >= lo) & (v <= hi);
+    }
+    // The k-th smallest lies in [lo, hi] exactly when below <= k < below + inside.
+    if (below <= k && k < below + inside) {
+      const auto kth = band.begin() + static_cast<long>(k - below);
+      std::nth_element(band.begin(), kth, band.begin() + static_cast<long>(inside));
+      return *kth;
+    }
+  }
+  const auto kth = x.begin() + static_cast<long>(k);
+  std::nth_element(x.begin(), kth, x.end());
+  return *kth;
+}
+
 double medianAbs(std::vector<double>& x) {
   if (x.empty()) return 0.0;
   for (double& v : x) v = std::abs(v);

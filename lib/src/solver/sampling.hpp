@@ -14,6 +14,13 @@ std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed);
 /// to the sizes (rounded down).
 std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bool balanced);
 
+/// The k-th smallest of x (0-based, k < x.size(); x is reordered), the value
+/// std::nth_element puts at k. [lo, hi] is a guess of where it lies: when it
+/// holds (and x holds a few hundred values), only the values inside it are
+/// selected among (after one pass without branches that moves them into
+/// `band`), else all of x are.
+double kthSmallest(std::vector<double>& x, size_t k, double lo, double hi, std::vector<double>& band);
+
 /// Median of |x| (upper median for an even count; x is overwritten and reordered). 0 when empty.
 double medianAbs(std::vector<double>& x);
 

@@ -22,32 +22,21 @@ struct SignVotes {
 
   SignVotes(const ClusterObservation& c, const ClusterFrame& frame, const MotionModel& motion)
       : cl(&c), terms(frame, motion) {}
-  // lambda of the event (t, f); NaN when it sees neither plane. Under a
-  // constant twist from the cluster's terms, else from the pose as the row
-  // of celcRow (bit-identical to the former test there).
-  double depth(double t, const Vec3& f, const MotionModel& motion, const Vec3& v) const {
-    double a1, a3, d1, d3;  // m_i.f' and m_i.(p_i - p_k)
-    if (terms.twist()) {
-      const EventLineTerms e = terms.at(t);
-      a1 = e.g1.dot(f), a3 = e.g3.dot(f), d1 = e.s.dot(v), d3 = e.u.dot(v);
-    } else {
-      const ClusterFrame& fr = terms.frame();
-      Mat3 Rk, Pk;
-      motion.pose(t, Rk, Pk);
-      const Vec3 fp = Rk * f, pk = Pk * v;
-      a1 = fr.m1.dot(fp), a3 = fr.m3.dot(fp);
-      d1 = fr.m1.dot(fr.Ps * v - pk), d3 = fr.m3.dot(fr.Pe * v - pk);
-    }
+  // lambda of the event (t, f) from the cluster's terms; NaN when it sees
+  // neither plane.
+  double depth(double t, const Vec3& f, const Vec3& v) const {
+    const EventLineTerms e = terms.at(t);
+    const double a1 = e.g1.dot(f), a3 = e.g3.dot(f), d1 = e.s.dot(v), d3 = e.u.dot(v);
     const double den = a1 * a1 + a3 * a3;
     if (!(den > 1e-24)) return NAN;
     return (a1 * d1 + a3 * d3) / den;
   }
   size_t remaining() const { return next < cl->size() ? (cl->size() - 1 - next) / stride + 1 : 0; }
   // Counts votes until the majority cannot change (or all are counted).
-  void count(const MotionModel& motion, const Vec3& v, bool all) {
+  void count(const Vec3& v, bool all) {
     for (; next < cl->size(); next += stride) {
       if (!all && static_cast<size_t>(std::abs(pos - neg)) > remaining()) return;
-      const double lambda = depth(cl->times[next], cl->bearings[next], motion, v);
+      const double lambda = depth(cl->times[next], cl->bearings[next], v);
       if (std::isnan(lambda)) continue;
       if (lambda > 0) ++pos;
       else if (lambda < 0) ++neg;
@@ -71,7 +60,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   for (int c : frames.clusters()) {
     SignVotes& s = clusters.emplace_back(obs.clusters[c], frames[c], motion);
     s.stride = std::max<size_t>(1, s.cl->size() / kSignVotesPerCluster);
-    s.count(motion, v, false);
+    s.count(v, false);
   }
   // A line that hardly moved (rotation removed) carries almost no depth:
   // each cluster's vote counts by its line's motion, up to kSignFullWeightPx.
@@ -93,7 +82,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   }
   long event_balance = 0;
   for (auto& s : clusters) {
-    s.count(motion, v, true);
+    s.count(v, true);
     if (s.pos != s.neg) event_balance += s.pos - s.neg;
   }
   d.sign = event_balance >= 0 ? 1 : -1;

@@ -40,7 +40,7 @@ ClusterParallax clusterParallax(const ClusterObservation& c, const MotionModel& 
   std::vector<double> tau;
   for (size_t k = 0; k < n; k += stride) {
     if (!c.bearings[k].allFinite() || !std::isfinite(c.times[k])) continue;
-    f.push_back((motion.rotation(c.times[k]) * c.bearings[k]).normalized());
+    f.push_back(motion.rotate(c.times[k], c.bearings[k]).normalized());
     tau.push_back((c.times[k] - tm) / half);
   }
   if (f.size() < 8) return out;

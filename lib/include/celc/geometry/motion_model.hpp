@@ -58,6 +58,10 @@ class MotionModel {
   /// R(t) and P(t) together (one sin/cos for the constant twist).
   void pose(double t, Mat3& R, Mat3& P) const;
 
+  /// R(t) x (x in the camera at t, the result in the reference frame), as
+  /// rotation(t) * x up to rounding, without forming R(t).
+  Vec3 rotate(double t, const Vec3& x) const;
+
   /// R(t)^T x and P(t)^T x for two reference-frame vectors x = a, b.
   struct TransposedActions {
     Vec3 Rt_a, Rt_b, Pt_a, Pt_b;
@@ -68,6 +72,24 @@ class MotionModel {
   /// gyro), exp(phi)^T y = y - A phi x y + B phi x (phi x y) and
   /// J_l(phi)^T y = y - B phi x y + C phi x (phi x y) (so3::coefficients).
   TransposedActions transposedActions(double t, const Vec3& a, const Vec3& b) const;
+
+  /// GyroIntegrated: the rotation over one piece of the samples, for kernels
+  /// that evaluate many times at once. For t in the piece, dt = t - t0:
+  ///   R(t) = R0 exp(phi),  phi = (w0 + h dt) dt  (the step turns at the mean
+  ///   of the rates at t0 and t),
+  ///   P(t) = P0 + R0 J_l(phi) dt (Body) or (t - t_ref) I (Reference).
+  /// Piece 0 lies before the first sample and piece n (n samples) after the
+  /// last (the end rate held, h = 0); piece i in 1..n-1 between samples i-1
+  /// and i.
+  struct RotationPiece {
+    double t0 = 0.0;
+    Vec3 w0 = Vec3::Zero(), h = Vec3::Zero();
+    Mat3 R0 = Mat3::Identity(), P0 = Mat3::Zero();
+  };
+  /// GyroIntegrated: the piece that holds t (0 for ConstantTwist).
+  size_t pieceIndex(double t) const;
+  /// GyroIntegrated: piece `index` (<= the sample count).
+  RotationPiece piece(size_t index) const;
 
   /// The same model with a different constant rate (ConstantTwist) or with all
   /// rate samples shifted by delta (GyroIntegrated): used to perturb the gyroscope.
@@ -90,6 +112,9 @@ class MotionModel {
   /// GyroIntegrated: the sample i whose step holds t, and that step's
   /// rotation vector phi (R(t) = rotations_[i] exp(phi)) and length dt [s].
   void sampleStep(double t, size_t& i, Vec3& phi, double& dt) const;
+  /// GyroIntegrated: h of the piece between samples i and i + 1 (half the
+  /// rate's slope: the mean of the rates at t_i and t_i + dt is w_i + h dt).
+  Vec3 rateSlope(size_t i) const;
 };
 
 }  // namespace celc
