@@ -1,0 +1,55 @@
+#pragma once
+// Internal: the per-event passes of celc_ml's joint Levenberg-Marquardt
+// (joint_refine.cpp) over its event terms packed as structure of arrays, so
+// that the compiler forms several events at once (as irls_kernel does for
+// the IRLS): the Gauss-Newton blocks of one cluster and its robust cost.
+#include <cstddef>
+#include <vector>
+
+#include "celc/solver/celc_residual.hpp"
+
+namespace celc::detail {
+
+/// Event terms (EventTerm) as 27 columns: fp, the two rows of R_k^T, then De
+/// and Ds row by row; column j holds entry j of every event.
+class JointColumns {
+ public:
+  static constexpr int kColumns = 27;
+  void assign(const std::vector<EventTerm>& terms);
+  size_t size() const { return n_; }
+  const double* data() const { return data_.data(); }
+  size_t stride() const { return n_; }  ///< between columns [doubles]
+
+ private:
+  size_t n_ = 0;
+  std::vector<double> data_;
+};
+
+/// The loss of a pass: Huber with threshold `scale` [px], or the Cauchy loss
+/// with scale c [px] by iteratively reweighted steps (weights frozen at the
+/// point of linearisation: r = d / sqrt(1 + d^2 / c^2)).
+enum class JointLossKind { Huber, Cauchy };
+
+/// One cluster's Gauss-Newton sums at (v, m1, m3) over the events begin,
+/// begin + step, ... < end: with d the event distance [px] (eventDistance),
+/// r the loss's square-root residual, dr/dd its slope, and the tangent
+/// bases Bv, B1, B3 (3 x 2, column-major), jv = slope Bv^T dd/dv and
+/// jc = slope (B1^T dd/dm1, B3^T dd/dm3):
+///   V = sum jv jv^T (xx, xy, yy), bv = sum jv r,
+///   U = sum jc jc^T (upper triangle, row by row), W = sum jv jc^T (row by
+///   row), bc = sum jc r.
+/// Events whose distance is not finite add nothing.
+struct JointBlockSums {
+  double V[3], bv[2], U[10], W[8], bc[4];
+};
+JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, size_t step,
+                              const Vec3& v, const Vec3& m1, const Vec3& m3, const double* Bv,
+                              const double* B1, const double* B3, double focal, JointLossKind loss,
+                              double scale);
+
+/// sum of the Huber rho(d) = d^2 (|d| <= delta), 2 delta |d| - delta^2
+/// (beyond) over the same events; +inf when a distance is not finite.
+double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, size_t step,
+                      const Vec3& v, const Vec3& m1, const Vec3& m3, double focal, double delta);
+
+}  // namespace celc::detail
