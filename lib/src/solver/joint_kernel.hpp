@@ -15,10 +15,16 @@ namespace celc::detail {
 class JointColumns {
  public:
   static constexpr int kColumns = 27;
-  void assign(const std::vector<EventTerm>& terms);
+  /// Every step-th event of each cluster c, terms[begin[c], begin[c + 1]);
+  /// strided_begin gets the clusters' ranges in the columns.
+  void assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
+              std::vector<size_t>& strided_begin);
   size_t size() const { return n_; }
   const double* data() const { return data_.data(); }
   size_t stride() const { return n_; }  ///< between columns [doubles]
+  /// Exchanges the column storage with `buffer` (to keep its memory across
+  /// problems).
+  void swapStorage(std::vector<double>& buffer) { data_.swap(buffer); }
 
  private:
   size_t n_ = 0;
@@ -30,11 +36,11 @@ class JointColumns {
 /// point of linearisation: r = d / sqrt(1 + d^2 / c^2)).
 enum class JointLossKind { Huber, Cauchy };
 
-/// One cluster's Gauss-Newton sums at (v, m1, m3) over the events begin,
-/// begin + step, ... < end: with d the event distance [px] (eventDistance),
-/// r the loss's square-root residual, dr/dd its slope, and the tangent
-/// bases Bv, B1, B3 (3 x 2, column-major), jv = slope Bv^T dd/dv and
-/// jc = slope (B1^T dd/dm1, B3^T dd/dm3):
+/// One cluster's Gauss-Newton sums at (v, m1, m3) over the events
+/// begin .. end - 1 of the columns: with d the event distance [px]
+/// (eventDistance), r the loss's square-root residual, dr/dd its slope, and
+/// the tangent bases Bv, B1, B3 (3 x 2, column-major), jv = slope Bv^T dd/dv
+/// and jc = slope (B1^T dd/dm1, B3^T dd/dm3):
 ///   V = sum jv jv^T (xx, xy, yy), bv = sum jv r,
 ///   U = sum jc jc^T (upper triangle, row by row), W = sum jv jc^T (row by
 ///   row), bc = sum jc r.
@@ -42,14 +48,13 @@ enum class JointLossKind { Huber, Cauchy };
 struct JointBlockSums {
   double V[3], bv[2], U[10], W[8], bc[4];
 };
-JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, size_t step,
-                              const Vec3& v, const Vec3& m1, const Vec3& m3, const double* Bv,
-                              const double* B1, const double* B3, double focal, JointLossKind loss,
-                              double scale);
+JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, const Vec3& v,
+                              const Vec3& m1, const Vec3& m3, const double* Bv, const double* B1,
+                              const double* B3, double focal, JointLossKind loss, double scale);
 
 /// sum of the Huber rho(d) = d^2 (|d| <= delta), 2 delta |d| - delta^2
 /// (beyond) over the same events; +inf when a distance is not finite.
-double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, size_t step,
-                      const Vec3& v, const Vec3& m1, const Vec3& m3, double focal, double delta);
+double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
+                      const Vec3& m3, double focal, double delta);
 
 }  // namespace celc::detail

@@ -30,6 +30,11 @@ std::vector<EventTerm>& threadBuffer() {
   return buffer;
 }
 
+std::vector<double>& threadColumns() {
+  thread_local std::vector<double> buffer;
+  return buffer;
+}
+
 /// a and b within the angle of cosine min_cos in v and in every line
 /// normal (unit vectors, sign-agnostic).
 bool near(const JointProblem::State& a, const JointProblem::State& b, double min_cos) {
@@ -73,10 +78,20 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
     m1_.push_back(frame.m1.normalized());
     m3_.push_back(frame.m3.normalized());
   }
+  columns_.swapStorage(threadColumns());
+}
+
+const JointColumns& JointProblem::columns(int stride) const {
+  if (stride != column_stride_) {
+    columns_.assign(terms_, begin_, static_cast<size_t>(stride), column_begin_);
+    column_stride_ = stride;
+  }
+  return columns_;
 }
 
 JointProblem::~JointProblem() {
   if (terms_.capacity() > threadBuffer().capacity()) terms_.swap(threadBuffer());
+  columns_.swapStorage(threadColumns());
 }
 
 size_t JointProblem::events() const { return terms_.size(); }
@@ -115,6 +130,12 @@ JointProblem::State JointProblem::start(const Vec3& v) const { return {v.normali
 
 double JointProblem::cost(const State& s, int stride) const {
   double total = 0.0;
+  if (loss_ == Loss::Huber) {
+    const JointColumns& cols = columns(stride);
+    for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
+      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_, scale_);
+    return 0.5 * total;  // +inf when a distance is not finite
+  }
   for (size_t c = 0; c + 1 < begin_.size(); ++c)
     for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
       const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr);
@@ -145,30 +166,25 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
     // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s (Huber),
     // or of r = sqrt(w(d_s)) d with the weights frozen at s (Cauchy: IRLS).
     const Mat32 Bv = tangentBasis(s.v);
+    const JointColumns& cols = columns(stride);
     Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
     Eigen::Vector2d bv = Eigen::Vector2d::Zero();
     for (size_t c = 0; c < nc; ++c) {
       B1[c] = tangentBasis(s.m1[c]);
       B3[c] = tangentBasis(s.m3[c]);
-      U[c].setZero();
-      W[c].setZero();
-      bc[c].setZero();
-      for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
-        Vec3 gv = Vec3::Zero(), g1 = Vec3::Zero(), g3 = Vec3::Zero();
-        const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, &gv, &g1, &g3);
-        if (!std::isfinite(d)) continue;  // not at s: its cost is finite
-        double slope;
-        const double r = weighted(d, &slope);
-        const Eigen::Vector2d jv = slope * (Bv.transpose() * gv);
-        Vec4 jc;
-        jc.head<2>() = slope * (B1[c].transpose() * g1);
-        jc.tail<2>() = slope * (B3[c].transpose() * g3);
-        V.noalias() += jv * jv.transpose();
-        bv += jv * r;
-        U[c].noalias() += jc * jc.transpose();
-        W[c].noalias() += jv * jc.transpose();
-        bc[c] += jc * r;
-      }
+      // An event whose distance is not finite adds nothing (not at s: its
+      // cost is finite).
+      const JointBlockSums b =
+          jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
+                         B1[c].data(), B3[c].data(), focal_,
+                         loss_ == Loss::Huber ? JointLossKind::Huber : JointLossKind::Cauchy, scale_);
+      V(0, 0) += b.V[0], V(0, 1) += b.V[1], V(1, 0) += b.V[1], V(1, 1) += b.V[2];
+      bv += Eigen::Vector2d(b.bv[0], b.bv[1]);
+      for (int i = 0, k = 0; i < 4; ++i)
+        for (int j = i; j < 4; ++j, ++k) U[c](i, j) = U[c](j, i) = b.U[k];
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 4; ++j) W[c](i, j) = b.W[4 * i + j];
+      bc[c] = Vec4(b.bc[0], b.bc[1], b.bc[2], b.bc[3]);
     }
     // Damped steps until one lowers the cost (lambda grows on failure).
     bool accepted = false;

@@ -15,6 +15,7 @@
 #include "celc/core/observations.hpp"
 #include "celc/solver/celc_residual.hpp"
 #include "constraint_rows.hpp"
+#include "joint_kernel.hpp"
 #include "sampling.hpp"
 
 namespace celc::detail {
@@ -79,6 +80,13 @@ class JointProblem {
   /// cost more than building the terms.
   std::vector<EventTerm> terms_;
   std::vector<size_t> begin_{0};
+  /// Every stride-th event of terms_ as columns, for the passes of
+  /// joint_kernel.hpp, with the clusters' ranges in them; formed for the
+  /// stride of the last pass that asked (columns()).
+  mutable JointColumns columns_;
+  mutable std::vector<size_t> column_begin_;
+  mutable int column_stride_ = 0;
+  const JointColumns& columns(int stride) const;
   std::vector<Vec3> m1_, m3_;                  // fitted lines (frames), unit
   /// rho(d) (twice the event's cost) and the IRLS residual r with dr/dd.
   double rho(double d) const;

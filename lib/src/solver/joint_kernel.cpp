@@ -1,0 +1,216 @@
+// celc_ml's per-event passes: plain loops over the event columns that the
+// compiler vectorises across the lanes of a block (`#pragma omp simd`),
+// compiled like the IRLS passes (isa_clones.hpp, CMakeLists.txt).
+#include "joint_kernel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "isa_clones.hpp"
+
+namespace celc::detail {
+
+void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
+                          std::vector<size_t>& strided_begin) {
+  step = std::max<size_t>(1, step);
+  std::vector<size_t> keep;
+  strided_begin.assign(1, 0);
+  for (size_t c = 0; c + 1 < begin.size(); ++c) {
+    for (size_t k = begin[c]; k < begin[c + 1]; k += step) keep.push_back(k);
+    strided_begin.push_back(keep.size());
+  }
+  n_ = keep.size();
+  data_.resize(static_cast<size_t>(kColumns) * n_);
+  for (size_t row = 0; row < n_; ++row) {
+    const EventTerm& e = terms[keep[row]];
+    double* c = data_.data() + row;
+    for (int j = 0; j < 3; ++j) {
+      c[static_cast<size_t>(j) * n_] = e.fp(j);
+      c[static_cast<size_t>(3 + j) * n_] = e.Rt01(0, j);
+      c[static_cast<size_t>(6 + j) * n_] = e.Rt01(1, j);
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        c[static_cast<size_t>(9 + 3 * i + j) * n_] = e.De(i, j);
+        c[static_cast<size_t>(18 + 3 * i + j) * n_] = e.Ds(i, j);
+      }
+  }
+}
+
+namespace {
+constexpr int kSums = 27;
+
+// One event's distance d [px] and, with kGradients, dd/dv, dd/dm1, dd/dm3:
+// eventDistance (celc_residual.hpp) on the columns c (stride s) at index i.
+// ok is false where the transferred line has no image direction.
+template <bool kGradients>
+CELC_PASS_INLINE double distance(const double* c, size_t s, size_t i, const double* v, const double* m1,
+                                 const double* m3, double focal, bool& ok, double* gv, double* g1,
+                                 double* g3) {
+  const auto at = [&](int j) { return c[static_cast<size_t>(j) * s + i]; };
+  double u[3], sv3[3];  // u = De^T m3, s = Ds^T m1
+  #pragma GCC unroll 4
+  for (int j = 0; j < 3; ++j) {
+    u[j] = at(9 + j) * m3[0] + at(12 + j) * m3[1] + at(15 + j) * m3[2];
+    sv3[j] = at(18 + j) * m1[0] + at(21 + j) * m1[1] + at(24 + j) * m1[2];
+  }
+  const double uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  const double sv = sv3[0] * v[0] + sv3[1] * v[1] + sv3[2] * v[2];
+  double l[3];
+  #pragma GCC unroll 4
+  for (int j = 0; j < 3; ++j) l[j] = m1[j] * uv - m3[j] * sv;
+  const double ga = at(3) * l[0] + at(4) * l[1] + at(5) * l[2];
+  const double gb = at(6) * l[0] + at(7) * l[1] + at(8) * l[2];
+  const double gn_raw = std::sqrt(ga * ga + gb * gb);
+  ok = gn_raw > 1e-300;
+  const double gn = ok ? gn_raw : 1.0;
+  const double num = at(0) * l[0] + at(1) * l[1] + at(2) * l[2];
+  const double d = focal * num / gn;
+  if (kGradients) {
+    // Written out per component: loops here were left in place (not
+    // unrolled) and kept the pass from vectorising.
+    const double k3 = num / (gn * gn * gn);
+    const double dl0 = focal * (at(0) / gn - k3 * (at(3) * ga + at(6) * gb));
+    const double dl1 = focal * (at(1) / gn - k3 * (at(4) * ga + at(7) * gb));
+    const double dl2 = focal * (at(2) / gn - k3 * (at(5) * ga + at(8) * gb));
+    const double m1dl = m1[0] * dl0 + m1[1] * dl1 + m1[2] * dl2;
+    const double m3dl = m3[0] * dl0 + m3[1] * dl1 + m3[2] * dl2;
+    // (Ds v)_j and (De v)_j.
+    const double dsv0 = at(18) * v[0] + at(19) * v[1] + at(20) * v[2];
+    const double dsv1 = at(21) * v[0] + at(22) * v[1] + at(23) * v[2];
+    const double dsv2 = at(24) * v[0] + at(25) * v[1] + at(26) * v[2];
+    const double dev0 = at(9) * v[0] + at(10) * v[1] + at(11) * v[2];
+    const double dev1 = at(12) * v[0] + at(13) * v[1] + at(14) * v[2];
+    const double dev2 = at(15) * v[0] + at(16) * v[1] + at(17) * v[2];
+    gv[0] = u[0] * m1dl - sv3[0] * m3dl, gv[1] = u[1] * m1dl - sv3[1] * m3dl, gv[2] = u[2] * m1dl - sv3[2] * m3dl;
+    g1[0] = uv * dl0 - dsv0 * m3dl, g1[1] = uv * dl1 - dsv1 * m3dl, g1[2] = uv * dl2 - dsv2 * m3dl;
+    g3[0] = dev0 * m1dl - sv * dl0, g3[1] = dev1 * m1dl - sv * dl1, g3[2] = dev2 * m1dl - sv * dl2;
+  }
+  return d;
+}
+
+// The sums of jointBlockSums (in its order: V, bv, U, W, bc) over the
+// events begin .. begin + count - 1, one flat loop the compiler vectorises
+// with one accumulator per sum and lane.
+template <JointLossKind kLoss>
+CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t count,
+                                const double* v, const double* m1, const double* m3, const double* Bv,
+                                const double* B1, const double* B3, double focal, double scale,
+                                double* out) {
+  // Local copies: loads inside the selects below could not be speculated
+  // from the pointers (they might trap), which would keep the loop scalar.
+  double vb[6], b1[6], b3[6];
+  std::copy(Bv, Bv + 6, vb), std::copy(B1, B1 + 6, b1), std::copy(B3, B3 + 6, b3);
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0, s5 = 0.0, s6 = 0.0, s7 = 0.0, s8 = 0.0, s9 = 0.0, s10 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0, s14 = 0.0, s15 = 0.0, s16 = 0.0, s17 = 0.0, s18 = 0.0, s19 = 0.0, s20 = 0.0, s21 = 0.0, s22 = 0.0, s23 = 0.0, s24 = 0.0, s25 = 0.0, s26 = 0.0;
+#pragma omp simd reduction(+ : s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14, s15, s16, s17, s18, s19, s20, s21, s22, s23, s24, s25, s26)
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = begin + k;
+    bool ok;
+    double gv[3], g1[3], g3[3];
+    const double d = distance<true>(c, s, i, v, m1, m3, focal, ok, gv, g1, g3);
+    double r, slope;
+    if (kLoss == JointLossKind::Huber) {
+      // sqrtHuber: r = d inside the threshold, sign(d) sqrt(2 delta |d| - delta^2) beyond.
+      const double a = std::abs(d);
+      const bool inside = a <= scale;
+      const double root = std::sqrt(inside ? 1.0 : 2.0 * scale * a - scale * scale);
+      slope = inside ? 1.0 : scale / root;
+      r = inside ? d : (d < 0.0 ? -root : root);
+    } else {
+      const double q = d / scale;
+      slope = 1.0 / std::sqrt(1.0 + q * q);
+      r = slope * d;
+    }
+    const bool use = ok & std::isfinite(d);
+    const double w = use ? slope : 0.0, rr = use ? r : 0.0;
+    double jv[2], jc[4];
+    #pragma GCC unroll 4
+    for (int a = 0; a < 2; ++a) {
+      jv[a] = w * (vb[3 * a] * gv[0] + vb[3 * a + 1] * gv[1] + vb[3 * a + 2] * gv[2]);
+      jc[a] = w * (b1[3 * a] * g1[0] + b1[3 * a + 1] * g1[1] + b1[3 * a + 2] * g1[2]);
+      jc[2 + a] = w * (b3[3 * a] * g3[0] + b3[3 * a + 1] * g3[1] + b3[3 * a + 2] * g3[2]);
+    }
+    // A non-finite gradient of a used event would poison the sums, as it
+    // did the former per-event loop's; unused events add exact zeros.
+    #pragma GCC unroll 4
+    for (int a = 0; a < 2; ++a) jv[a] = use ? jv[a] : 0.0;
+    #pragma GCC unroll 4
+    for (int a = 0; a < 4; ++a) jc[a] = use ? jc[a] : 0.0;
+    s0 += jv[0] * jv[0], s1 += jv[0] * jv[1], s2 += jv[1] * jv[1];
+    s3 += jv[0] * rr, s4 += jv[1] * rr, s5 += jc[0] * jc[0];
+    s6 += jc[0] * jc[1], s7 += jc[0] * jc[2], s8 += jc[0] * jc[3];
+    s9 += jc[1] * jc[1], s10 += jc[1] * jc[2], s11 += jc[1] * jc[3];
+    s12 += jc[2] * jc[2], s13 += jc[2] * jc[3], s14 += jc[3] * jc[3];
+    s15 += jv[0] * jc[0], s16 += jv[0] * jc[1], s17 += jv[0] * jc[2];
+    s18 += jv[0] * jc[3], s19 += jv[1] * jc[0], s20 += jv[1] * jc[1];
+    s21 += jv[1] * jc[2], s22 += jv[1] * jc[3], s23 += jc[0] * rr;
+    s24 += jc[1] * rr, s25 += jc[2] * rr, s26 += jc[3] * rr;
+  }
+  const double sums[27] = {s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14, s15, s16, s17, s18, s19, s20, s21, s22, s23, s24, s25, s26};
+  std::copy(sums, sums + 27, out);
+}
+
+CELC_ISA_CLONES void blockSumsHuber(const double* c, size_t s, size_t begin, size_t count, const double* v,
+                                    const double* m1, const double* m3, const double* Bv, const double* B1,
+                                    const double* B3, double focal, double scale, double* out) {
+  blockSums<JointLossKind::Huber>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
+}
+CELC_ISA_CLONES void blockSumsCauchy(const double* c, size_t s, size_t begin, size_t count, const double* v,
+                                     const double* m1, const double* m3, const double* Bv, const double* B1,
+                                     const double* B3, double focal, double scale, double* out) {
+  blockSums<JointLossKind::Cauchy>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
+}
+
+// sum rho(d) over the events begin .. begin + count - 1, and the number of
+// them whose distance is not finite.
+CELC_ISA_CLONES void huberCost(const double* c, size_t s, size_t begin, size_t count, const double* v,
+                               const double* m1, const double* m3, double focal, double delta, double* out) {
+  double total = 0.0, bad = 0.0;
+#pragma omp simd reduction(+ : total, bad)
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = begin + k;
+    bool ok;
+    const double d = distance<false>(c, s, i, v, m1, m3, focal, ok, nullptr, nullptr, nullptr);
+    const double a = std::abs(d);
+    const double rho = a <= delta ? d * d : 2.0 * delta * a - delta * delta;
+    const bool good = ok & std::isfinite(d);
+    total += good ? rho : 0.0;
+    bad += good ? 0.0 : 1.0;
+  }
+  out[0] = total, out[1] = bad;
+}
+
+}  // namespace
+
+JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, const Vec3& v,
+                              const Vec3& m1, const Vec3& m3, const double* Bv,
+                              const double* B1, const double* B3, double focal, JointLossKind loss,
+                              double scale) {
+  double total[kSums];
+  const double vv[3] = {v.x(), v.y(), v.z()}, a1[3] = {m1.x(), m1.y(), m1.z()},
+               a3[3] = {m3.x(), m3.y(), m3.z()};
+  const size_t count = end > begin ? end - begin : 0;
+  if (loss == JointLossKind::Huber)
+    blockSumsHuber(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
+  else
+    blockSumsCauchy(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
+  JointBlockSums out;
+  std::copy(total, total + 3, out.V);
+  std::copy(total + 3, total + 5, out.bv);
+  std::copy(total + 5, total + 15, out.U);
+  std::copy(total + 15, total + 23, out.W);
+  std::copy(total + 23, total + 27, out.bc);
+  return out;
+}
+
+double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
+                      const Vec3& m3, double focal, double delta) {
+  const double vv[3] = {v.x(), v.y(), v.z()}, a1[3] = {m1.x(), m1.y(), m1.z()},
+               a3[3] = {m3.x(), m3.y(), m3.z()};
+  double out[2];
+  huberCost(columns.data(), columns.stride(), begin, end > begin ? end - begin : 0, vv, a1, a3, focal, delta, out);
+  return out[1] > 0.0 ? std::numeric_limits<double>::infinity() : out[0];
+}
+
+}  // namespace celc::detail

@@ -1,0 +1,142 @@
+// celc_ml's per-event passes over packed columns (solver/joint_kernel)
+// against the same sums formed event by event with eventDistance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "solver/joint_kernel.hpp"
+#include "solver/refine_costs.hpp"
+#include "solver/sphere_tangent.hpp"
+
+using namespace celc;
+using detail::JointBlockSums;
+using detail::JointColumns;
+using detail::JointLossKind;
+
+namespace {
+
+Vec3 randomVec(std::mt19937_64& rng, double scale) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  return Vec3(g(rng), g(rng), g(rng)) * scale;
+}
+
+// Random event terms near a CELC geometry: a unit bearing, R^T's first two
+// rows of a random rotation, De, Ds of the size of a displacement over
+// 0.5 s. Events 125 and 130 see no image direction (R^T's rows zero).
+std::vector<EventTerm> randomTerms(size_t n, std::mt19937_64& rng) {
+  std::vector<EventTerm> terms(n);
+  for (size_t k = 0; k < n; ++k) {
+    const Mat3 R = Eigen::AngleAxisd(0.3, randomVec(rng, 1.0).normalized()).toRotationMatrix();
+    terms[k].fp = (Vec3(0.0, 0.0, 1.0) + randomVec(rng, 0.3)).normalized();
+    terms[k].Rt01 = R.transpose().topRows<2>();
+    if (k == 125 || k == 130) terms[k].Rt01.setZero();
+    terms[k].De = Mat3::Identity() * 0.25 + Mat3::Random() * 0.02;
+    terms[k].Ds = Mat3::Identity() * -0.25 + Mat3::Random() * 0.02;
+  }
+  return terms;
+}
+
+// The sums event by event, as JointProblem::refine formed them before the kernel.
+JointBlockSums directSums(const std::vector<EventTerm>& terms, size_t begin, size_t end, size_t step,
+                          const Vec3& v, const Vec3& m1, const Vec3& m3, const detail::Mat32& Bv,
+                          const detail::Mat32& B1, const detail::Mat32& B3, double focal, JointLossKind loss,
+                          double scale) {
+  Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d bv = Eigen::Vector2d::Zero();
+  Eigen::Matrix4d U = Eigen::Matrix4d::Zero();
+  Eigen::Matrix<double, 2, 4> W = Eigen::Matrix<double, 2, 4>::Zero();
+  Eigen::Vector4d bc = Eigen::Vector4d::Zero();
+  for (size_t k = begin; k < end; k += step) {
+    Vec3 gv, g1, g3;
+    const double d = eventDistance(terms[k], v, m1, m3, focal, &gv, &g1, &g3);
+    if (!std::isfinite(d)) continue;
+    double slope, r;
+    if (loss == JointLossKind::Huber) {
+      r = detail::sqrtHuber(d, scale, &slope);
+    } else {
+      slope = 1.0 / std::sqrt(1.0 + (d / scale) * (d / scale));
+      r = slope * d;
+    }
+    const Eigen::Vector2d jv = slope * (Bv.transpose() * gv);
+    Eigen::Vector4d jc;
+    jc << slope * (B1.transpose() * g1), slope * (B3.transpose() * g3);
+    V += jv * jv.transpose(), bv += jv * r;
+    U += jc * jc.transpose(), W += jv * jc.transpose(), bc += jc * r;
+  }
+  JointBlockSums out;
+  out.V[0] = V(0, 0), out.V[1] = V(0, 1), out.V[2] = V(1, 1);
+  out.bv[0] = bv(0), out.bv[1] = bv(1);
+  for (int i = 0, k = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) out.U[k++] = U(i, j);
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 4; ++j) out.W[4 * i + j] = W(i, j);
+  for (int i = 0; i < 4; ++i) out.bc[i] = bc(i);
+  return out;
+}
+
+void expectSumsNear(const JointBlockSums& got, const JointBlockSums& want) {
+  const double* g = got.V;
+  const double* w = want.V;
+  double scale = 0.0;
+  for (int k = 0; k < 27; ++k) scale = std::max(scale, std::abs(w[k]));
+  // Sums of a few hundred products in another order: rounding ~1e-14 relative.
+  for (int k = 0; k < 27; ++k) EXPECT_NEAR(g[k], w[k], 1e-11 * scale) << "sum " << k;
+}
+
+}  // namespace
+
+// Three clusters of 61, 0 and 140 events, every event and every 3rd, both
+// losses, thresholds that leave most events inside and most outside Huber's
+// quadratic part; events without an image direction add nothing.
+TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
+  std::mt19937_64 rng(3);
+  const std::vector<EventTerm> terms = randomTerms(201, rng);
+  const std::vector<size_t> begin = {0, 61, 61, 201};
+  const double focal = 320.0;
+  int checked = 0;
+  for (size_t step : {size_t{1}, size_t{3}}) {
+    JointColumns columns;
+    std::vector<size_t> column_begin;
+    columns.assign(terms, begin, step, column_begin);
+    ASSERT_EQ(column_begin.size(), begin.size());
+    for (int trial = 0; trial < 3; ++trial) {
+      const Vec3 v = randomVec(rng, 1.0).normalized();
+      const Vec3 m1 = randomVec(rng, 1.0).normalized(), m3 = randomVec(rng, 1.0).normalized();
+      const detail::Mat32 Bv = detail::tangentBasis(v), B1 = detail::tangentBasis(m1),
+                          B3 = detail::tangentBasis(m3);
+      for (size_t c = 0; c + 1 < begin.size(); ++c) {
+        for (JointLossKind loss : {JointLossKind::Huber, JointLossKind::Cauchy}) {
+          for (double scale : {0.5, 50.0}) {
+            const JointBlockSums got =
+                detail::jointBlockSums(columns, column_begin[c], column_begin[c + 1], v, m1, m3, Bv.data(),
+                                       B1.data(), B3.data(), focal, loss, scale);
+            expectSumsNear(got, directSums(terms, begin[c], begin[c + 1], step, v, m1, m3, Bv, B1, B3, focal,
+                                           loss, scale));
+            ++checked;
+          }
+        }
+        // The Huber cost: +inf with an event that has no image direction
+        // (the third cluster: 125 and 130; every 3rd event: 130).
+        double want = 0.0;
+        bool finite = true;
+        for (size_t k = begin[c]; k < begin[c + 1]; k += step) {
+          const double d = eventDistance(terms[k], v, m1, m3, focal, nullptr, nullptr, nullptr);
+          double slope;
+          const double r = detail::sqrtHuber(d, 2.0, &slope);
+          finite = finite && std::isfinite(d);
+          want += r * r;
+        }
+        const double got =
+            detail::jointHuberCost(columns, column_begin[c], column_begin[c + 1], v, m1, m3, focal, 2.0);
+        EXPECT_EQ(finite, c != 2);
+        if (!finite) {
+          EXPECT_TRUE(std::isinf(got)) << "cluster " << c;
+        } else {
+          EXPECT_NEAR(got, want, 1e-11 * std::max(1.0, want)) << "cluster " << c;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 2 * 3 * 3 * 2 * 2);
+}
