@@ -44,11 +44,19 @@ constexpr int kSums = 27;
 // One event's distance d [px] and, with kGradients, dd/dv, dd/dm1, dd/dm3:
 // eventDistance (celc_residual.hpp) on the columns c (stride s) at index i.
 // ok is false where the transferred line has no image direction.
+struct Distance {
+  double d;
+  bool ok;
+  double gv[3], g1[3], g3[3];  // with kGradients
+};
 template <bool kGradients>
-CELC_PASS_INLINE double distance(const double* c, size_t s, size_t i, const double* v, const double* m1,
-                                 const double* m3, double focal, bool& ok, double* gv, double* g1,
-                                 double* g3) {
-  const auto at = [&](int j) { return c[static_cast<size_t>(j) * s + i]; };
+CELC_PASS_INLINE Distance distance(const double* c, size_t s, size_t i, const double* v, const double* m1,
+                                   const double* m3, double focal) {
+  // By value: a lambda holding references to the loop's index would make
+  // the compiler keep it in memory per lane.
+  const double* e = c + i;
+  const auto at = [e, s](int j) { return e[static_cast<size_t>(j) * s]; };
+  Distance out;
   double u[3], sv3[3];  // u = De^T m3, s = Ds^T m1
   #pragma GCC unroll 4
   for (int j = 0; j < 3; ++j) {
@@ -63,10 +71,10 @@ CELC_PASS_INLINE double distance(const double* c, size_t s, size_t i, const doub
   const double ga = at(3) * l[0] + at(4) * l[1] + at(5) * l[2];
   const double gb = at(6) * l[0] + at(7) * l[1] + at(8) * l[2];
   const double gn_raw = std::sqrt(ga * ga + gb * gb);
-  ok = gn_raw > 1e-300;
-  const double gn = ok ? gn_raw : 1.0;
+  out.ok = gn_raw > 1e-300;
+  const double gn = out.ok ? gn_raw : 1.0;
   const double num = at(0) * l[0] + at(1) * l[1] + at(2) * l[2];
-  const double d = focal * num / gn;
+  out.d = focal * num / gn;
   if (kGradients) {
     // Written out per component: loops here were left in place (not
     // unrolled) and kept the pass from vectorising.
@@ -83,11 +91,12 @@ CELC_PASS_INLINE double distance(const double* c, size_t s, size_t i, const doub
     const double dev0 = at(9) * v[0] + at(10) * v[1] + at(11) * v[2];
     const double dev1 = at(12) * v[0] + at(13) * v[1] + at(14) * v[2];
     const double dev2 = at(15) * v[0] + at(16) * v[1] + at(17) * v[2];
-    gv[0] = u[0] * m1dl - sv3[0] * m3dl, gv[1] = u[1] * m1dl - sv3[1] * m3dl, gv[2] = u[2] * m1dl - sv3[2] * m3dl;
-    g1[0] = uv * dl0 - dsv0 * m3dl, g1[1] = uv * dl1 - dsv1 * m3dl, g1[2] = uv * dl2 - dsv2 * m3dl;
-    g3[0] = dev0 * m1dl - sv * dl0, g3[1] = dev1 * m1dl - sv * dl1, g3[2] = dev2 * m1dl - sv * dl2;
+    out.gv[0] = u[0] * m1dl - sv3[0] * m3dl, out.gv[1] = u[1] * m1dl - sv3[1] * m3dl;
+    out.gv[2] = u[2] * m1dl - sv3[2] * m3dl;
+    out.g1[0] = uv * dl0 - dsv0 * m3dl, out.g1[1] = uv * dl1 - dsv1 * m3dl, out.g1[2] = uv * dl2 - dsv2 * m3dl;
+    out.g3[0] = dev0 * m1dl - sv * dl0, out.g3[1] = dev1 * m1dl - sv * dl1, out.g3[2] = dev2 * m1dl - sv * dl2;
   }
-  return d;
+  return out;
 }
 
 // The sums of jointBlockSums (in its order: V, bv, U, W, bc) over the
@@ -106,9 +115,12 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
 #pragma omp simd reduction(+ : s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14, s15, s16, s17, s18, s19, s20, s21, s22, s23, s24, s25, s26)
   for (size_t k = 0; k < count; ++k) {
     const size_t i = begin + k;
-    bool ok;
-    double gv[3], g1[3], g3[3];
-    const double d = distance<true>(c, s, i, v, m1, m3, focal, ok, gv, g1, g3);
+    const Distance e = distance<true>(c, s, i, v, m1, m3, focal);
+    const double d = e.d;
+    const double* gv = e.gv;
+    const double* g1 = e.g1;
+    const double* g3 = e.g3;
+    const bool ok = e.ok;
     double r, slope;
     if (kLoss == JointLossKind::Huber) {
       // sqrtHuber: r = d inside the threshold, sign(d) sqrt(2 delta |d| - delta^2) beyond.
@@ -170,8 +182,9 @@ CELC_ISA_CLONES void huberCost(const double* c, size_t s, size_t begin, size_t c
 #pragma omp simd reduction(+ : total, bad)
   for (size_t k = 0; k < count; ++k) {
     const size_t i = begin + k;
-    bool ok;
-    const double d = distance<false>(c, s, i, v, m1, m3, focal, ok, nullptr, nullptr, nullptr);
+    const Distance e = distance<false>(c, s, i, v, m1, m3, focal);
+    const double d = e.d;
+    const bool ok = e.ok;
     const double a = std::abs(d);
     const double rho = a <= delta ? d * d : 2.0 * delta * a - delta * delta;
     const bool good = ok & std::isfinite(d);
