@@ -21,25 +21,27 @@ void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector
     strided_begin.push_back(keep.size());
   }
   n_ = keep.size();
-  data_.resize(static_cast<size_t>(kColumns) * n_);
+  const size_t s = stride();
+  data_.assign(static_cast<size_t>(kColumns) * s, 0.0);
   for (size_t row = 0; row < n_; ++row) {
     const EventTerm& e = terms[keep[row]];
     double* c = data_.data() + row;
     for (int j = 0; j < 3; ++j) {
-      c[static_cast<size_t>(j) * n_] = e.fp(j);
-      c[static_cast<size_t>(3 + j) * n_] = e.Rt01(0, j);
-      c[static_cast<size_t>(6 + j) * n_] = e.Rt01(1, j);
+      c[static_cast<size_t>(j) * s] = e.fp(j);
+      c[static_cast<size_t>(3 + j) * s] = e.Rt01(0, j);
+      c[static_cast<size_t>(6 + j) * s] = e.Rt01(1, j);
     }
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
-        c[static_cast<size_t>(9 + 3 * i + j) * n_] = e.De(i, j);
-        c[static_cast<size_t>(18 + 3 * i + j) * n_] = e.Ds(i, j);
+        c[static_cast<size_t>(9 + 3 * i + j) * s] = e.De(i, j);
+        c[static_cast<size_t>(18 + 3 * i + j) * s] = e.Ds(i, j);
       }
   }
 }
 
 namespace {
 constexpr int kSums = 27;
+constexpr size_t kLanes = 8;
 
 // One event's distance d [px] and, with kGradients, dd/dv, dd/dm1, dd/dm3:
 // eventDistance (celc_residual.hpp) on the columns c (stride s) at index i.
@@ -111,55 +113,60 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
   // from the pointers (they might trap), which would keep the loop scalar.
   double vb[6], b1[6], b3[6];
   std::copy(Bv, Bv + 6, vb), std::copy(B1, B1 + 6, b1), std::copy(B3, B3 + 6, b3);
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0, s5 = 0.0, s6 = 0.0, s7 = 0.0, s8 = 0.0, s9 = 0.0, s10 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0, s14 = 0.0, s15 = 0.0, s16 = 0.0, s17 = 0.0, s18 = 0.0, s19 = 0.0, s20 = 0.0, s21 = 0.0, s22 = 0.0, s23 = 0.0, s24 = 0.0, s25 = 0.0, s26 = 0.0;
-#pragma omp simd reduction(+ : s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14, s15, s16, s17, s18, s19, s20, s21, s22, s23, s24, s25, s26)
-  for (size_t k = 0; k < count; ++k) {
-    const size_t i = begin + k;
-    const Distance e = distance<true>(c, s, i, v, m1, m3, focal);
-    const double d = e.d;
-    const double* gv = e.gv;
-    const double* g1 = e.g1;
-    const double* g3 = e.g3;
-    const bool ok = e.ok;
-    double r, slope;
-    if (kLoss == JointLossKind::Huber) {
-      // sqrtHuber: r = d inside the threshold, sign(d) sqrt(2 delta |d| - delta^2) beyond.
-      const double a = std::abs(d);
-      const bool inside = a <= scale;
-      const double root = std::sqrt(inside ? 1.0 : 2.0 * scale * a - scale * scale);
-      slope = inside ? 1.0 : scale / root;
-      r = inside ? d : (d < 0.0 ? -root : root);
-    } else {
-      const double q = d / scale;
-      slope = 1.0 / std::sqrt(1.0 + q * q);
-      r = slope * d;
+  // Blocks of kLanes events, lane l adding to its own sums (as the IRLS
+  // passes do); the last block reads into the next cluster's events or the
+  // columns' padding, masked.
+  double acc[27][kLanes] = {};
+  for (size_t b = 0; b < count; b += kLanes) {
+#pragma omp simd
+    for (size_t l = 0; l < kLanes; ++l) {
+      const size_t i = begin + b + l;
+      const bool in = b + l < count;
+      const Distance e = distance<true>(c, s, i, v, m1, m3, focal);
+      const double d = e.d;
+      const bool ok = e.ok;
+      double r, slope;
+      if (kLoss == JointLossKind::Huber) {
+        // sqrtHuber: r = d inside the threshold, sign(d) sqrt(2 delta |d| - delta^2) beyond.
+        const double a = std::abs(d);
+        const bool inside = a <= scale;
+        const double root = std::sqrt(inside ? 1.0 : 2.0 * scale * a - scale * scale);
+        slope = inside ? 1.0 : scale / root;
+        r = inside ? d : (d < 0.0 ? -root : root);
+      } else {
+        const double q = d / scale;
+        slope = 1.0 / std::sqrt(1.0 + q * q);
+        r = slope * d;
+      }
+      const bool use = in & ok & std::isfinite(d);
+      const double w = use ? slope : 0.0, rr = use ? r : 0.0;
+      double jv[2], jc[4];
+      #pragma GCC unroll 4
+      for (int a = 0; a < 2; ++a) {
+        jv[a] = w * (vb[3 * a] * e.gv[0] + vb[3 * a + 1] * e.gv[1] + vb[3 * a + 2] * e.gv[2]);
+        jc[a] = w * (b1[3 * a] * e.g1[0] + b1[3 * a + 1] * e.g1[1] + b1[3 * a + 2] * e.g1[2]);
+        jc[2 + a] = w * (b3[3 * a] * e.g3[0] + b3[3 * a + 1] * e.g3[1] + b3[3 * a + 2] * e.g3[2]);
+      }
+      // A non-finite gradient of a used event would poison the sums, as it
+      // did the former per-event loop's; unused events add exact zeros.
+      #pragma GCC unroll 4
+      for (int a = 0; a < 2; ++a) jv[a] = use ? jv[a] : 0.0;
+      #pragma GCC unroll 4
+      for (int a = 0; a < 4; ++a) jc[a] = use ? jc[a] : 0.0;
+      acc[0][l] += jv[0] * jv[0], acc[1][l] += jv[0] * jv[1], acc[2][l] += jv[1] * jv[1];
+      acc[3][l] += jv[0] * rr, acc[4][l] += jv[1] * rr, acc[5][l] += jc[0] * jc[0];
+      acc[6][l] += jc[0] * jc[1], acc[7][l] += jc[0] * jc[2], acc[8][l] += jc[0] * jc[3];
+      acc[9][l] += jc[1] * jc[1], acc[10][l] += jc[1] * jc[2], acc[11][l] += jc[1] * jc[3];
+      acc[12][l] += jc[2] * jc[2], acc[13][l] += jc[2] * jc[3], acc[14][l] += jc[3] * jc[3];
+      acc[15][l] += jv[0] * jc[0], acc[16][l] += jv[0] * jc[1], acc[17][l] += jv[0] * jc[2];
+      acc[18][l] += jv[0] * jc[3], acc[19][l] += jv[1] * jc[0], acc[20][l] += jv[1] * jc[1];
+      acc[21][l] += jv[1] * jc[2], acc[22][l] += jv[1] * jc[3], acc[23][l] += jc[0] * rr;
+      acc[24][l] += jc[1] * rr, acc[25][l] += jc[2] * rr, acc[26][l] += jc[3] * rr;
     }
-    const bool use = ok & std::isfinite(d);
-    const double w = use ? slope : 0.0, rr = use ? r : 0.0;
-    double jv[2], jc[4];
-    #pragma GCC unroll 4
-    for (int a = 0; a < 2; ++a) {
-      jv[a] = w * (vb[3 * a] * gv[0] + vb[3 * a + 1] * gv[1] + vb[3 * a + 2] * gv[2]);
-      jc[a] = w * (b1[3 * a] * g1[0] + b1[3 * a + 1] * g1[1] + b1[3 * a + 2] * g1[2]);
-      jc[2 + a] = w * (b3[3 * a] * g3[0] + b3[3 * a + 1] * g3[1] + b3[3 * a + 2] * g3[2]);
-    }
-    // A non-finite gradient of a used event would poison the sums, as it
-    // did the former per-event loop's; unused events add exact zeros.
-    #pragma GCC unroll 4
-    for (int a = 0; a < 2; ++a) jv[a] = use ? jv[a] : 0.0;
-    #pragma GCC unroll 4
-    for (int a = 0; a < 4; ++a) jc[a] = use ? jc[a] : 0.0;
-    s0 += jv[0] * jv[0], s1 += jv[0] * jv[1], s2 += jv[1] * jv[1];
-    s3 += jv[0] * rr, s4 += jv[1] * rr, s5 += jc[0] * jc[0];
-    s6 += jc[0] * jc[1], s7 += jc[0] * jc[2], s8 += jc[0] * jc[3];
-    s9 += jc[1] * jc[1], s10 += jc[1] * jc[2], s11 += jc[1] * jc[3];
-    s12 += jc[2] * jc[2], s13 += jc[2] * jc[3], s14 += jc[3] * jc[3];
-    s15 += jv[0] * jc[0], s16 += jv[0] * jc[1], s17 += jv[0] * jc[2];
-    s18 += jv[0] * jc[3], s19 += jv[1] * jc[0], s20 += jv[1] * jc[1];
-    s21 += jv[1] * jc[2], s22 += jv[1] * jc[3], s23 += jc[0] * rr;
-    s24 += jc[1] * rr, s25 += jc[2] * rr, s26 += jc[3] * rr;
   }
-  const double sums[27] = {s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14, s15, s16, s17, s18, s19, s20, s21, s22, s23, s24, s25, s26};
+  double sums[27] = {};
+  for (int k = 0; k < 27; ++k)
+    for (size_t l = 0; l < kLanes; ++l) sums[k] += acc[k][l];
   std::copy(sums, sums + 27, out);
 }
 

@@ -11,7 +11,8 @@
 namespace celc::detail {
 
 /// Event terms (EventTerm) as 27 columns: fp, the two rows of R_k^T, then De
-/// and Ds row by row; column j holds entry j of every event.
+/// and Ds row by row; column j holds entry j of every event, then kPadding
+/// zeros.
 class JointColumns {
  public:
   static constexpr int kColumns = 27;
@@ -19,9 +20,12 @@ class JointColumns {
   /// strided_begin gets the clusters' ranges in the columns.
   void assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
               std::vector<size_t>& strided_begin);
+  /// Zero rows after the events, so that a pass may read a whole block of
+  /// lanes past the last one.
+  static constexpr size_t kPadding = 8;
   size_t size() const { return n_; }
   const double* data() const { return data_.data(); }
-  size_t stride() const { return n_; }  ///< between columns [doubles]
+  size_t stride() const { return n_ + kPadding; }  ///< between columns [doubles]
   /// Exchanges the column storage with `buffer` (to keep its memory across
   /// problems).
   void swapStorage(std::vector<double>& buffer) { data_.swap(buffer); }
