@@ -76,7 +76,18 @@ double LineProfile::operator()(const Vec3& v) const {
   for (const Sums& s : sums_) {
     Mat3 H, B;
     forms(s, v, H, B);
-    const Mat3 Q = s.S - B * Eigen::LLT<Mat3>(H).solve(B.transpose());  // S - B H^-1 B^T
+    // S - B H^-1 B^T = S - X^T X with H = L L^T and X = L^-1 B^T (H is
+    // positive definite: the ridge in forms()).
+    const double l00 = std::sqrt(H(0, 0)), l10 = H(1, 0) / l00, l20 = H(2, 0) / l00;
+    const double l11 = std::sqrt(H(1, 1) - l10 * l10), l21 = (H(2, 1) - l20 * l10) / l11;
+    const double l22 = std::sqrt(H(2, 2) - l20 * l20 - l21 * l21);
+    Mat3 X;  // row r of X = L^-1 B^T, by forward substitution
+    for (int j = 0; j < 3; ++j) {
+      X(0, j) = B(j, 0) / l00;
+      X(1, j) = (B(j, 1) - l10 * X(0, j)) / l11;
+      X(2, j) = (B(j, 2) - l20 * X(0, j) - l21 * X(1, j)) / l22;
+    }
+    const Mat3 Q = s.S - X.transpose() * X;
     eig.computeDirect(0.5 * (Q + Q.transpose()), Eigen::EigenvaluesOnly);
     total += std::max(0.0, eig.eigenvalues()(0));
   }
