@@ -20,6 +20,20 @@ LineSceneTrial scene(int events_per_line) {
   return generateLineScene(o, rng);
 }
 
+// 16 trials of the peers' scene (V = 2 m/s, 1 px) with 5 lines of
+// events_per_line events: the time of a solve depends on the trial.
+std::vector<PeerSceneTrial> peerTrials(int events_per_line) {
+  PeerSceneOptions o;
+  o.events_per_line = events_per_line;
+  std::vector<PeerSceneTrial> trials;
+  std::mt19937_64 rng(42);
+  while (trials.size() < 16) {
+    auto tr = generatePeerScene(o, rng);
+    if (tr.ok) trials.push_back(std::move(tr));
+  }
+  return trials;
+}
+
 std::vector<detail::ConstraintRow> rowsOf(const LineSceneTrial& tr) {
   std::vector<detail::ConstraintRow> rows;
   for (const auto& c : tr.observations.clusters) {
@@ -116,14 +130,7 @@ BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 // count, and so the time, depends on the trial): the mean time per solve, and
 // the mean iteration count.
 static void BM_CelcLinearPeers16(benchmark::State& state) {
-  PeerSceneOptions o;
-  o.events_per_line = static_cast<int>(state.range(0));
-  std::vector<PeerSceneTrial> trials;
-  std::mt19937_64 rng(42);
-  while (trials.size() < 16) {
-    auto tr = generatePeerScene(o, rng);
-    if (tr.ok) trials.push_back(std::move(tr));
-  }
+  const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
   const LinearOptions opt;
   size_t i = 0;
   double iterations = 0.0;
@@ -144,14 +151,7 @@ BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond
 // depends on the trial); arg = events per line, 5 lines. Target (issue 14):
 // median <= 1 ms at 200 events per line, <= 0.3 ms at 20.
 static void BM_CelcMlPeers(benchmark::State& state) {
-  PeerSceneOptions o;
-  o.events_per_line = static_cast<int>(state.range(0));
-  std::vector<PeerSceneTrial> trials;
-  std::mt19937_64 rng(42);
-  while (trials.size() < 16) {
-    auto tr = generatePeerScene(o, rng);
-    if (tr.ok) trials.push_back(std::move(tr));
-  }
+  const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
   SolverOptions opt;
   opt.check_parallax = false;  // as the peer study runs it
   size_t i = 0;

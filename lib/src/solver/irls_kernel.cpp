@@ -99,6 +99,20 @@ CELC_ISA_CLONES void squaredResiduals3(const double* c, size_t m, size_t s, cons
   squaredResiduals<3>(c, m, s, v, r2_degenerate, r2);
 }
 
+// Row i of the columns from an event's terms (EventLineTerms: g1, g3, u,
+// s) and bearing f: a = (g1.f) u - (g3.f) s and N's rows g1_r u - g3_r s,
+// at c (the row's entry in column 0; stride s).
+CELC_PASS_INLINE void writeRow(const double (&g1)[3], const double (&g3)[3], const double (&u)[3],
+                               const double (&sv)[3], double fx, double fy, double fz, double* c, size_t s) {
+  const double al = g1[0] * fx + g1[1] * fy + g1[2] * fz;
+  const double be = g3[0] * fx + g3[1] * fy + g3[2] * fz;
+  for (int j = 0; j < 3; ++j) {
+    c[static_cast<size_t>(j) * s] = al * u[j] - be * sv[j];
+    c[static_cast<size_t>(3 + j) * s] = g1[0] * u[j] - g3[0] * sv[j];
+    c[static_cast<size_t>(6 + j) * s] = g1[1] * u[j] - g3[1] * sv[j];
+  }
+}
+
 // The CELC rows of m events under a constant twist (constants q: t_ref, w2,
 // then m1 m3 u0 s0 wm1 wm3 wwm1 wwm3, 3 each), into columns c (stride s) from
 // row 0: ClusterRowTerms::at and ::row, one event per lane.
@@ -120,13 +134,7 @@ CELC_ISA_CLONES void twistRows(const double* q, const double* t, const double* f
       u[j] = u0[j] - (tau * m3[j] - rb * wm3[j] + pc * wwm3[j]);
       sv[j] = s0[j] - (tau * m1[j] - rb * wm1[j] + pc * wwm1[j]);
     }
-    const double al = g1[0] * fx[i] + g1[1] * fy[i] + g1[2] * fz[i];
-    const double be = g3[0] * fx[i] + g3[1] * fy[i] + g3[2] * fz[i];
-    for (int j = 0; j < 3; ++j) {
-      c[static_cast<size_t>(j) * s + i] = al * u[j] - be * sv[j];
-      c[static_cast<size_t>(3 + j) * s + i] = g1[0] * u[j] - g3[0] * sv[j];
-      c[static_cast<size_t>(6 + j) * s + i] = g1[1] * u[j] - g3[1] * sv[j];
-    }
+    writeRow(g1, g3, u, sv, fx[i], fy[i], fz[i], c + i, s);
   }
 }
 
@@ -160,13 +168,7 @@ CELC_PASS_INLINE void gyroRows(const double* q, const double* t, const double* f
       u[j] = U[j] - dt * p3;
       sv[j] = S[j] - dt * p1;
     }
-    const double al = g1[0] * fx[i] + g1[1] * fy[i] + g1[2] * fz[i];
-    const double be = g3[0] * fx[i] + g3[1] * fy[i] + g3[2] * fz[i];
-    for (int j = 0; j < 3; ++j) {
-      c[static_cast<size_t>(j) * s + i] = al * u[j] - be * sv[j];
-      c[static_cast<size_t>(3 + j) * s + i] = g1[0] * u[j] - g3[0] * sv[j];
-      c[static_cast<size_t>(6 + j) * s + i] = g1[1] * u[j] - g3[1] * sv[j];
-    }
+    writeRow(g1, g3, u, sv, fx[i], fy[i], fz[i], c + i, s);
   }
 }
 CELC_ISA_CLONES void gyroRowsBody(const double* q, const double* t, const double* fx, const double* fy,
