@@ -54,9 +54,7 @@ struct Distance {
 template <bool kGradients>
 CELC_PASS_INLINE Distance distance(const double* c, size_t s, size_t i, const double* v, const double* m1,
                                    const double* m3, double focal) {
-  // By value: a lambda holding references to the loop's index would make
-  // the compiler keep it in memory per lane.
-  const double* e = c + i;
+  const double* e = c + i;  // captured by value (above)
   const auto at = [e, s](int j) { return e[static_cast<size_t>(j) * s]; };
   Distance out;
   double u[3], sv3[3];  // u = De^T m3, s = Ds^T m1
@@ -78,8 +76,8 @@ CELC_PASS_INLINE Distance distance(const double* c, size_t s, size_t i, const do
   const double num = at(0) * l[0] + at(1) * l[1] + at(2) * l[2];
   out.d = focal * num / gn;
   if (kGradients) {
-    // Written out per component: loops here were left in place (not
-    // unrolled) and kept the pass from vectorising.
+    // dl = dd/dl = focal (fp / |g| - num (R01^T g) / |g|^3), then the chain
+    // rule through l = m1 (u.v) - m3 (s.v).
     const double k3 = num / (gn * gn * gn);
     const double dl0 = focal * (at(0) / gn - k3 * (at(3) * ga + at(6) * gb));
     const double dl1 = focal * (at(1) / gn - k3 * (at(4) * ga + at(7) * gb));
@@ -102,8 +100,11 @@ CELC_PASS_INLINE Distance distance(const double* c, size_t s, size_t i, const do
 }
 
 // The sums of jointBlockSums (in its order: V, bv, U, W, bc) over the
-// events begin .. begin + count - 1, one flat loop the compiler vectorises
-// with one accumulator per sum and lane.
+// events begin .. begin + count - 1, in blocks of kLanes events whose lanes
+// the compiler forms together, each lane with its own accumulators. Values
+// stay in locals returned by value: through pointers (output arguments, a
+// struct's arrays, a lambda holding the index by reference) the compiler
+// kept them in memory per lane and the loop ran scalar.
 template <JointLossKind kLoss>
 CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t count,
                                 const double* v, const double* m1, const double* m3, const double* Bv,
@@ -113,10 +114,9 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
   // from the pointers (they might trap), which would keep the loop scalar.
   double vb[6], b1[6], b3[6];
   std::copy(Bv, Bv + 6, vb), std::copy(B1, B1 + 6, b1), std::copy(B3, B3 + 6, b3);
-  // Blocks of kLanes events, lane l adding to its own sums (as the IRLS
-  // passes do); the last block reads into the next cluster's events or the
-  // columns' padding, masked.
-  double acc[27][kLanes] = {};
+  // The last block reads into the next cluster's events or the columns'
+  // padding, masked out.
+  double acc[kSums][kLanes] = {};
   for (size_t b = 0; b < count; b += kLanes) {
 #pragma omp simd
     for (size_t l = 0; l < kLanes; ++l) {
@@ -164,10 +164,10 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
       acc[24][l] += jc[1] * rr, acc[25][l] += jc[2] * rr, acc[26][l] += jc[3] * rr;
     }
   }
-  double sums[27] = {};
-  for (int k = 0; k < 27; ++k)
+  double sums[kSums] = {};
+  for (int k = 0; k < kSums; ++k)
     for (size_t l = 0; l < kLanes; ++l) sums[k] += acc[k][l];
-  std::copy(sums, sums + 27, out);
+  std::copy(sums, sums + kSums, out);
 }
 
 CELC_ISA_CLONES void blockSumsHuber(const double* c, size_t s, size_t begin, size_t count, const double* v,
