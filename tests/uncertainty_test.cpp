@@ -231,6 +231,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   const auto s = summarize(old_rows, 5.0);
   EXPECT_EQ(s[0].ok, 1);
   EXPECT_EQ(s[0].kept, 0);
+  fs::remove_all(d);
 }
 
 // The first still second: found after a moving start, its mean is the bias.
@@ -271,6 +272,7 @@ TEST(Uncertainty, GyroBiasIsSubtractedInThePipeline) {
     EXPECT_NEAR((a.omega - b.omega - Vec3(0.01, -0.02, 0.03)).norm(), 0.0, 2e-6);
     EXPECT_GE(a.n_lines, 0);
   }
+  fs::remove_all(d);
 }
 
 // motion.gyro_bias_from_still: the sample shifted by 1.5 s behind an IMU
