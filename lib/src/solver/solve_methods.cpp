@@ -84,7 +84,12 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       }
       case Method::CelcOpt: {
         const SolverResult& init = getLinear();
-        if (!init.ok()) {
+        // An ambiguous nullspace (two near-equal singular values) still
+        // points into the cost's valley: the refinement starts from it and
+        // the sign is resolved at its end point. Its sigma_deg says how well
+        // the geometric cost fixes the direction there.
+        const bool ambiguous = init.degeneracy == Degeneracy::NullspaceNotUnique && init.v.norm() > 0.5;
+        if (!init.ok() && !ambiguous) {
           out.push_back(init);
           break;
         }
@@ -94,6 +99,13 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         r.sigma_min = init.sigma_min;
         r.sigma_second = init.sigma_second;
         r.sign_margin = init.sign_margin;
+        if (ambiguous && r.ok() && options.linear.resolve_sign) {
+          const auto t0 = detail::Clock::now();
+          const SignDecision s = detail::resolveSign(obs, motion, r.v, frames);
+          r.v *= s.sign;
+          r.sign_margin = s.margin * s.sign;
+          r.time_us += detail::microsecondsSince(t0);
+        }
         out.push_back(r);
         break;
       }

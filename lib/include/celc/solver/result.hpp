@@ -23,7 +23,7 @@ struct SolverResult {
   /// Unit linear velocity direction, reference camera frame. Not an estimate
   /// unless ok(): a linear method whose nullspace is not unique
   /// (Degeneracy::NullspaceNotUnique) leaves its ambiguous direction here, sign
-  /// unresolved, which celc_ml still tries as a start.
+  /// unresolved, which celc_opt and celc_ml still start from.
   Vec3 v = Vec3::Zero();
   double sigma_min = 0.0;         ///< smallest singular value of the final weighted system
   double sigma_second = 0.0;      ///< second smallest

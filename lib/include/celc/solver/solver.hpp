@@ -53,7 +53,9 @@ struct SampleSeeds {
 };
 
 /// Runs the requested methods on one window; celc_opt and celc_ml start from
-/// the celc result (computed once), the window checks run once, and the
+/// the celc result (computed once; also when its nullspace is ambiguous,
+/// Degeneracy::NullspaceNotUnique: celc_opt then resolves the sign at its end
+/// point), the window checks run once, and the
 /// clusters' frames are computed once and shared by every method and sign test.
 /// npt's sign is resolved with resolveSign when options.linear.resolve_sign.
 /// Results are in the order of `methods`.

@@ -1,0 +1,113 @@
+// How often `celc solve` answers with its defaults (issue 14 part 3): the
+// peer scene's trials (sim/peer_scene.hpp) taken through the path that
+// `celc solve` takes for labelled events - normalised pixels and cluster
+// labels -> clustersFromLabels -> toObservations -> solveMethods, every option
+// at its `celc run` default, the given rate as a constant twist from the first
+// event - and the share of trials each method answers (status ok) per cell.
+//   build/celc_solve_path_study [--trials N] [--seed S]
+// Prints a markdown table (docs/peers.md); about 5 s for 100 trials per cell.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "celc/cluster/to_observations.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/sim/peer_scene.hpp"
+#include "celc/solver/solver.hpp"
+
+using namespace celc;
+
+namespace {
+
+struct Cell {
+  double speed_m_s, sigma_px;
+  int events_per_line;
+};
+
+/// The trial's events as `celc solve` reads them, solved as it solves them.
+std::vector<SolverResult> solveLikeCelcSolve(const PeerSceneTrial& tr, const RunConfig& defaults) {
+  std::vector<Event> events;
+  std::vector<int> labels;
+  double t_min = 1e300;
+  for (size_t c = 0; c < tr.observations.clusters.size(); ++c) {
+    const ClusterObservation& cl = tr.observations.clusters[c];
+    for (size_t k = 0; k < cl.size(); ++k) {
+      Event e;
+      e.t = cl.times[k];
+      e.x = static_cast<float>(cl.bearings[k].x() / cl.bearings[k].z());
+      e.y = static_cast<float>(cl.bearings[k].y() / cl.bearings[k].z());
+      events.push_back(e);
+      labels.push_back(static_cast<int>(c));
+      t_min = std::min(t_min, e.t);
+    }
+  }
+  const double t_ref = tr.given_motion.referenceTime();
+  const MotionModel motion = MotionModel::constantTwist(tr.given_motion.meanOmega(t_ref, t_ref + 1.0), t_min);
+  const WindowObservations obs =
+      toObservations(events, clustersFromLabels(events, labels),
+                     [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 320.0, defaults.observations, &motion);
+  return solveMethods(obs, motion, defaults.methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
+}
+
+int parsePositive(const char* flag, const char* text) {
+  char* end = nullptr;
+  const long v = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || v <= 0 || v > 1000000) {
+    std::fprintf(stderr, "celc_solve_path_study: error: %s '%s': expected a whole number in [1, 1000000]\n", flag,
+                 text);
+    std::exit(1);
+  }
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int trials = 100, seed = 4242;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if ((a == "--trials" || a == "--seed") && i + 1 < argc) {
+      (a == "--trials" ? trials : seed) = parsePositive(argv[i], argv[i + 1]);
+      ++i;
+    } else {
+      std::fprintf(stderr, "usage: celc_solve_path_study [--trials N] [--seed S]\n");
+      return a == "--help" || a == "-h" ? 0 : 1;
+    }
+  }
+  const RunConfig defaults;
+  const std::vector<Cell> cells{{1, 0.5, 200}, {1, 1, 200}, {1, 2, 200}, {2, 0.5, 200}, {2, 1, 200},
+                                {2, 2, 200},   {5, 0.5, 200}, {5, 1, 200}, {5, 2, 200},   {2, 0.5, 20},
+                                {2, 1, 20},    {1, 0.5, 20}};
+  std::printf("| V [m/s], sigma [px], events per line | trials |");
+  for (Method m : defaults.methods) std::printf(" %s |", toString(m).c_str());
+  std::printf(" celc nullspace_not_unique |\n|---|---|");
+  for (size_t i = 0; i <= defaults.methods.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  for (const Cell& cell : cells) {
+    PeerSceneOptions o;
+    o.speed = cell.speed_m_s;
+    o.event_noise_px = cell.sigma_px;
+    o.events_per_line = cell.events_per_line;
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    std::vector<int> ok(defaults.methods.size(), 0);
+    int generated = 0, ambiguous = 0;
+    for (int t = 0; t < trials; ++t) {
+      const PeerSceneTrial tr = generatePeerScene(o, rng);
+      if (!tr.ok) continue;
+      ++generated;
+      const std::vector<SolverResult> res = solveLikeCelcSolve(tr, defaults);
+      for (size_t m = 0; m < res.size(); ++m) {
+        ok[m] += res[m].ok();
+        ambiguous += defaults.methods[m] == Method::Celc && res[m].degeneracy == Degeneracy::NullspaceNotUnique;
+      }
+    }
+    std::printf("| %g, %g, %d | %d |", cell.speed_m_s, cell.sigma_px, cell.events_per_line, generated);
+    for (int n : ok) std::printf(" %.2f |", generated > 0 ? static_cast<double>(n) / generated : 0.0);
+    std::printf(" %d |\n", ambiguous);
+    std::fflush(stdout);
+  }
+  return 0;
+}
