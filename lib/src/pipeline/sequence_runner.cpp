@@ -201,7 +201,7 @@ std::vector<std::string> SequenceRunner::describe() const {
 }
 
 WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, double t1,
-                                           const std::vector<Event>& events, double translation_px) const {
+                                           const std::vector<Event>& events, std::optional<double> probe_px) const {
   const Impl& m = *impl_;
   const RunConfig& cfg = m.config;
   WindowRecord rec;
@@ -264,14 +264,18 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   rec.times.lines = secondsSince(start);
   rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
 
-  // The parallax policy grew the window to windows.max_seconds and its lines
-  // still show too little translation: no method is asked for a direction.
-  if (std::isfinite(translation_px) && translation_px < cfg.parallax.no_parallax_px) {
+  // The parallax policy grew the window as far as it could (to
+  // windows.max_seconds, or to the end of the data) and its lines still show
+  // too little translation: no method is asked for a direction. D is the
+  // probe's that chose the length, or the whole window's where the probe
+  // could not measure it.
+  const double shown_px = probe_px && std::isfinite(*probe_px) ? *probe_px : rec.translation_px;
+  if (probe_px && std::isfinite(shown_px) && shown_px < cfg.parallax.no_parallax_px) {
     for (MethodRow& row : rec.rows) {
       row.result.status = SolveStatus::Degenerate;
       row.result.degeneracy = Degeneracy::NoParallax;
       row.result.message = fmt::format("the lines moved {:.1f} px in {:.3f} s, less than windows.no_parallax_px = {:g}",
-                                       translation_px, t1 - t0, cfg.parallax.no_parallax_px);
+                                       shown_px, t1 - t0, cfg.parallax.no_parallax_px);
     }
     spdlog::debug("window {}: {}", index, rec.rows.front().result.message);
     return rec;
@@ -302,7 +306,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
     std::uint64_t index = 0;
     double t0 = 0.0, t1 = 0.0;
     std::vector<Event> events;
-    double translation_px = NAN;  ///< the parallax policy's D (NaN: other policies)
+    std::optional<double> probe_px;  ///< the parallax policy's D (window_policy.hpp); nullopt: other policies
   };
   const RunConfig& cfg = m.config;
   const bool parallax = cfg.window_policy == WindowPolicy::Parallax;
@@ -368,12 +372,12 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
           job.t0 = window.t0;
           job.t1 = window.t1;
           job.events = std::move(window.events);
-          job.translation_px = parallax ? joiner.translationPx() : NAN;
+          job.probe_px = parallax ? std::optional<double>(joiner.translationPx()) : std::nullopt;
           window.events = {};
           return true;
         }
       },
-      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events, job.translation_px); },
+      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events, job.probe_px); },
       [&](WindowRecord& rec) {  // in window order, on this thread
         stats.windows_processed++;
         stats.events_processed += rec.n_events;

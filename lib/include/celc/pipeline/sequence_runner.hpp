@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -109,10 +110,14 @@ class SequenceRunner {
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
   /// Processes one window's events (the per-window pipeline; thread-safe).
-  /// translation_px: the parallax policy's D of the window (window_policy.hpp);
-  /// below windows.parallax_px every method is degenerate (no_parallax).
+  /// probe_px: with the parallax policy, the D that its probe measured when it
+  /// chose the window's length (window_policy.hpp; NaN when it could not, as
+  /// for the last window, cut by the end of the data); nullopt for the other
+  /// policies. With the parallax policy a window whose D (the probe's, else
+  /// the whole window's) is below windows.no_parallax_px is degenerate
+  /// (no_parallax) for every method.
   WindowRecord processWindow(std::uint64_t index, double t0, double t1, const std::vector<Event>& events,
-                             double translation_px = NAN) const;
+                             std::optional<double> probe_px = std::nullopt) const;
 
  private:
   struct Impl;
