@@ -17,6 +17,7 @@
 #include "celc/sim/line_scene.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "peer_solve_path.hpp"
 #include "solver/constraint_rows.hpp"
 #include "solver/joint_refine.hpp"
 #include "solver/ml_screen.hpp"
@@ -235,36 +236,6 @@ TEST(CelcMl, ProfileStartsEscapeWrongBasins) {
   EXPECT_LT(with[0].rms_agn_deg, 1.5 * with[0].crlb_rms_deg);
 }
 
-namespace {
-
-/// `celc solve`'s path for a peer-scene trial: its events as labelled
-/// normalised pixels -> clustersFromLabels -> toObservations with `celc run`'s
-/// defaults, the given rate as a constant twist from the first event.
-WindowObservations solvePathObservations(const PeerSceneTrial& tr, const RunConfig& defaults,
-                                         MotionModel& motion) {
-  std::vector<Event> events;
-  std::vector<int> labels;
-  double t_min = 1e300;
-  for (size_t c = 0; c < tr.observations.clusters.size(); ++c) {
-    const ClusterObservation& cl = tr.observations.clusters[c];
-    for (size_t k = 0; k < cl.size(); ++k) {
-      Event e;
-      e.t = cl.times[k];
-      e.x = static_cast<float>(cl.bearings[k].x() / cl.bearings[k].z());
-      e.y = static_cast<float>(cl.bearings[k].y() / cl.bearings[k].z());
-      events.push_back(e);
-      labels.push_back(static_cast<int>(c));
-      t_min = std::min(t_min, e.t);
-    }
-  }
-  const double t_ref = tr.given_motion.referenceTime();
-  motion = MotionModel::constantTwist(tr.given_motion.meanOmega(t_ref, t_ref + 1.0), t_min);
-  return toObservations(events, clustersFromLabels(events, labels),
-                        [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 320.0, defaults.observations,
-                        &motion);
-}
-
-}  // namespace
 
 // Issue 14 part 3: `celc solve`'s path on the peer scene at V = 1 m/s, 1 px:
 // in a few of 100 trials the linear stage finds its nullspace ambiguous (two
@@ -286,7 +257,7 @@ TEST(CelcMl, AnswersWhenTheLinearStageIsAmbiguous) {
     ASSERT_TRUE(tr.ok) << tr.message;
     ++trials;
     MotionModel motion = tr.given_motion;
-    const WindowObservations obs = solvePathObservations(tr, defaults, motion);
+    const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
     const auto res = solveMethods(obs, motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
     if (res[1].ok()) ++ml_ok;
     if (!res[0].ok()) {
@@ -329,7 +300,7 @@ TEST(CelcOpt, AnswersWhenTheLinearStageIsAmbiguous) {
     const PeerSceneTrial tr = generatePeerScene(o, rng);
     ASSERT_TRUE(tr.ok) << tr.message;
     MotionModel motion = tr.given_motion;
-    const WindowObservations obs = solvePathObservations(tr, defaults, motion);
+    const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
     const auto res = solveMethods(obs, motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
     opt_ok += res[opt].ok();
     if (res[celc].degeneracy != Degeneracy::NullspaceNotUnique) continue;

@@ -6,17 +6,16 @@
 // event - and the share of trials each method answers (status ok) per cell.
 //   build/celc_solve_path_study [--trials N] [--seed S]
 // Prints a markdown table (docs/peers.md); about 5 s for 100 trials per cell.
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "celc/cluster/to_observations.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "../peer_solve_path.hpp"
 
 using namespace celc;
 
@@ -27,28 +26,10 @@ struct Cell {
   int events_per_line;
 };
 
-/// The trial's events as `celc solve` reads them, solved as it solves them.
+/// The trial solved as `celc solve` solves it (peer_solve_path.hpp).
 std::vector<SolverResult> solveLikeCelcSolve(const PeerSceneTrial& tr, const RunConfig& defaults) {
-  std::vector<Event> events;
-  std::vector<int> labels;
-  double t_min = 1e300;
-  for (size_t c = 0; c < tr.observations.clusters.size(); ++c) {
-    const ClusterObservation& cl = tr.observations.clusters[c];
-    for (size_t k = 0; k < cl.size(); ++k) {
-      Event e;
-      e.t = cl.times[k];
-      e.x = static_cast<float>(cl.bearings[k].x() / cl.bearings[k].z());
-      e.y = static_cast<float>(cl.bearings[k].y() / cl.bearings[k].z());
-      events.push_back(e);
-      labels.push_back(static_cast<int>(c));
-      t_min = std::min(t_min, e.t);
-    }
-  }
-  const double t_ref = tr.given_motion.referenceTime();
-  const MotionModel motion = MotionModel::constantTwist(tr.given_motion.meanOmega(t_ref, t_ref + 1.0), t_min);
-  const WindowObservations obs =
-      toObservations(events, clustersFromLabels(events, labels),
-                     [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 320.0, defaults.observations, &motion);
+  MotionModel motion = tr.given_motion;
+  const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
   return solveMethods(obs, motion, defaults.methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
 }
 
