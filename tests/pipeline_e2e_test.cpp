@@ -31,6 +31,17 @@ std::string editedScene(const std::string& file, const std::vector<std::pair<std
   }
   return scene;
 }
+
+/// The edited scene written into d and rendered into d/seq by `celc synth`;
+/// returns the error, empty when it worked.
+std::string renderEditedScene(const fs::path& d, const std::string& file,
+                              const std::vector<std::pair<std::string, std::string>>& lines) {
+  const std::string scene = editedScene(file, lines);
+  if (scene.empty()) return file + ": a line to replace is missing";
+  std::ofstream((d / "scene.yaml").string()) << scene;
+  const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
+  return synth.status == 0 ? "" : synth.err;
+}
 }  // namespace
 
 // The stated setting (config/scenes/e2e_davis346_room_fast.yaml): a DAVIS346
@@ -115,11 +126,7 @@ TEST(EndToEnd, DenseRecordingGetsWindowsShorterThanTheMaximum) {
 // at 0.27-1.57 rad; docs/results.md).
 TEST(EndToEnd, ShortLastWindowWithoutParallaxIsNotSolved) {
   const fs::path d = test::freshTempDir("e2e_last_window");
-  const std::string scene = editedScene("sample_davis346_room.yaml", {{"duration:", "duration: 0.45"}});
-  ASSERT_FALSE(scene.empty());
-  std::ofstream((d / "scene.yaml").string()) << scene;
-  const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
-  ASSERT_EQ(synth.status, 0) << synth.err;
+  ASSERT_EQ(renderEditedScene(d, "sample_davis346_room.yaml", {{"duration:", "duration: 0.45"}}), "");
   const auto run = test::runCelc("run '" + (d / "seq").string() + "' --threads 2 -q -o '" + (d / "run").string() + "'", d);
   ASSERT_EQ(run.status, 0) << run.err;
   const auto rows = readWindowsCsv((d / "run" / "windows.csv").string(), false);
@@ -148,13 +155,9 @@ TEST(EndToEnd, ShortLastWindowWithoutParallaxIsNotSolved) {
 // sigma_deg below 10 deg (measured: every window degenerate, no_parallax).
 TEST(EndToEnd, RenderedPureRotationIsNeverConfident) {
   const fs::path d = test::freshTempDir("e2e_rotation");
-  const std::string scene = editedScene("sample_davis346_room.yaml", {{"duration:", "duration: 0.6"},
+  ASSERT_EQ(renderEditedScene(d, "sample_davis346_room.yaml", {{"duration:", "duration: 0.6"},
                                                                       {"  v: [", "  v: [0.0, 0.0, 0.0]"},
-                                                                      {"  w: [", "  w: [0.6, -1.2, 0.9]"}});
-  ASSERT_FALSE(scene.empty());
-  std::ofstream((d / "scene.yaml").string()) << scene;
-  const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
-  ASSERT_EQ(synth.status, 0) << synth.err;
+                                                                      {"  w: [", "  w: [0.6, -1.2, 0.9]"}}), "");
   int rows_seen = 0;
   for (const std::string windows : {"", "--window-seconds 0.2", "--window-events 80000"}) {
     const fs::path out = d / ("run" + std::to_string(rows_seen));
@@ -183,11 +186,7 @@ TEST(EndToEnd, RenderedPureRotationIsNeverConfident) {
 // speed, 98%.
 TEST(EndToEnd, RenderedChessboardClustersArePure) {
   const fs::path d = test::freshTempDir("e2e_chessboard");
-  const std::string scene = editedScene("davis346_chessboard.yaml", {{"duration:", "duration: 0.25"}});
-  ASSERT_FALSE(scene.empty());
-  std::ofstream((d / "scene.yaml").string()) << scene;
-  const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
-  ASSERT_EQ(synth.status, 0) << synth.err;
+  ASSERT_EQ(renderEditedScene(d, "davis346_chessboard.yaml", {{"duration:", "duration: 0.25"}}), "");
   std::ifstream ev((d / "seq" / "events.txt").string()), lab((d / "seq" / "labels.txt").string());
   std::vector<Event> events;
   std::vector<int> labels;
@@ -229,16 +228,12 @@ TEST(EndToEnd, RenderedChessboardClustersArePure) {
 // direction in the first window (celc_ml 3.13 rad, 0.008 rad from -v).
 TEST(EndToEnd, ClustersThatHardlyMovedDoNotDecideTheSign) {
   const fs::path d = test::freshTempDir("e2e_sign");
-  const std::string scene = editedScene("e2e_davis346_room_fast.yaml",
+  ASSERT_EQ(renderEditedScene(d, "e2e_davis346_room_fast.yaml",
                                         {{"seed:", "seed: 1009"},
                                          {"duration:", "duration: 0.31"},
                                          {"  v: [", "  v: [-0.28, 1.9, 1.53]"},
                                          {"  w: [", "  w: [-0.79, -0.37, 0.24]"},
-                                         {"  noise_rate:", "  noise_rate: 1.0"}});
-  ASSERT_FALSE(scene.empty());
-  std::ofstream((d / "scene.yaml").string()) << scene;
-  const auto synth = test::runCelc("synth '" + (d / "scene.yaml").string() + "' -o '" + (d / "seq").string() + "' -q", d);
-  ASSERT_EQ(synth.status, 0) << synth.err;
+                                         {"  noise_rate:", "  noise_rate: 1.0"}}), "");
   const auto run = test::runCelc("run '" + (d / "seq").string() +
                                      "' --window-seconds 0.15 --methods celc,celc_ml --threads 2 -q -o '" +
                                      (d / "run").string() + "'",
