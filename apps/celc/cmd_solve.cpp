@@ -137,7 +137,8 @@ void registerSolve(CLI::App& app) {
       "solve",
       "Solvers alone on labelled events (CSV header t,x,y,cluster; seconds, pixels; cluster -1 = "
       "unassigned). Builds each cluster's observation and lines as `celc run` does (its configuration: "
-      "-c / --set) and prints method,status,vx,vy,vz,runtime_us to stdout (v: unit direction, camera frame).");
+      "-c / --set) and prints method,status,vx,vy,vz,runtime_us to stdout (v: unit direction, in the camera frame at the "
+      "first clustered event, the motion's reference time).");
   cmd->add_option("events", a->events, "labelled events CSV")->required()->check(CLI::ExistingFile);
   cmd->add_option("--omega", a->omega, "constant angular velocity wx,wy,wz [rad/s], camera frame")
       ->capture_default_str();
