@@ -102,18 +102,16 @@ pyb::dict solveImpl(const pyb::object& events, const pyb::object& labels, const 
     // What a C++ caller runs (timed, temporaries' destruction included).
     const auto start = Clock::now();
     {
-      const ClusterResult clusters = clustersFromLabels(ev, lb);
-      // Reference time: the first labelled event (as `celc solve`).
-      double t_ref = clusters.clusters.empty() ? 0.0 : clusters.clusters.front().t_begin;
-      for (const ClusterStats& c : clusters.clusters) t_ref = std::min(t_ref, c.t_begin);
-      const MotionModel motion = has_gyro ? MotionModel::gyroIntegrated(track.times, track.rates, t_ref)
-                                          : MotionModel::constantTwist(w, t_ref);
       const BearingFunction bearing = [&](const Vec2& p) {
         return normalized ? Vec3(p.x(), p.y(), 1.0) : cam.bearing(p);
       };
-      const WindowObservations obs =
-          toObservations(ev, clusters, bearing, cam.focal(), cfg.observations, &motion);
-      results = solveMethods(obs, motion, cfg.methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
+      // Reference time: the first labelled event (as `celc solve`).
+      const LabelledObservations in =
+          observeLabelledEvents(ev, lb, bearing, cam.focal(), cfg.observations, [&](double t_first) {
+            return has_gyro ? MotionModel::gyroIntegrated(track.times, track.rates, t_first)
+                            : MotionModel::constantTwist(w, t_first);
+          });
+      results = solveMethods(in.observations, in.motion, cfg.methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
     }
     if (cpp_seconds) *cpp_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   }

@@ -1,10 +1,10 @@
 #pragma once
-// `celc solve`'s path (apps/celc/cmd_solve.cpp) for a peer-scene trial, shared
-// by the tests and tests/study/solve_path_study.cpp: the trial's events as
-// labelled normalised pixels -> clustersFromLabels -> toObservations with the
-// given configuration's lines and observations sections, the given rate as a
-// constant twist from the first event.
-#include <algorithm>
+// `celc solve`'s path (observeLabelledEvents, as apps/celc/cmd_solve.cpp
+// runs it) for a peer-scene trial, shared by the tests and
+// tests/study/solve_path_study.cpp: the trial's events as labelled normalised
+// pixels, the given configuration's lines and observations sections, the given
+// rate as a constant twist from the first event.
+#include <utility>
 #include <vector>
 
 #include "celc/cluster/to_observations.hpp"
@@ -19,7 +19,6 @@ inline WindowObservations solvePathObservations(const PeerSceneTrial& tr, const 
                                                 MotionModel& motion) {
   std::vector<Event> events;
   std::vector<int> labels;
-  double t_min = 1e300;
   for (size_t c = 0; c < tr.observations.clusters.size(); ++c) {
     const ClusterObservation& cl = tr.observations.clusters[c];
     for (size_t k = 0; k < cl.size(); ++k) {
@@ -29,14 +28,15 @@ inline WindowObservations solvePathObservations(const PeerSceneTrial& tr, const 
       e.y = static_cast<float>(cl.bearings[k].y() / cl.bearings[k].z());
       events.push_back(e);
       labels.push_back(static_cast<int>(c));
-      t_min = std::min(t_min, e.t);
     }
   }
   const double t_ref = tr.given_motion.referenceTime();
-  motion = MotionModel::constantTwist(tr.given_motion.meanOmega(t_ref, t_ref + 1.0), t_min);
-  return toObservations(events, clustersFromLabels(events, labels),
-                        [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 320.0, config.observations,
-                        &motion);
+  const Vec3 omega = tr.given_motion.meanOmega(t_ref, t_ref + 1.0);
+  LabelledObservations in = observeLabelledEvents(
+      events, labels, [](const Vec2& p) { return Vec3(p.x(), p.y(), 1.0); }, 320.0, config.observations,
+      [&](double t_first) { return MotionModel::constantTwist(omega, t_first); });
+  motion = in.motion;
+  return std::move(in.observations);
 }
 
 }  // namespace celc::test

@@ -93,19 +93,18 @@ void runSolve(const SolveArgs& a) {
     events.push_back(Event{e.t, static_cast<float>(e.x), static_cast<float>(e.y), true});
     labels.push_back(e.cluster < 0 ? -1 : e.cluster);
   }
-  const ClusterResult clusters = clustersFromLabels(events, labels);
-  double t_min = clusters.clusters.empty() ? 0.0 : clusters.clusters.front().t_begin;
-  for (const ClusterStats& c : clusters.clusters) t_min = std::min(t_min, c.t_begin);
-  const MotionModel motion = a.gyro.empty()
-                                 ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_min)
-                                 : loadGyro(a.gyro, t_min);
   // Event positions are floats: 3e-5 px at 300 px, 6e-8 in normalised units.
   const BearingFunction bearing = [&](const Vec2& p) {
     return a.normalized ? Vec3(p.x(), p.y(), 1.0) : cam.bearing(p);
   };
-  ObservationReport report;
-  const WindowObservations obs =
-      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
+  const LabelledObservations in = observeLabelledEvents(
+      events, labels, bearing, cam.focal(), cfg.observations, [&](double t_first) {
+        return a.gyro.empty() ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_first)
+                              : loadGyro(a.gyro, t_first);
+      });
+  const ClusterResult& clusters = in.clusters;
+  const ObservationReport& report = in.report;
+  const WindowObservations& obs = in.observations;
   auto listed = [](const std::vector<int>& ids, int id) { return std::find(ids.begin(), ids.end(), id) != ids.end(); };
   for (std::size_t k = 0; k < clusters.clusters.size(); ++k)
     if (!listed(report.used_ids, clusters.clusters[k].id) && !listed(report.merged_ids, clusters.clusters[k].id))
@@ -117,7 +116,7 @@ void runSolve(const SolveArgs& a) {
                events.size(), report.n_used, report.n_merged,
                obs.clusters.size() - static_cast<std::size_t>(report.n_used));
   const auto& methods = cfg.methods;
-  const auto results = solveMethods(obs, motion, methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
+  const auto results = solveMethods(obs, in.motion, methods, cfg.solver, SampleSeeds{cfg.seed, cfg.seed});
   std::cout << "method,status,vx,vy,vz,runtime_us\n";
   for (size_t i = 0; i < methods.size(); ++i) {
     const auto& r = results[i];

@@ -1,4 +1,5 @@
-// Labelled events as a clustering result (to_observations.hpp).
+// Labelled events as a clustering result, and `celc solve`'s observations of
+// them (to_observations.hpp).
 #include <algorithm>
 #include <map>
 #include <stdexcept>
@@ -41,6 +42,19 @@ ClusterResult clustersFromLabels(const std::vector<Event>& events, const std::ve
   if (!events.empty()) out.t0 = std::min_element(events.begin(), events.end(), [](const Event& a, const Event& b) {
                                   return a.t < b.t;
                                 })->t;
+  return out;
+}
+
+LabelledObservations observeLabelledEvents(const std::vector<Event>& events, const std::vector<int>& labels,
+                                           const BearingFunction& bearing, double focal_px,
+                                           const ObservationOptions& options,
+                                           const std::function<MotionModel(double)>& motion_from) {
+  LabelledObservations out;
+  out.clusters = clustersFromLabels(events, labels);
+  double t_first = out.clusters.clusters.empty() ? 0.0 : out.clusters.clusters.front().t_begin;
+  for (const ClusterStats& c : out.clusters.clusters) t_first = std::min(t_first, c.t_begin);
+  out.motion = motion_from(t_first);
+  out.observations = toObservations(events, out.clusters, bearing, focal_px, options, &out.motion, &out.report);
   return out;
 }
 

@@ -56,6 +56,22 @@ struct ObservationReport {
 /// std::invalid_argument when the sizes differ.
 ClusterResult clustersFromLabels(const std::vector<Event>& events, const std::vector<int>& labels);
 
+/// `celc solve`'s input (the CLI and the Python module): what follows from
+/// events labelled by cluster.
+struct LabelledObservations {
+  ClusterResult clusters;  ///< clustersFromLabels
+  /// motion_from(t_first), t_first the first clustered event's time [s] (0
+  /// without clusters): the motion's reference time, and so the camera frame
+  /// of the solvers' v.
+  MotionModel motion = MotionModel::constantTwist(Vec3::Zero(), 0.0);
+  WindowObservations observations;  ///< toObservations with that motion
+  ObservationReport report;
+};
+LabelledObservations observeLabelledEvents(const std::vector<Event>& events, const std::vector<int>& labels,
+                                           const BearingFunction& bearing, double focal_px,
+                                           const ObservationOptions& options,
+                                           const std::function<MotionModel(double)>& motion_from);
+
 /// Builds the solver input of a window. Clusters keep their ClusterResult id in
 /// ClusterObservation::id; a cluster whose lines could not be fitted is kept
 /// with has_lines = false. Events whose bearing is not finite are left out.
