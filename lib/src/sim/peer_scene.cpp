@@ -25,6 +25,7 @@ std::string PeerSceneOptions::validate() const {
   if (!(omega_deg_s >= 0.0) || !std::isfinite(omega_deg_s)) e << "omega_deg_s must be >= 0; ";
   if (!(event_noise_px >= 0.0) || !(omega_error_deg_s >= 0.0)) e << "noise levels must be >= 0; ";
   if (!(outlier_fraction >= 0.0 && outlier_fraction < 1.0)) e << "outlier_fraction must be in [0, 1); ";
+  if (!(acceleration >= 0.0) || !std::isfinite(acceleration)) e << "acceleration must be >= 0; ";
   if (!(min_separation_px >= 0.0)) e << "min_separation_px must be >= 0; ";
   if (!(depth_range[0] > 0.0 && depth_range[1] >= depth_range[0])) e << "depth_range must be 0 < min <= max; ";
   if (max_attempts < 1 || max_motion_draws < 1) e << "max_attempts and max_motion_draws must be >= 1; ";
@@ -60,7 +61,12 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
 
   // Motion (constant rate, velocity constant in the reference frame) and the
   // segments; the motion is drawn again when a line finds no segment.
-  Vec3 v = Vec3::Zero();
+  Vec3 v = Vec3::Zero(), a = Vec3::Zero();
+  // The camera's position in the reference frame at time t.
+  auto position = [&](double t) {
+    const double tau = t - o.t_ref;
+    return Vec3(trial.true_motion.positionMatrix(t) * v + 0.5 * tau * tau * a);
+  };
   Mat3 R0 = Mat3::Identity(), R1 = Mat3::Identity();
   Vec3 p0 = Vec3::Zero(), p1 = Vec3::Zero();
   std::vector<std::array<Vec3, 2>> segments;
@@ -69,13 +75,16 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
     trial.true_omega = randomUnit(rng) * (o.omega_deg_s * deg);
     trial.true_direction = randomUnit(rng);
     v = trial.true_direction * o.speed;
+    // Drawn only when asked for, so that the other studies' draws stay the same.
+    if (o.acceleration > 0.0) a = randomUnit(rng) * o.acceleration;
+    trial.true_acceleration = a;
     trial.true_motion =
         MotionModel::gyroIntegrated({t0, t1}, {trial.true_omega, trial.true_omega}, o.t_ref,
                                     VelocityFrame::Reference);
     R0 = trial.true_motion.rotation(t0);
     R1 = trial.true_motion.rotation(t1);
-    p0 = trial.true_motion.positionMatrix(t0) * v;
-    p1 = trial.true_motion.positionMatrix(t1) * v;
+    p0 = position(t0);
+    p1 = position(t1);
     for (int i = 0; i < n_lines; ++i) {
       bool found = false;
       for (int attempt = 0; attempt < o.max_attempts && !found; ++attempt) {
@@ -123,9 +132,8 @@ PeerSceneTrial generatePeerScene(const PeerSceneOptions& o, std::mt19937_64& rng
         continue;
       }
       const double s = u01(rng);
-      Mat3 R, P;
-      trial.true_motion.pose(t, R, P);
-      const Vec3 Xc = inCamera(R, P * v, seg[0] + s * (seg[1] - seg[0]));
+      const Mat3 R = trial.true_motion.rotation(t);
+      const Vec3 Xc = inCamera(R, position(t), seg[0] + s * (seg[1] - seg[0]));
       const Vec2 px = cam.project(Xc);
       Vec2 noisy = px + Vec2(noise(rng), noise(rng));
       if (o.integer_pixels) noisy = noisy.array().round().matrix();

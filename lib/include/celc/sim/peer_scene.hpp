@@ -46,6 +46,10 @@ struct PeerSceneOptions {
   double event_noise_px = 1.0;       ///< sigma of the event pixel noise per axis [px]
   double omega_error_deg_s = 0.0;    ///< magnitude of the error of the given angular velocity [deg/s]
   double outlier_fraction = 0.0;     ///< share of events replaced by uniform random pixels [0, 1)
+  /// |a| [m/s^2] of a constant acceleration in the reference frame, about a
+  /// random direction: p(t) = tau v + tau^2 a / 2, so that v stays the mean
+  /// velocity over the window (the truth) while the solvers assume it constant.
+  double acceleration = 0.0;
   double min_separation_px = 100.0;  ///< endpoint distance at t_ref [px]
   Vec2 depth_range{2.0, 6.0};        ///< endpoint depth z [m]
   int max_attempts = 2000;           ///< segment draws per line before the motion is drawn again
@@ -72,6 +76,7 @@ struct PeerSceneTrial {
   MotionModel given_motion = MotionModel::constantTwist(Vec3::Zero(), 0.0);
   Vec3 true_direction = Vec3::Zero();  ///< unit v
   Vec3 true_omega = Vec3::Zero();      ///< [rad/s]
+  Vec3 true_acceleration = Vec3::Zero();  ///< a [m/s^2], reference frame (options.acceleration)
   std::vector<std::array<Vec3, 2>> segments;  ///< endpoints [m], reference frame
   int lines_fitted = 0;             ///< clusters whose l1 and l3 could be fitted
 };

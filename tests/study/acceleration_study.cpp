@@ -1,0 +1,105 @@
+// What a constant-velocity solver makes of an accelerating camera: the peer
+// scene (sim/peer_scene.hpp) with a constant acceleration a in a random
+// direction, v the mean velocity over the window (the truth), solved by
+// solveMethods with `celc run`'s default solver options and the exact rotation.
+//
+// Why the ratio rho = |a| Z / (2 V^2) (Z = 4 m, the depths' middle): the
+// direction of v reaches the image lines only at second order in time. Under
+// a constant v a line's image l(tau) = m - tau (v x d) is linear in tau
+// (homogeneous coordinates); the first-order motion is explained by any v
+// with the line's own depth, and what fixes v is the curvature of that motion,
+// of size f (V T / Z)^2. An acceleration adds f |a| T^2 / (2 Z) at the same
+// order, so the bias should depend on their ratio, rho, and not on T.
+// The cells vary T at one V (same a) and V at one T (same rho).
+//   build/celc_acceleration_study [--trials N] [--seed S]
+// Prints a markdown table of the median phi [deg] per method (docs/results.md).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "celc/pipeline/run_config.hpp"
+#include "celc/sim/peer_scene.hpp"
+#include "celc/solver/solver.hpp"
+
+using namespace celc;
+
+namespace {
+
+constexpr double kMidDepth = 4.0;  // [m], the middle of the peer scene's 2-6 m
+
+struct Cell {
+  double speed_m_s, duration_s, rho;
+};
+
+int parsePositive(const char* flag, const char* text) {
+  char* end = nullptr;
+  const long v = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || v <= 0 || v > 1000000) {
+    std::fprintf(stderr, "celc_acceleration_study: error: %s '%s': expected a whole number in [1, 1000000]\n",
+                 flag, text);
+    std::exit(1);
+  }
+  return static_cast<int>(v);
+}
+
+double median(std::vector<double> x) {
+  if (x.empty()) return NAN;
+  const size_t h = x.size() / 2;
+  std::nth_element(x.begin(), x.begin() + static_cast<long>(h), x.end());
+  return x[h];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int trials = 100, seed = 31;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if ((a == "--trials" || a == "--seed") && i + 1 < argc) {
+      (a == "--trials" ? trials : seed) = parsePositive(argv[i], argv[i + 1]);
+      ++i;
+    } else {
+      std::fprintf(stderr, "usage: celc_acceleration_study [--trials N] [--seed S]\n");
+      return a == "--help" || a == "-h" ? 0 : 1;
+    }
+  }
+  const RunConfig defaults;
+  std::vector<Cell> cells;
+  for (double rho : {0.0, 0.03, 0.1, 0.3, 1.0}) {
+    for (double T : {0.25, 0.5, 1.0}) cells.push_back({2.0, T, rho});  // one V: a the same, T varies
+    cells.push_back({1.0, 0.5, rho});                                  // one T: rho the same, a and V vary
+  }
+  std::printf("| rho | V [m/s] | T [s] | a [m/s^2] | trials |");
+  for (Method m : defaults.methods) std::printf(" %s |", toString(m).c_str());
+  std::printf("\n|---|---|---|---|---|");
+  for (size_t i = 0; i < defaults.methods.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  for (const Cell& cell : cells) {
+    PeerSceneOptions o;
+    o.speed = cell.speed_m_s;
+    o.duration = cell.duration_s;
+    o.event_noise_px = 0.5;
+    o.acceleration = cell.rho * 2.0 * cell.speed_m_s * cell.speed_m_s / kMidDepth;
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    std::vector<std::vector<double>> phi(defaults.methods.size());
+    int generated = 0;
+    for (int t = 0; t < trials; ++t) {
+      const PeerSceneTrial tr = generatePeerScene(o, rng);
+      if (!tr.ok) continue;
+      ++generated;
+      const std::vector<SolverResult> res = solveMethods(tr.observations, tr.given_motion, defaults.methods,
+                                                         defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
+      for (size_t m = 0; m < res.size(); ++m)
+        phi[m].push_back(res[m].ok() ? angleBetween(tr.true_direction, res[m].v) * 180.0 / M_PI : 180.0);
+    }
+    std::printf("| %g | %g | %g | %.3g | %d |", cell.rho, cell.speed_m_s, cell.duration_s, o.acceleration, generated);
+    for (const std::vector<double>& p : phi) std::printf(" %.2f |", median(p));
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  return 0;
+}
