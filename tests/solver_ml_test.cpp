@@ -213,6 +213,30 @@ TEST(CelcMl, DefaultOptionsNearTheBound) {
   }
 }
 
+// celc_ml draws its own subset (ml.max_events), not celc_opt's
+// (refine.max_events): 5 lines x 600 events, 1000 drawn, or all of them.
+TEST(CelcMl, DrawsItsOwnEventBudget) {
+  const PeerSceneTrial tr = peerTrial(11, 2.0, 0.5, 600);
+  ASSERT_TRUE(tr.ok);
+  SolverOptions options;
+  options.check_parallax = false;
+  options.refine.max_events = 100;  // celc_opt's budget: not celc_ml's
+  options.ml.max_events = 1000;
+  const auto budget = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl, Method::CelcOpt}, options);
+  ASSERT_TRUE(budget[0].ok() && budget[1].ok());
+  EXPECT_EQ(budget[0].rows_used, 1000);
+  EXPECT_EQ(budget[1].rows_used, 100);
+  options.ml.max_events = 0;  // every event
+  const SolverResult all = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options)[0];
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all.rows_used, 3000);
+  // The defaults of `celc run` draw more than the library's: its windows
+  // hold 10^4-10^6 events (docs/solver.md).
+  EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions{}.ml.max_events);
+  options.ml.max_events = -1;
+  EXPECT_NE(options.validate().find("max_events must be >= 0"), std::string::npos);
+}
+
 // The profile's minima as starts (the default) against the linear and npt
 // starts alone, at the lowest parallax of the study (V = 1 m/s, 0.5 px): the
 // peer study's first 100 trials of that cell (a few trials hold the whole

@@ -67,7 +67,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   auto fallback = [&]() -> SolverResult { return linear.ok() || !npt || !npt->ok() ? linear : *npt; };
   for (const Vec3& d : hemisphereDirections(options.ml.grid_starts)) starts.push_back({d, nullptr});
   const double time_us = linear.time_us + (npt ? npt->time_us : 0.0);
-  JointProblem problem(obs, motion, frames, options.refine.max_events, options.refine.balance_clusters,
+  JointProblem problem(obs, motion, frames, options.ml.max_events, options.refine.balance_clusters,
                        event_seed, options.refine.huber_px);
   const size_t events = problem.events();
   if (events < 3) return fallback();

@@ -20,7 +20,7 @@ bool nptStartApplies(const WindowObservations& obs, const MotionModel& motion,
 /// not used); options.ml.grid_starts directions of a hemisphere lattice. A
 /// start within ml.second_start_deg of an end point already found is skipped.
 /// With a lattice, the starts are refined on a seeded subset of
-/// ml.screen_events events and only the winner on refine.max_events. The
+/// ml.screen_events events and only the winner on ml.max_events. The
 /// winner keeps its start's singular values and sign margin; a lattice start's
 /// sign is resolved by cheirality. Events drawn with event_seed.
 SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motion,

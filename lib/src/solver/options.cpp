@@ -41,6 +41,7 @@ std::string MlOptions::validate() const {
   if (!(second_start_deg >= 0.0)) e += "second_start_deg must be >= 0; ";
   if (!(second_start_max_twist >= 0.0)) e += "second_start_max_twist must be >= 0; ";
   if (grid_starts < 0 || grid_starts > 10000) e += "grid_starts must be in [0, 10000]; ";
+  if (max_events < 0) e += "max_events must be >= 0; ";
   if (screen_events < 0) e += "screen_events must be >= 0; ";
   if (profile_lattice < 0 || profile_lattice > 100000) e += "profile_lattice must be in [0, 100000]; ";
   if (profile_starts < 1 || profile_starts > 100) e += "profile_starts must be in [1, 100]; ";

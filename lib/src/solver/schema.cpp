@@ -76,6 +76,7 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"second_start_deg", "deg", "... and the celc start ends this far from it"}, o.second_start_deg);
   v.field({"grid_starts", "", "extra starts on a hemisphere lattice, lowest cost kept (0 = off)"},
           o.grid_starts);
+  v.field({"max_events", "events", "events of the joint problem, a seeded subset (0 = all)"}, o.max_events);
   v.field({"screen_events", "events", "with several starts, each refined on about this many events (0 = all)"},
           o.screen_events);
   v.field({"profile_lattice", "", "start from the line profile's minima: lattice directions (0 = off)"},

@@ -67,12 +67,17 @@ struct RunConfig {
   ObservationOptions observations;
   /// The solvers' defaults, except the global starts: on clustered real or
   /// rendered events the linear stage's robust cost and the joint refinement
-  /// both have local minima that a single start falls into.
+  /// both have local minima that a single start falls into; and celc_ml's
+  /// event budget: a recorded window holds 10^4-10^6 events, and the few
+  /// thousand drawn decided its basin in windows of little parallax
+  /// (docs/solver.md, "celc_ml's event budget").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
     s.ml.grid_starts = 8;
+    s.ml.max_events = 10000;
+    s.ml.screen_events = 4000;
     return s;
   }();
   std::vector<Method> methods = allMethods();

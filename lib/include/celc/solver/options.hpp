@@ -122,9 +122,15 @@ struct MlOptions {
   /// and keep the end point of lowest robust cost; each start costs one joint
   /// refinement.
   int grid_starts = 0;
+  /// Events of the joint problem: a seeded subset of about this many (0 =
+  /// all), drawn as refine.max_events draws celc_opt's. A window of a
+  /// recorded sequence holds 10^4-10^6 events, and which few thousand are
+  /// drawn decides the basin in windows of little parallax: `celc run` uses
+  /// more (pipeline/run_config.hpp, docs/solver.md).
+  int max_events = 5000;
   /// With several starts, each is refined on every k-th event of the
-  /// refinement's subset, k chosen so that about this many are used, and only
-  /// the lowest-cost end point on all (refine.max_events) of them
+  /// joint problem's subset, k chosen so that about this many are used, and
+  /// only the lowest-cost end point on all (max_events) of them
   /// (0 = every start on all events).
   int screen_events = 1000;
   /// Also start from the lowest local minima of the line profile J(v), the
