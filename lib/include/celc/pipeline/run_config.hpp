@@ -67,9 +67,8 @@ struct RunConfig {
   ObservationOptions observations;
   /// The solvers' defaults, except the global starts: on clustered real or
   /// rendered events the linear stage's robust cost and the joint refinement
-  /// both have local minima that a single start falls into; and celc_ml's
-  /// event budget: a recorded window holds 10^4-10^6 events, and the few
-  /// thousand drawn decided its basin in windows of little parallax
+  /// both have local minima that a single start falls into; and a larger
+  /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events
   /// (docs/solver.md, "celc_ml's event budget").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;

@@ -123,10 +123,9 @@ struct MlOptions {
   /// refinement.
   int grid_starts = 0;
   /// Events of the joint problem: a seeded subset of about this many (0 =
-  /// all), drawn as refine.max_events draws celc_opt's. A window of a
-  /// recorded sequence holds 10^4-10^6 events, and which few thousand are
-  /// drawn decides the basin in windows of little parallax: `celc run` uses
-  /// more (pipeline/run_config.hpp, docs/solver.md).
+  /// all), drawn as refine.max_events draws celc_opt's. `celc run` draws
+  /// more (pipeline/run_config.hpp; docs/solver.md, "celc_ml's event
+  /// budget").
   int max_events = 5000;
   /// With several starts, each is refined on every k-th event of the
   /// joint problem's subset, k chosen so that about this many are used, and
