@@ -24,6 +24,7 @@
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "study_args.hpp"
 
 using namespace celc;
 
@@ -34,17 +35,6 @@ constexpr double kMidDepth = 4.0;  // [m], the middle of the peer scene's 2-6 m
 struct Cell {
   double speed_m_s, duration_s, rho;
 };
-
-int parsePositive(const char* flag, const char* text) {
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || v <= 0 || v > 1000000) {
-    std::fprintf(stderr, "celc_acceleration_study: error: %s '%s': expected a whole number in [1, 1000000]\n",
-                 flag, text);
-    std::exit(1);
-  }
-  return static_cast<int>(v);
-}
 
 double median(std::vector<double> x) {
   if (x.empty()) return NAN;
@@ -57,16 +47,8 @@ double median(std::vector<double> x) {
 
 int main(int argc, char** argv) {
   int trials = 100, seed = 31;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if ((a == "--trials" || a == "--seed") && i + 1 < argc) {
-      (a == "--trials" ? trials : seed) = parsePositive(argv[i], argv[i + 1]);
-      ++i;
-    } else {
-      std::fprintf(stderr, "usage: celc_acceleration_study [--trials N] [--seed S]\n");
-      return a == "--help" || a == "-h" ? 0 : 1;
-    }
-  }
+  const int status = study::parseStudyArgs(argc, argv, "celc_acceleration_study", trials, seed);
+  if (status >= 0) return status;
   const RunConfig defaults;
   std::vector<Cell> cells;
   for (double rho : {0.0, 0.03, 0.1, 0.3, 1.0}) {

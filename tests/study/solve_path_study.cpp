@@ -15,6 +15,7 @@
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
+#include "study_args.hpp"
 #include "../peer_solve_path.hpp"
 
 using namespace celc;
@@ -33,31 +34,12 @@ std::vector<SolverResult> solveLikeCelcSolve(const PeerSceneTrial& tr, const Run
   return solveMethods(obs, motion, defaults.methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
 }
 
-int parsePositive(const char* flag, const char* text) {
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || v <= 0 || v > 1000000) {
-    std::fprintf(stderr, "celc_solve_path_study: error: %s '%s': expected a whole number in [1, 1000000]\n", flag,
-                 text);
-    std::exit(1);
-  }
-  return static_cast<int>(v);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   int trials = 100, seed = 4242;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if ((a == "--trials" || a == "--seed") && i + 1 < argc) {
-      (a == "--trials" ? trials : seed) = parsePositive(argv[i], argv[i + 1]);
-      ++i;
-    } else {
-      std::fprintf(stderr, "usage: celc_solve_path_study [--trials N] [--seed S]\n");
-      return a == "--help" || a == "-h" ? 0 : 1;
-    }
-  }
+  const int status = study::parseStudyArgs(argc, argv, "celc_solve_path_study", trials, seed);
+  if (status >= 0) return status;
   const RunConfig defaults;
   const std::vector<Cell> cells{{1, 0.5, 200}, {1, 1, 200}, {1, 2, 200}, {2, 0.5, 200}, {2, 1, 200},
                                 {2, 2, 200},   {5, 0.5, 200}, {5, 1, 200}, {5, 2, 200},   {2, 0.5, 20},
