@@ -84,9 +84,13 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   const int start_iterations =
       starts.size() > 1 && options.ml.start_iterations > 0 ? std::min(options.ml.start_iterations, iterations)
                                                            : iterations;
-  JointProblem::Result best;
-  const Start* best_start = nullptr;
-  std::vector<JointProblem::State> ends;  // the refined starts' end points
+  // The refined starts' end points, with their costs (all on the screen's events).
+  struct End {
+    JointProblem::Result result;
+    const Start* start;
+  };
+  std::vector<End> screened;
+  std::vector<JointProblem::State> ends;
   for (const Start& s : starts) {
     bool seen = false;
     for (const JointProblem::State& e : ends)
@@ -112,15 +116,42 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       }
     }
     ends.push_back(r.state);
-    if (!best_start || r.cost < best.cost) {
-      best = std::move(r);
-      best_start = &s;
-    }
+    screened.push_back({std::move(r), &s});
   }
-  if (!best_start) return fallback();
+  if (screened.empty()) return fallback();
+  std::stable_sort(screened.begin(), screened.end(),
+                   [](const End& a, const End& b) { return a.result.cost < b.result.cost; });
+  JointProblem::Result best = screened.front().result;
+  const Start* best_start = screened.front().start;
   if (stride > 1 || start_iterations < iterations) {
-    JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
-    if (r.ok) best = std::move(r);
+    // The screen ranks its end points after a few iterations on a subset,
+    // and near-tied basins can swap places on convergence: the
+    // ml.finalists lowest are refined on every event of the problem and the
+    // lowest converged cost wins (docs/solver.md, "celc_ml's finalists").
+    // The first runs to convergence; a later one runs start_iterations and
+    // continues only while it is below the best so far, and one heading
+    // into a basin an earlier finalist ended in stops there.
+    std::vector<JointProblem::State> converged;
+    bool have = false;
+    const double merge_rad = kMergeDeg * M_PI / 180.0;
+    const size_t finalists = static_cast<size_t>(std::max(1, options.ml.finalists));
+    for (size_t i = 0; i < screened.size() && i < finalists; ++i) {
+      JointProblem::Result r = problem.refine(screened[i].result.state, have ? start_iterations : iterations,
+                                              tolerance, 1, converged, merge_rad);
+      if (!r.ok || r.merged || (have && r.cost >= best.cost)) continue;
+      if (have && r.iterations == start_iterations && start_iterations < iterations) {
+        JointProblem::Result rest = problem.refine(r.state, iterations, tolerance, 1, converged, merge_rad);
+        if (!rest.ok || rest.merged) continue;
+        rest.iterations += r.iterations;
+        r = std::move(rest);
+      }
+      converged.push_back(r.state);
+      if (!have || r.cost < best.cost) {
+        best = std::move(r);
+        best_start = screened[i].start;
+        have = true;
+      }
+    }
   }
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));

@@ -85,6 +85,8 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"profile_events", "events", "... events per cluster in the profile (0 = all)"}, o.profile_events);
   v.field({"start_iterations", "", "with several starts: iterations of each before the best continues (0 = all)"},
           o.start_iterations);
+  v.field({"finalists", "", "... then this many lowest end points refined to convergence, the lowest cost kept"},
+          o.finalists);
   v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
                                 "refine.huber_px (0 = off)"},
           o.huber_scale);

@@ -68,15 +68,17 @@ struct RunConfig {
   /// The solvers' defaults, except the global starts: on clustered real or
   /// rendered events the linear stage's robust cost and the joint refinement
   /// both have local minima that a single start falls into; and a larger
-  /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events
-  /// (docs/solver.md, "celc_ml's event budget").
+  /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
+  /// with its three lowest screened basins refined to convergence
+  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
     s.ml.grid_starts = 8;
-    s.ml.max_events = 10000;
+    s.ml.max_events = 40000;
     s.ml.screen_events = 4000;
+    s.ml.finalists = 3;
     return s;
   }();
   std::vector<Method> methods = allMethods();

@@ -145,6 +145,10 @@ struct MlOptions {
   /// (0 = refine.max_iterations) and only the lowest-cost one continues to
   /// convergence.
   int start_iterations = 8;
+  /// ... then the finalists, this many lowest end points of the starts,
+  /// are each refined to convergence on all max_events events and the
+  /// lowest converged cost wins (1 = the screen's winner alone).
+  int finalists = 1;
   /// The Huber threshold of the joint cost becomes huber_scale times the
   /// robust scale (1.4826 MAD) of the residuals at the first start's end
   /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
