@@ -15,8 +15,26 @@ std::vector<size_t> sampleIndices(size_t n, size_t k, std::uint64_t seed) {
     for (size_t i = 0; i < n; ++i) idx[i] = i;
     return idx;
   }
-  // Floyd's algorithm: k draws, no O(n) buffer.
+  // Floyd's algorithm: k draws; the chosen set is a bitmap of n bits when
+  // k is a fair share of n (read out in order, no sort), else a hash set
+  // (no O(n) buffer). Both hold the same draws, so the subset is the same.
   std::mt19937_64 rng(seed);
+  idx.reserve(k);
+  if (k >= n / 64) {
+    std::vector<std::uint64_t> bits((n + 63) / 64, 0);
+    for (size_t j = n - k; j < n; ++j) {
+      const size_t t = std::uniform_int_distribution<size_t>(0, j)(rng);
+      const std::uint64_t bit = std::uint64_t{1} << (t % 64);
+      if (bits[t / 64] & bit)
+        bits[j / 64] |= std::uint64_t{1} << (j % 64);
+      else
+        bits[t / 64] |= bit;
+    }
+    for (size_t w = 0; w < bits.size(); ++w)
+      for (std::uint64_t b = bits[w]; b != 0; b &= b - 1)
+        idx.push_back(64 * w + static_cast<size_t>(__builtin_ctzll(b)));
+    return idx;
+  }
   std::unordered_set<size_t> chosen;
   chosen.reserve(2 * k);
   for (size_t j = n - k; j < n; ++j) {
