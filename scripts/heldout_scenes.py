@@ -5,9 +5,12 @@ chosen on. Each variant takes one of three base scenes (the room, the
 hand-held room with its sinusoidal rotation, the rectangles wall as a
 constant twist) and draws a new scene seed, a speed of 0.8-3 m/s and a
 rotation rate of 0.2-2.5 rad/s in random directions, and a background noise
-rate; durations are 0.6 s. Render them with `celc synth FILE -o DIR`.
+rate; durations are 0.6 s. `--kinds` chooses other bases: `deep` is the slow,
+deep scene (slow_deep.yaml: 3-6 m away) as a constant twist at 0.5-1.5 m/s
+and 0.05-1 rad/s for 2 s, long enough for two windows of a second. Render
+them with `celc synth FILE -o DIR`.
 
-    scripts/heldout_scenes.py OUTDIR [--count N] [--seed S]
+    scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect]
 
 Writes OUTDIR/hNN_<base>.yaml and prints one line per scene (its motion)."""
 import argparse
@@ -17,8 +20,11 @@ import random
 import re
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BASES = [("room", "e2e_davis346_room_fast"), ("hand", "handheld_fast_rotation"),
-         ("rect", "davis240_rectangles")]
+BASES = {"room": "e2e_davis346_room_fast", "hand": "handheld_fast_rotation", "rect": "davis240_rectangles",
+         "deep": "slow_deep"}
+# Per kind: speed [m/s], rotation rate [rad/s], duration [s].
+RANGES = {"room": ((0.8, 3.0), (0.2, 2.5), 0.6), "hand": ((0.8, 3.0), (0.2, 2.5), 0.6),
+          "rect": ((0.8, 3.0), (0.2, 2.5), 0.6), "deep": ((0.5, 1.5), (0.05, 1.0), 2.0)}
 
 
 def random_vector(rng, norm):
@@ -40,11 +46,12 @@ def set_key(text, pattern, value):
 
 def variant(rng, index, kind, base):
     text = open(os.path.join(ROOT, "config", "scenes", base + ".yaml")).read()
-    speed, rate = rng.uniform(0.8, 3.0), rng.uniform(0.2, 2.5)
+    speeds, rates, duration = RANGES[kind]
+    speed, rate = rng.uniform(*speeds), rng.uniform(*rates)
     v, w = random_vector(rng, speed), random_vector(rng, rate)
     noise = rng.choice([0.1, 0.5, 1.0, 2.0])
     text = set_key(text, r"^(seed: )\d+", str(1000 + index))
-    text = set_key(text, r"^(duration: )[0-9.]+", "0.6")
+    text = set_key(text, r"^(duration: )[0-9.]+", str(duration))
     if kind == "rect":  # the shipped wall moves sinusoidally: here a constant twist
         text = set_key(text, r"^(\s*type: )sinusoid", "constant_twist")
         text = re.sub(r"^\s*(amplitude_v|amplitude_w|frequency):.*\n", "", text, flags=re.M)
@@ -61,13 +68,20 @@ def main():
     ap.add_argument("outdir")
     ap.add_argument("--count", type=int, default=16, help="scenes to write (default 16)")
     ap.add_argument("--seed", type=int, default=2026, help="seed of the draw (default 2026)")
+    ap.add_argument("--kinds", default="room,hand,rect",
+                    help="bases, taken in turn: room, hand, rect, deep (default room,hand,rect)")
     a = ap.parse_args()
     if a.count < 1:
         raise SystemExit("heldout_scenes.py: --count must be >= 1")
+    kinds = a.kinds.split(",")
+    for k in kinds:
+        if k not in BASES:
+            raise SystemExit(f"heldout_scenes.py: --kinds: unknown kind {k!r} (room, hand, rect, deep)")
     os.makedirs(a.outdir, exist_ok=True)
     rng = random.Random(a.seed)
     for i in range(a.count):
-        kind, base = BASES[i % len(BASES)]
+        kind = kinds[i % len(kinds)]
+        base = BASES[kind]
         text, motion = variant(rng, i, kind, base)
         name = f"h{i:02d}_{kind}"
         with open(os.path.join(a.outdir, name + ".yaml"), "w") as f:

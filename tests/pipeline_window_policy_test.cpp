@@ -208,6 +208,55 @@ TEST(WindowPolicy, JoinerStopsGrowingWhenALongerWindowCannotBeMeasured) {
   EXPECT_NEAR(w.t1 - w.t0, 0.3, 1e-9);
 }
 
+// A camera that turns slowly may need more than max_seconds to show the
+// target: the window grows on to slow_turn_max_seconds while the camera
+// turns less than slow_turn_rad over it; a fast-turning one stops at
+// max_seconds, and without a known rotation nothing grows past it.
+TEST(WindowPolicy, JoinerGrowsPastMaxSecondsOnlyWhileTheCameraTurnsSlowly) {
+  ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s; slowly turning: 1 s within 0.5 rad
+  auto firstWindow = [&](double rate_rad_s, bool known) {
+    StepStream stream(150000);  // ~1.5 s
+    std::vector<double> probed;
+    ParallaxWindowJoiner::Turn turn = [&](double t0, double t1) { return known ? rate_rad_s * (t1 - t0) : NAN; };
+    // 20 px/s: 25 px would take 1.25 s.
+    ParallaxWindowJoiner joiner(
+        *stream.source, o, 0.5,
+        [&](double t0, double t1, const std::vector<Event>&) {
+          probed.push_back(t1 - t0);
+          return 20.0 * (t1 - t0);
+        },
+        turn);
+    EventWindow w;
+    EXPECT_TRUE(joiner.next(w));
+    return std::make_pair(w.t1 - w.t0, probed);
+  };
+  // 0.2 rad/s: grows 0.05 -> 0.15 -> 0.45 -> 1.0 s (capped), D measured at each.
+  const auto [slow, slow_probed] = firstWindow(0.2, true);
+  EXPECT_NEAR(slow, 1.0, 1e-9);
+  ASSERT_EQ(slow_probed.size(), 4u);
+  EXPECT_NEAR(slow_probed[2], 0.45, 1e-9);
+  // 1.1 rad/s: 0.45 s turns 0.495 rad, 0.475 s 0.52: the longest is 0.45 s.
+  EXPECT_NEAR(firstWindow(1.1, true).first, 0.45, 1e-9);
+  // 2 rad/s turns 0.6 rad in 0.3 s: max_seconds, as without the rule.
+  EXPECT_NEAR(firstWindow(2.0, true).first, 0.3, 1e-9);
+  EXPECT_NEAR(firstWindow(0.2, false).first, 0.3, 1e-9);
+  // The extension off: slow_turn_max_seconds at max_seconds.
+  o.slow_turn_max_seconds = o.max_seconds;
+  EXPECT_NEAR(firstWindow(0.2, true).first, 0.3, 1e-9);
+  // Or a longer max_seconds alone.
+  o.max_seconds = 0.6;
+  EXPECT_NEAR(firstWindow(2.0, true).first, 0.6, 1e-9);
+}
+
+// The probe's subsample keeps its density in windows longer than max_seconds.
+TEST(WindowPolicy, ProbeBudgetGrowsPastMaxSeconds) {
+  ParallaxWindowOptions o;  // 30,000 events per 0.3 s
+  EXPECT_EQ(o.probeBudget(0.05), 30000u);
+  EXPECT_EQ(o.probeBudget(0.3), 30000u);
+  EXPECT_EQ(o.probeBudget(0.45), 45000u);
+  EXPECT_EQ(o.probeBudget(1.0), 100000u);
+}
+
 TEST(WindowPolicy, JoinerReportsTheShortLastWindow) {
   TempDir d;
   auto ev = celc::test::randomEvents(10000, 240, 180, 9, 1.0);  // ~0.1 s
@@ -250,6 +299,12 @@ TEST(WindowPolicy, PolicyKeysAreCheckedAgainstThePolicy) {
   EXPECT_NE(error("windows: {parallax_px: 20, no_parallax_px: 21}").find("windows.no_parallax_px: must be in [0, parallax_px (20)]"),
             std::string::npos);
   EXPECT_NE(error("windows: {no_parallax_px: -1}").find("windows.no_parallax_px"), std::string::npos);
+  EXPECT_EQ(error("windows: {max_seconds: 2, slow_turn_max_seconds: 0.5}"), "");  // the extension off
+  EXPECT_NE(error("windows: {slow_turn_max_seconds: 0}").find("windows.slow_turn_max_seconds"), std::string::npos);
+  EXPECT_NE(error("windows: {slow_turn_max_seconds: .inf}").find("windows.slow_turn_max_seconds"), std::string::npos);
+  EXPECT_NE(error("windows: {slow_turn_max_seconds: 300}").find("windows.slow_turn_max_seconds: more than 10000"),
+            std::string::npos);
+  EXPECT_NE(error("windows: {slow_turn_rad: -0.1}").find("windows.slow_turn_rad"), std::string::npos);
   // --set: keys that belong together are validated together, in any order.
   RunConfig c;
   applyRunSettings({"windows.seconds=0.1", "windows.policy=seconds"}, c);

@@ -66,6 +66,16 @@ struct SequenceRunner::Impl {
     omega = gw.mean_omega;
     return true;
   }
+  /// How far the camera turns over [t0, t1] [rad]: |mean rate| (t1 - t0), the
+  /// gyroscope's mean or motion.fixed_omega; NaN where the gyroscope does not
+  /// cover the span.
+  double turnAngle(double t0, double t1) const {
+    MotionModel motion = MotionModel::constantTwist(Vec3::Zero(), t0);
+    Vec3 omega;
+    std::string status;
+    if (!motionFor(t0, t1, motion, omega, status)) return NAN;
+    return omega.norm() * (t1 - t0);
+  }
   /// D of a growing parallax window (window_policy.hpp) [px], measured on at
   /// most parallax.probe_events of its events (every k-th); NaN when it cannot
   /// be measured (no motion model, clustering failed, too few lines).
@@ -77,8 +87,8 @@ struct SequenceRunner::Impl {
     Vec3 omega;
     std::string status;
     if (!motionFor(t0, t1, motion, omega, status)) return NAN;
-    std::size_t keep_every = std::max<std::size_t>(
-        1, (events.size() + config.parallax.probe_events - 1) / config.parallax.probe_events);
+    const std::size_t budget = config.parallax.probeBudget(t1 - t0);
+    std::size_t keep_every = std::max<std::size_t>(1, (events.size() + budget - 1) / budget);
     // A k times sparser subset needs longer time neighbourhoods: the probe
     // clusters at c = the median normal speed (factor 1), where the sparse
     // subsets found their clusters before the default factor became 3;
@@ -326,7 +336,8 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
                                 spdlog::debug("parallax window at {:.3f} s: {:.3f} s, {} events: D = {:.1f} px", t0,
                                               t1 - t0, events.size(), d);
                                 return d;
-                              });
+                              },
+                              [&](double t0, double t1) { return m.turnAngle(t0, t1); });
   auto nextWindow = [&](EventWindow& w) { return parallax ? joiner.next(w) : source.next(w); };
   // By count the number of windows per second of data depends on the event
   // rate: checked as windows arrive (by duration WindowOptions::validate did).

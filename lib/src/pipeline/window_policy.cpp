@@ -30,6 +30,11 @@ std::string ParallaxWindowOptions::validate() const {
     e << "max_seconds: must be finite and >= min_seconds (" << min_seconds << "); ";
   else if (step_seconds > 0.0 && max_seconds / step_seconds > 10000.0)
     e << "max_seconds: more than 10000 steps of step_seconds; ";
+  if (!(slow_turn_max_seconds > 0.0) || !std::isfinite(slow_turn_max_seconds))
+    e << "slow_turn_max_seconds: must be finite and > 0; ";
+  else if (step_seconds > 0.0 && slow_turn_max_seconds / step_seconds > 10000.0)
+    e << "slow_turn_max_seconds: more than 10000 steps of step_seconds; ";
+  if (!(slow_turn_rad >= 0.0) || !std::isfinite(slow_turn_rad)) e << "slow_turn_rad: must be finite and >= 0; ";
   if (probe_events < 1000) e << "probe_events: must be >= 1000; ";
   return e.str();
 }
@@ -37,14 +42,32 @@ std::string ParallaxWindowOptions::validate() const {
 void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
   v.field({"parallax_px", "px", "parallax policy: grow a window until its lines' translation reaches this"},
           o.target_px);
-  v.field({"no_parallax_px", "px", "parallax policy: a window at max_seconds with less is degenerate (no_parallax)"},
+  v.field({"no_parallax_px", "px",
+           "parallax policy: a window grown to its longest (max_seconds, or slow_turn_max_seconds) with less is "
+           "degenerate (no_parallax)"},
           o.no_parallax_px);
   v.field({"min_seconds", "s", "parallax policy: shortest window"}, o.min_seconds);
-  v.field({"max_seconds", "s", "parallax policy: longest window (reached without parallax: degenerate)"},
+  v.field({"max_seconds", "s",
+           "parallax policy: longest window but where the camera turns slowly (reached without parallax: "
+           "degenerate)"},
           o.max_seconds);
+  v.field({"slow_turn_max_seconds", "s",
+           "parallax policy: longest window while the camera turns less than slow_turn_rad over it (at or "
+           "below max_seconds: none grows past max_seconds)"},
+          o.slow_turn_max_seconds);
+  v.field({"slow_turn_rad", "rad",
+           "parallax policy: a window turning less than this (|mean gyro rate| x duration) may grow past "
+           "max_seconds"},
+          o.slow_turn_rad);
   v.field({"step_seconds", "s", "parallax policy: windows grow by whole steps of this"}, o.step_seconds);
-  v.field({"probe_events", "events", "parallax policy: events clustered to measure a growing window"},
+  v.field({"probe_events", "events",
+           "parallax policy: events clustered to measure a growing window, per max_seconds of window"},
           o.probe_events);
+}
+
+std::size_t ParallaxWindowOptions::probeBudget(double seconds) const {
+  const double scale = std::max(1.0, seconds / max_seconds);
+  return static_cast<std::size_t>(std::ceil(static_cast<double>(probe_events) * scale));
 }
 
 double lineTranslationPx(const WindowObservations& obs, const MotionModel& motion, double t0, double t1,
@@ -70,8 +93,20 @@ int nextWindowSteps(int steps, double d_px, double target_px, int max_steps) {
 }
 
 ParallaxWindowJoiner::ParallaxWindowJoiner(WindowSource& steps, const ParallaxWindowOptions& options,
-                                           double partial_min_share, Probe probe)
-    : source_(steps), o_(options), partial_min_share_(partial_min_share), probe_(std::move(probe)) {}
+                                           double partial_min_share, Probe probe, Turn turn)
+    : source_(steps),
+      o_(options),
+      partial_min_share_(partial_min_share),
+      probe_(std::move(probe)),
+      turn_(std::move(turn)) {}
+
+int ParallaxWindowJoiner::maxStepsFrom(double t0, int max_steps) const {
+  const int slow_steps = static_cast<int>(std::floor(o_.slow_turn_max_seconds / o_.step_seconds + 1e-9));
+  int steps = max_steps;
+  if (!turn_) return steps;
+  while (steps < slow_steps && turn_(t0, t0 + (steps + 1) * o_.step_seconds) <= o_.slow_turn_rad) ++steps;
+  return steps;
+}
 
 int ParallaxWindowJoiner::contiguousSteps(int wanted) {
   const double tolerance = 1e-6 * o_.step_seconds;
@@ -114,7 +149,11 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
   const int max_steps = std::max(min_steps, static_cast<int>(std::floor(o_.max_seconds / o_.step_seconds + 1e-9)));
   // The first try is the last window's length (the motion changes slowly);
   // one that shows twice the target is shrunk once toward it.
-  int steps = std::clamp(last_steps_, min_steps, max_steps);
+  // Where the camera turns slowly the window may grow past max_seconds.
+  const int have_first = contiguousSteps(1);
+  if (have_first == 0) return false;
+  const int longest = maxStepsFrom(pending_.front().t0, max_steps);
+  int steps = std::clamp(last_steps_, min_steps, longest);
   bool may_shrink = steps > min_steps;
   bool measured = false;  // a finite D on a shorter try of this window
   translation_px_ = NAN;
@@ -148,8 +187,8 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     }
     may_shrink = false;
     measured = measured || std::isfinite(translation_px_);
-    if (translation_px_ >= o_.target_px || steps >= max_steps) break;
-    steps = nextWindowSteps(steps, translation_px_, o_.target_px, max_steps);
+    if (translation_px_ >= o_.target_px || steps >= longest) break;
+    steps = nextWindowSteps(steps, translation_px_, o_.target_px, longest);
   }
   last_steps_ = std::isfinite(translation_px_) || measured ? steps : min_steps;
   join(steps, window);

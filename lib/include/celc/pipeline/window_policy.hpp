@@ -36,17 +36,30 @@ std::string toString(WindowPolicy policy);  ///< "parallax" | "events" | "second
 /// The parallax policy's options (keys of the `windows:` section).
 struct ParallaxWindowOptions {
   double target_px = 25.0;     ///< grow until the lines' translation D reaches this [px]
-  /// A window that stops at max_seconds with D below this [px] is degenerate
+  /// A window grown to its longest (max_seconds, or slow_turn_max_seconds
+  /// where the camera turns slowly) with D below this [px] is degenerate
   /// (no_parallax) for every method; between it and target_px it is solved.
   double no_parallax_px = 15.0;
   double min_seconds = 0.05;   ///< first (shortest) window tried [s]
-  double max_seconds = 0.3;    ///< longest window [s]; see no_parallax_px
+  double max_seconds = 0.3;    ///< longest window [s]; see no_parallax_px and the next two
+  /// A window that turns slowly may grow past max_seconds, up to this [s]:
+  /// while the camera's rotation over it, |mean gyro rate| x duration, stays
+  /// within slow_turn_rad. Under fast rotation lines sweep across the image
+  /// and long windows hold fragments; a slowly turning camera far from the
+  /// scene needs them (1 m/s at 3-6 m shows ~20 px of translation per second).
+  /// At or below max_seconds no window grows past max_seconds.
+  double slow_turn_max_seconds = 1.0;
+  double slow_turn_rad = 0.5;  ///< see slow_turn_max_seconds [rad]
   /// Growth is in steps of this duration [s]: windows are whole numbers of steps.
   double step_seconds = 0.025;
   /// The measurement of D while a window grows clusters at most this many
-  /// events (every k-th event of the window; denser where that finds no D);
-  /// the window itself keeps all.
+  /// events per max_seconds of window (every k-th event of the window;
+  /// denser where that finds no D); the window itself keeps all. A sparser
+  /// probe measures less D: a 1 s window probed on 30,000 events showed
+  /// a third of its D, hence a budget growing with the window's length.
   std::size_t probe_events = 30000;
+  /// The probe's budget for a window of `seconds` [events].
+  std::size_t probeBudget(double seconds) const;
   std::string validate() const;  ///< "key: what; " per problem ("" = valid)
 };
 /// The parallax keys of the `windows:` section (core/fields.hpp).
@@ -69,16 +82,21 @@ int nextWindowSteps(int steps, double d_px, double target_px, int max_steps);
 /// starts as long as the last one (min_seconds at first, and after a window
 /// the probe could not measure); one that shows twice target_px is shrunk
 /// once toward it; while the probe measures D < target_px it grows by
-/// nextWindowSteps, up to max_seconds (where D is measured once more). A gap the source skipped ends a window.
+/// nextWindowSteps, up to max_seconds (where D is measured once more), or
+/// up to slow_turn_max_seconds where the camera turns slowly. A gap the
+/// source skipped ends a window.
 /// The last window, cut by the end of the data, is emitted when its events
 /// span at least partial_min_share of min_seconds (else tail() reports it).
-/// Memory: at most max_seconds of events.
+/// Memory: at most max(max_seconds, slow_turn_max_seconds) of events.
 class ParallaxWindowJoiner {
  public:
   /// D [px] of the window [t0, t1) holding `events` (NaN: not measurable).
   using Probe = std::function<double(double t0, double t1, const std::vector<Event>& events)>;
+  /// How far the camera turns over [t0, t1] [rad] (NaN: unknown).
+  using Turn = std::function<double(double t0, double t1)>;
+  /// Without `turn`, no window grows past max_seconds.
   ParallaxWindowJoiner(WindowSource& steps, const ParallaxWindowOptions& options, double partial_min_share,
-                       Probe probe);
+                       Probe probe, Turn turn = nullptr);
   /// The next window (indices 0, 1, ...); false when none remains.
   bool next(EventWindow& window);
   /// After next() returned false: the last, partial window, emitted or not.
@@ -91,11 +109,15 @@ class ParallaxWindowJoiner {
  private:
   /// Pulls steps until `wanted` contiguous ones are pending; returns how many are.
   int contiguousSteps(int wanted);
+  /// The longest window [steps] starting at t0: max_seconds, or longer up to
+  /// slow_turn_max_seconds while the camera turns less than slow_turn_rad.
+  int maxStepsFrom(double t0, int max_steps) const;
   void join(int steps, EventWindow& window) const;
   WindowSource& source_;
   ParallaxWindowOptions o_;
   double partial_min_share_;
   Probe probe_;
+  Turn turn_;
   std::deque<EventWindow> pending_;
   bool source_done_ = false;
   std::uint64_t index_ = 0;
