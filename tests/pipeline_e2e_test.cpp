@@ -149,6 +149,37 @@ TEST(EndToEnd, ShortLastWindowWithoutParallaxIsNotSolved) {
   fs::remove_all(d);
 }
 
+// A slowly turning camera far from its scene (config/scenes/slow_deep.yaml:
+// 1 m/s at 3-6 m, 0.2 rad/s) for 1.05 s: its lines show ~5 px per 0.3 s, so
+// with windows of at most max_seconds (0.3 s) every window is `no_parallax`.
+// The window grows on while the camera turns less than slow_turn_rad (0.5
+// rad): to 1 s (slow_turn_max_seconds), where D is ~22 px and celc_ml is
+// 0.009 rad off (measured; 0.1 rad is the D study's tolerance at 15-25 px).
+// With the extension off (slow_turn_max_seconds = max_seconds) the first
+// window stops at 0.3 s, `no_parallax`.
+TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
+  const fs::path d = test::freshTempDir("e2e_slow_turn");
+  ASSERT_EQ(renderEditedScene(d, "slow_deep.yaml", {{"duration:", "duration: 1.05"}}), "");
+  auto firstWindow = [&](const std::string& extra) {
+    const fs::path out = d / ("run" + std::to_string(extra.size()));
+    const auto run = test::runCelc("run '" + (d / "seq").string() + "' --methods celc_ml --threads 2 -q " + extra +
+                                       " -o '" + out.string() + "'",
+                                   d);
+    EXPECT_EQ(run.status, 0) << run.err;
+    const auto rows = readWindowsCsv((out / "windows.csv").string(), false);
+    return rows.empty() ? WindowsCsvRow{} : rows.front();
+  };
+  const auto grown = firstWindow("");
+  EXPECT_NEAR(grown.t_end - grown.t_start, 1.0, 1e-6);
+  EXPECT_EQ(grown.status, "ok") << grown.reason;
+  EXPECT_GE(grown.translation_px, 15.0);
+  EXPECT_LT(grown.phi, 0.1);
+  const auto capped = firstWindow("--set windows.slow_turn_max_seconds=0.3");
+  EXPECT_NEAR(capped.t_end - capped.t_start, 0.3, 1e-6);
+  EXPECT_EQ(capped.reason, "no_parallax");
+  fs::remove_all(d);
+}
+
 // Rendered pure rotation (issue 13): the sample's room seen by a camera that
 // only turns, at 1.6 rad/s, for 0.6 s. With the default windows and with
 // fixed windows of 0.2 s and of 80,000 events, no row is `ok` with a
