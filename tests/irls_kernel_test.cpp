@@ -29,13 +29,18 @@ std::vector<ConstraintRow> randomRows(size_t n, bool two_rows, std::mt19937_64& 
   return rows;
 }
 
+enum class Weight { Plain, Huber, Tukey };
+
 // sum w a a^T and sum w N^T N, entries xx yy zz xy xz yz.
-PackedSums directSums(const std::vector<ConstraintRow>& rows, const Vec3& v, double thr, bool plain) {
+PackedSums directSums(const std::vector<ConstraintRow>& rows, const Vec3& v, double thr, Weight kind) {
   Mat3 Sa = Mat3::Zero(), Sn = Mat3::Zero();
   for (const auto& row : rows) {
     const double d = row.a.dot(v), g2 = (row.N * v).squaredNorm();
     double w = 1.0;
-    if (!plain) w = g2 > 0.0 ? std::min(1.0, thr / std::abs(d / std::sqrt(g2))) / g2 : 0.0;
+    if (kind != Weight::Plain && !(g2 > 0.0)) w = 0.0;
+    const double r = g2 > 0.0 ? std::abs(d / std::sqrt(g2)) : 0.0;
+    if (kind == Weight::Huber && g2 > 0.0) w = std::min(1.0, thr / r) / g2;
+    if (kind == Weight::Tukey && g2 > 0.0) w = r < thr ? std::pow(1.0 - (r / thr) * (r / thr), 2) / g2 : 0.0;
     Sa += w * row.a * row.a.transpose();
     Sn += w * row.N.transpose() * row.N;
   }
@@ -53,8 +58,9 @@ void expectSumsNear(const PackedSums& got, const PackedSums& want) {
 }  // namespace
 
 // Row counts around the 8-row blocks (padding), both layouts, thresholds that
-// make most rows inliers and most rows outliers.
-TEST(IrlsKernel, HuberSumsMatchRowByRowEvaluation) {
+// make most rows inliers and most rows outliers (Tukey: beyond the threshold
+// a row has no weight).
+TEST(IrlsKernel, HuberAndTukeySumsMatchRowByRowEvaluation) {
   std::mt19937_64 rng(3);
   for (const size_t n : {1u, 7u, 8u, 9u, 63u, 300u}) {
     for (const bool two_rows : {true, false}) {
@@ -62,10 +68,12 @@ TEST(IrlsKernel, HuberSumsMatchRowByRowEvaluation) {
       const PackedRows packed(rows);
       EXPECT_EQ(packed.size(), n);
       EXPECT_EQ(packed.normalRows(), two_rows ? 2 : 3);
-      expectSumsNear(packed.plainSums(), directSums(rows, Vec3::Zero(), 0.0, true));
+      expectSumsNear(packed.plainSums(), directSums(rows, Vec3::Zero(), 0.0, Weight::Plain));
       const Vec3 v = Vec3(0.3, -0.8, 0.5).normalized();
-      for (const double thr : {0.05, 0.5, 5.0})
-        expectSumsNear(detail::huberWeightedSums(packed, v, thr), directSums(rows, v, thr, false));
+      for (const double thr : {0.05, 0.5, 5.0}) {
+        expectSumsNear(detail::huberWeightedSums(packed, v, thr), directSums(rows, v, thr, Weight::Huber));
+        expectSumsNear(detail::tukeyWeightedSums(packed, v, thr), directSums(rows, v, thr, Weight::Tukey));
+      }
     }
   }
 }

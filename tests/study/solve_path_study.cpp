@@ -6,12 +6,15 @@
 // event - and the share of trials each method answers (status ok) per cell.
 //   build/celc_solve_path_study [--trials N] [--seed S]
 // Prints a markdown table (docs/peers.md); about 5 s for 100 trials per cell.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "celc/eval/metrics.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/peer_scene.hpp"
 #include "celc/solver/solver.hpp"
@@ -46,8 +49,8 @@ int main(int argc, char** argv) {
                                 {2, 1, 20},    {1, 0.5, 20}};
   std::printf("| V [m/s], sigma [px], events per line | trials |");
   for (Method m : defaults.methods) std::printf(" %s |", toString(m).c_str());
-  std::printf(" celc nullspace_not_unique |\n|---|---|");
-  for (size_t i = 0; i <= defaults.methods.size(); ++i) std::printf("---|");
+  std::printf(" celc nullspace_not_unique | celc phi median / 90th pct. [deg] |\n|---|---|");
+  for (size_t i = 0; i <= defaults.methods.size() + 1; ++i) std::printf("---|");
   std::printf("\n");
   for (const Cell& cell : cells) {
     PeerSceneOptions o;
@@ -57,6 +60,7 @@ int main(int argc, char** argv) {
     std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
     std::vector<int> ok(defaults.methods.size(), 0);
     int generated = 0, ambiguous = 0;
+    std::vector<double> celc_phi_deg;  // celc's ok trials
     for (int t = 0; t < trials; ++t) {
       const PeerSceneTrial tr = generatePeerScene(o, rng);
       if (!tr.ok) continue;
@@ -65,11 +69,17 @@ int main(int argc, char** argv) {
       for (size_t m = 0; m < res.size(); ++m) {
         ok[m] += res[m].ok();
         ambiguous += defaults.methods[m] == Method::Celc && res[m].degeneracy == Degeneracy::NullspaceNotUnique;
+        if (defaults.methods[m] == Method::Celc && res[m].ok())
+          celc_phi_deg.push_back(directionAngle(tr.true_direction, res[m].v) * 180.0 / M_PI);
       }
     }
     std::printf("| %g, %g, %d | %d |", cell.speed_m_s, cell.sigma_px, cell.events_per_line, generated);
     for (int n : ok) std::printf(" %.2f |", generated > 0 ? static_cast<double>(n) / generated : 0.0);
-    std::printf(" %d |\n", ambiguous);
+    std::sort(celc_phi_deg.begin(), celc_phi_deg.end());
+    auto quantile = [&](double q) {
+      return celc_phi_deg.empty() ? NAN : celc_phi_deg[static_cast<size_t>(q * (celc_phi_deg.size() - 1))];
+    };
+    std::printf(" %d | %.2f / %.2f |\n", ambiguous, quantile(0.5), quantile(0.9));
     std::fflush(stdout);
   }
   return 0;

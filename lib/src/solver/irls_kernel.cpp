@@ -14,13 +14,17 @@ namespace {
 constexpr size_t L = PackedRows::kLanes;
 using LaneSums = double[12][L];
 
+enum class Weights { Plain, Huber, Tukey };
+
 // One pass over n rows (a multiple of L) stored as columns c (stride s; a,
 // then R rows of N). Row b + l of each block b adds to lane l's sums: the
-// weight w (Huber over |N v|^2, or 1 when kPlain), then w a a^T and w N^T N.
-template <int R, bool kPlain>
+// weight w (Huber's or Tukey's of r = a.v / |N v| at the threshold thr, over
+// |N v|^2; or 1 when Plain), then w a a^T and w N^T N.
+template <int R, Weights kWeights>
 CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
                      LaneSums& out) {
   LaneSums acc = {};  // local: nothing the loop stores aliases the columns it reads
+  constexpr bool kPlain = kWeights == Weights::Plain;
   const double v0 = kPlain ? 0.0 : v[0], v1 = kPlain ? 0.0 : v[1], v2 = kPlain ? 0.0 : v[2];
   const double thr2 = thr * thr;
   for (size_t b = 0; b < n; b += L) {
@@ -32,7 +36,18 @@ CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double
       for (int r = 0; r < R; ++r)
         for (int k = 0; k < 3; ++k) N[r][k] = c[static_cast<size_t>(3 + 3 * r + k) * s + i];
       double w = 1.0;
-      if (!kPlain) {
+      if (kWeights == Weights::Tukey) {
+        const double d = a0 * v0 + a1 * v1 + a2 * v2;
+        double g2 = 0.0;
+        for (int r = 0; r < R; ++r) {
+          const double u = N[r][0] * v0 + N[r][1] * v1 + N[r][2] * v2;
+          g2 += u * u;
+        }
+        // (1 - r^2 / thr^2)^2 / g2 for |r| < thr, else 0; r^2 = d^2 / g2.
+        const double q = 1.0 - d * d / (thr2 * g2);
+        w = g2 > 0.0 && q > 0.0 ? q * q / g2 : 0.0;
+      }
+      if (kWeights == Weights::Huber) {
         const double d = a0 * v0 + a1 * v1 + a2 * v2;
         double g2 = 0.0;
         for (int r = 0; r < R; ++r) {
@@ -63,13 +78,15 @@ CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double
   std::copy(&acc[0][0], &acc[0][0] + 12 * L, &out[0][0]);
 }
 
-// Every pass (R rows of N kept; plain or Huber weights).
-CELC_ISA_CLONES void sums(int R, bool plain, const double* c, size_t n, size_t s, const double* v,
+// Every pass (R rows of N kept; plain, Huber or Tukey weights).
+CELC_ISA_CLONES void sums(int R, Weights weights, const double* c, size_t n, size_t s, const double* v,
                           double thr, LaneSums& out) {
-  if (R == 2 && plain) sumsPass<2, true>(c, n, s, v, thr, out);
-  if (R == 2 && !plain) sumsPass<2, false>(c, n, s, v, thr, out);
-  if (R == 3 && plain) sumsPass<3, true>(c, n, s, v, thr, out);
-  if (R == 3 && !plain) sumsPass<3, false>(c, n, s, v, thr, out);
+  if (R == 2 && weights == Weights::Plain) sumsPass<2, Weights::Plain>(c, n, s, v, thr, out);
+  if (R == 2 && weights == Weights::Huber) sumsPass<2, Weights::Huber>(c, n, s, v, thr, out);
+  if (R == 2 && weights == Weights::Tukey) sumsPass<2, Weights::Tukey>(c, n, s, v, thr, out);
+  if (R == 3 && weights == Weights::Plain) sumsPass<3, Weights::Plain>(c, n, s, v, thr, out);
+  if (R == 3 && weights == Weights::Huber) sumsPass<3, Weights::Huber>(c, n, s, v, thr, out);
+  if (R == 3 && weights == Weights::Tukey) sumsPass<3, Weights::Tukey>(c, n, s, v, thr, out);
 }
 
 // r2_k = (a_k.v)^2 / |N_k v|^2 (r2_degenerate where |N_k v| = 0) over m rows
@@ -284,7 +301,7 @@ void PackedRows::sealWithoutSample() {
   const size_t columns = 3 + 3 * static_cast<size_t>(normal_rows_);
   for (size_t j = 0; j < columns; ++j) std::fill(c + j * stride_ + n_, c + j * stride_ + padded_, 0.0);
   LaneSums plain;
-  sums(normal_rows_, true, c, padded_, stride_, nullptr, 0.0, plain);
+  sums(normal_rows_, Weights::Plain, c, padded_, stride_, nullptr, 0.0, plain);
   plain_sums_ = laneTotals(plain);
 }
 
@@ -322,7 +339,14 @@ void PackedRows::squaredResiduals(const Vec3& v, double r_degenerate, std::vecto
 PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr) {
   const double vv[3] = {v.x(), v.y(), v.z()};
   LaneSums acc;
-  sums(rows.normalRows(), false, rows.data(), rows.paddedSize(), rows.stride(), vv, thr, acc);
+  sums(rows.normalRows(), Weights::Huber, rows.data(), rows.paddedSize(), rows.stride(), vv, thr, acc);
+  return laneTotals(acc);
+}
+
+PackedSums tukeyWeightedSums(const PackedRows& rows, const Vec3& v, double thr) {
+  const double vv[3] = {v.x(), v.y(), v.z()};
+  LaneSums acc;
+  sums(rows.normalRows(), Weights::Tukey, rows.data(), rows.paddedSize(), rows.stride(), vv, thr, acc);
   return laneTotals(acc);
 }
 

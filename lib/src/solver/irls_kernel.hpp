@@ -89,5 +89,8 @@ class PackedRows {
 /// (rows l, l + kLanes, ...), and the lanes' sums are added in lane order, so
 /// the result does not depend on how the compiler vectorises the lanes.
 PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
+/// The same with Tukey's biweight: w_i = (1 - r_i^2 / thr^2)^2 / |N_i v|^2 for
+/// |r_i| < thr, else 0 (a row beyond thr has no influence at all).
+PackedSums tukeyWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
 
 }  // namespace celc::detail

@@ -12,6 +12,7 @@ std::string LinearOptions::validate() const {
   if (max_rows < 0) e += "max_rows must be >= 0; ";
   if (max_iterations < 1) e += "max_iterations must be >= 1; ";
   if (!(huber_k > 0.0)) e += "huber_k must be > 0; ";
+  if (!(tukey_k >= 0.0) || !std::isfinite(tukey_k)) e += "tukey_k must be finite and >= 0 (0 = off); ";
   if (!(tolerance > 0.0)) e += "tolerance must be > 0; ";
   if (grid_directions < 0 || grid_starts < 0 || grid_rows < 1)
     e += "grid_directions, grid_starts must be >= 0 and grid_rows >= 1; ";

@@ -108,7 +108,8 @@ double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::
 
 // IRLS from a starting direction. Each step solves the generalised
 // eigenproblem (sum w_i a_i a_i^T) v = lambda (sum w_i N_i^T N_i) v with
-// w_i = Huber(r_i / scale) / |N_i v_prev|^2. A plain weighted eigenvector
+// w_i = Huber(r_i / scale) / |N_i v_prev|^2 (then, with tukey_k, Tukey's
+// biweight: an MM-style redescending stage from the Huber fixed point). A plain weighted eigenvector
 // (denominator frozen) walks toward directions where a whole cluster's
 // transferred lines collapse (|N v| -> 0 makes a.v -> 0 too); keeping the
 // weighted normaliser on the right-hand side penalises that collapse, and at a
@@ -131,26 +132,40 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
   Mat3 X;
   Vec3 last_step = Vec3::Zero();
   double relax = 1.0;  // share of the fixed-point step taken, halved at every reversal
-  for (int it = 0; it < std::max(1, opt.max_iterations); ++it) {
+  // Huber's IRLS to convergence, then (tukey_k > 0) Tukey's from its end point.
+  const int huber_iterations = std::max(1, opt.max_iterations);
+  const int iterations = huber_iterations * (opt.tukey_k > 0.0 ? 2 : 1);
+  for (int it = 0; it < iterations; ++it) {
+    const bool tukey = it >= huber_iterations;
+    if (it == huber_iterations) {  // a new fixed-point map: its own relaxation
+      last_step = Vec3::Zero();
+      relax = 1.0;
+    }
     const double scale = sampledMad(P, v, 0.0, sample, band, median_r2);
-    const double thr = opt.huber_k * std::max(scale, 1e-15);
-    const PackedSums s = huberWeightedSums(P, v, thr);
+    const double thr = (tukey ? opt.tukey_k : opt.huber_k) * std::max(scale, 1e-15);
+    const PackedSums s = tukey ? tukeyWeightedSums(P, v, thr) : huberWeightedSums(P, v, thr);
     const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
-    if (!generalizedEigen3(Ma, Mn, lambda, X)) return out;
+    if (!generalizedEigen3(Ma, Mn, lambda, X)) {
+      if (tukey) break;  // no row within Tukey's threshold: keep the Huber end point
+      return out;
+    }
     Vec3 next = X.col(0).normalized();
     if (next.dot(v) < 0.0) next = -next;
     // Singular values of the normalised system: sqrt of the generalised
     // eigenvalues, the weighted RMS geometric residual along each direction.
     out.sigma_min = std::sqrt(std::max(0.0, lambda(0)));
     out.sigma_second = std::sqrt(std::max(0.0, lambda(1)));
-    out.iterations = it + 1;
+    ++out.iterations;
     const Vec3 step = next - v;
     if (step.dot(last_step) < 0.0) relax *= 0.5;
     next = (v + relax * step).normalized();
     last_step = next - v;
     const double delta = std::acos(std::min(1.0, next.dot(v)));
     v = next;
-    if (delta < opt.tolerance) break;
+    if (delta < opt.tolerance) {
+      if (tukey || opt.tukey_k <= 0.0) break;
+      it = huber_iterations - 1;  // converged under Huber: on to Tukey's weights
+    }
   }
   out.v = v;
   // Robust scale at the end point (rows with |N v| = 0 count as outliers).

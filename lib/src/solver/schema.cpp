@@ -9,6 +9,9 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"seed", "", "seed of the row subset"}, o.seed);
   v.field({"max_iterations", "", "IRLS iterations"}, o.max_iterations);
   v.field({"huber_k", "-", "Huber threshold in robust scales"}, o.huber_k);
+  v.field({"tukey_k", "-",
+           "then IRLS with Tukey's biweight at this many robust scales, from the Huber end point (0 = off)"},
+          o.tukey_k);
   v.field({"tolerance", "rad", "IRLS stops when the direction moves less"}, o.tolerance);
   v.field({"grid_directions", "", "global start: hemisphere directions scored (0 = off)"}, o.grid_directions);
   v.field({"grid_starts", "", "IRLS also runs from the best this many of them"}, o.grid_starts);

@@ -19,6 +19,12 @@ struct LinearOptions {
   std::uint64_t seed = 1;        ///< seed of the row subset (solveMethods' SampleSeeds override it per window)
   int max_iterations = 20;       ///< IRLS iterations
   double huber_k = 1.345;        ///< Huber threshold in units of the robust scale
+  /// After the Huber IRLS converges, IRLS with Tukey's biweight at this many
+  /// robust scales (0 = off), from the Huber end point: rows beyond it get no
+  /// weight. Huber keeps a bounded pull of every far row; on rendered
+  /// clusters that hold a few per cent of another edge's events (at corners)
+  /// those rows together move the direction far off (docs/solver.md).
+  double tukey_k = 0.0;
   /// Stop when the direction moves less than this [rad]; well below the
   /// direction error at realistic noise.
   double tolerance = 1e-3;
