@@ -261,6 +261,10 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.cauchy_min_tail=2", c); }),
             "--set solver.refine.cauchy_min_tail=2: cauchy_min_tail must be in [0, 1]");
   EXPECT_EQ(c.solver.refine.cauchy_min_tail, RefineOptions{}.cauchy_min_tail);  // unchanged
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.tukey_scale=-1", c); }),
+            "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.linear.tukey_k=-2", c); }),
+            "--set solver.linear.tukey_k=-2: tukey_k must be finite and >= 0 (0 = off)");
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
   EXPECT_EQ(s.scene.camera.fx, 100.0);

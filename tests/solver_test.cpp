@@ -329,6 +329,22 @@ TEST(Refinement, AnalyticJacobianMatchesNumeric) {
     const double numeric = (detail::sqrtCauchy(d + 1e-7, 0.8, &s2) - detail::sqrtCauchy(d - 1e-7, 0.8, &s2)) / 2e-7;
     EXPECT_NEAR(slope, numeric, 1e-6);
   }
+  // The square-rooted Tukey biweight: r^2 = (c^2 / 3)(1 - (1 - d^2 / c^2)^3)
+  // inside c, c^2 / 3 beyond with slope 0 (no pull), slope = dr/dd.
+  for (double d : {-5.0, -1.0, -1e-8, 0.3, 1.5, 2.9, 7.0}) {
+    const double c = 3.0;
+    double slope = 0.0;
+    const double r = detail::sqrtTukey(d, c, &slope);
+    const double u = 1.0 - std::min(1.0, d * d / (c * c));
+    EXPECT_NEAR(r * r, c * c / 3.0 * (1.0 - u * u * u), 1e-12);
+    EXPECT_EQ(r < 0, d < 0);
+    double s2 = 0.0;
+    const double numeric = (detail::sqrtTukey(d + 1e-7, c, &s2) - detail::sqrtTukey(d - 1e-7, c, &s2)) / 2e-7;
+    EXPECT_NEAR(slope, numeric, 1e-6);
+    if (std::abs(d) >= c) {
+      EXPECT_EQ(slope, 0.0);
+    }
+  }
 }
 
 TEST(MethodNames, RoundTrip) {

@@ -34,6 +34,7 @@ std::string RefineOptions::validate() const {
   if (num_threads < 1) e << "num_threads must be >= 1; ";
   if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e << "cauchy_scale must be finite and >= 0; ";
   if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e << "cauchy_min_tail must be in [0, 1]; ";
+  if (!(tukey_scale >= 0.0) || !std::isfinite(tukey_scale)) e << "tukey_scale must be finite and >= 0; ";
   return e.str();
 }
 

@@ -112,7 +112,8 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   ceres::Solve(so, &problem, &summary);
   // The residual reported is the Huber cost's.
   const double huber_cost = summary.final_cost;
-  // celc_opt: a last solve under the Cauchy loss (refine.cauchy_scale) where
+  // celc_opt: a last solve under the Cauchy loss (refine.cauchy_scale; or
+  // Tukey's biweight, refine.tukey_scale) where
   // the residuals at the Huber solution have a heavier tail than Gaussian
   // noise gives (other edges' events, a line's stub): they stop pulling.
   if (opt.cauchy_scale > 0.0 && !refine_lines && summary.IsSolutionUsable()) {
@@ -122,9 +123,16 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     for (size_t c = 0; c < terms.size(); ++c)
       for (const EventTerm& e : terms[c])
         d.push_back(eventDistance(e, vh, m1[c], m3[c], obs.focal_px, nullptr, nullptr, nullptr));
-    const double cauchy_px = residualSpread(std::move(d)).cauchyScale(opt.cauchy_scale, opt.cauchy_min_tail);
+    const ResidualSpread spread = residualSpread(std::move(d));
+    const double cauchy_px = spread.cauchyScale(opt.cauchy_scale, opt.cauchy_min_tail);
     if (cauchy_px > 0.0) {
-      for (EventChunkCost* cost : costs) cost->setCauchy(cauchy_px);
+      const double tukey_px = opt.tukey_scale > 0.0 ? spread.cauchyScale(opt.tukey_scale, opt.cauchy_min_tail) : 0.0;
+      for (EventChunkCost* cost : costs) {
+        if (tukey_px > 0.0)
+          cost->setTukey(tukey_px);
+        else
+          cost->setCauchy(cauchy_px);
+      }
       ceres::Solver::Summary cauchy;
       ceres::Solve(so, &problem, &cauchy);
       result.iterations += static_cast<int>(cauchy.iterations.size());

@@ -41,6 +41,25 @@ inline double sqrtCauchy(double d, double c, double* slope) {
   return d < 0 ? -r : r;
 }
 
+/// Tukey's biweight in the same square-root form: rho(d^2) = (c^2 / 3)
+/// (1 - (1 - d^2 / c^2)^3) for |d| < c (about d^2 near 0) and c^2 / 3
+/// beyond, where the slope is 0: such an event does not pull at all.
+inline double sqrtTukey(double d, double c, double* slope) {
+  const double q2 = (d / c) * (d / c);
+  if (q2 < 1e-12) {
+    *slope = 1.0;
+    return d;
+  }
+  if (q2 >= 1.0) {
+    *slope = 0.0;
+    return d < 0 ? -c / std::sqrt(3.0) : c / std::sqrt(3.0);
+  }
+  const double u = 1.0 - q2;
+  const double r = c * std::sqrt((1.0 - u * u * u) / 3.0);
+  *slope = std::abs(d) * u * u / r;
+  return d < 0 ? -r : r;
+}
+
 /// A chunk of one cluster's events. Parameters: v (3), and with joint lines
 /// also m1 (3), m3 (3) of the cluster.
 class EventChunkCost final : public ceres::CostFunction {
@@ -57,6 +76,8 @@ class EventChunkCost final : public ceres::CostFunction {
 
   /// The loss from here on: Cauchy with scale c [px] instead of Huber.
   void setCauchy(double c) { cauchy_ = c; }
+  /// ... or Tukey's biweight with threshold c [px].
+  void setTukey(double c) { tukey_ = c; }
 
   /// With joint == false, m1 and m3 are the cluster's fixed lines.
   void setFixedLines(const Vec3& m1, const Vec3& m3) {
@@ -75,7 +96,9 @@ class EventChunkCost final : public ceres::CostFunction {
                                      want && joint_ ? &g1 : nullptr, want && joint_ ? &g3 : nullptr);
       if (!std::isfinite(d)) return false;
       double slope = 1.0;
-      residuals[i] = cauchy_ > 0.0 ? sqrtCauchy(d, cauchy_, &slope) : sqrtHuber(d, huber_, &slope);
+      residuals[i] = tukey_ > 0.0    ? sqrtTukey(d, tukey_, &slope)
+                     : cauchy_ > 0.0 ? sqrtCauchy(d, cauchy_, &slope)
+                                     : sqrtHuber(d, huber_, &slope);
       if (!want) continue;
       const Vec3* grads[3] = {&gv, &g1, &g3};
       for (int b = 0; b < (joint_ ? 3 : 1); ++b)
@@ -89,6 +112,7 @@ class EventChunkCost final : public ceres::CostFunction {
   std::vector<EventTerm> terms_;
   double focal_, huber_;
   double cauchy_ = 0.0;  // > 0: the Cauchy loss replaces Huber
+  double tukey_ = 0.0;   // > 0: Tukey's biweight replaces both
   bool joint_;
   Vec3 m1_ = Vec3::Zero(), m3_ = Vec3::Zero();
 };

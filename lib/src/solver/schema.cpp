@@ -57,6 +57,10 @@ void describe(FieldVisitor& v, RefineOptions& o) {
                       "celc_opt: then a last refinement under a Cauchy loss at this times the residuals' robust "
                       "scale: a cluster whose line is off stops pulling (0 = off)",
                       o.cauchy_scale, o.cauchy_min_tail);
+  v.field({"tukey_scale", "-",
+           "celc_opt: > 0: that last refinement uses Tukey's biweight at this times the robust scale instead "
+           "of the Cauchy loss (cauchy_scale 0 still turns it off)"},
+          o.tukey_scale);
 }
 
 void describe(FieldVisitor& v, NptOptions& o) {

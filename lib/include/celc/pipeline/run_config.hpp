@@ -69,15 +69,17 @@ struct RunConfig {
   /// rendered events the linear stage's robust cost and the joint refinement
   /// both have local minima that a single start falls into; and a larger
   /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
-  /// with its three lowest screened basins refined to convergence; and the
-  /// linear stage's Tukey stage, for clusters that hold a few per cent of
-  /// another edge's events (docs/solver.md, "celc_ml's event budget",
-  /// "celc_ml's finalists", "The linear stage's Tukey stage").
+  /// with its three lowest screened basins refined to convergence; and
+  /// Tukey's biweight in the linear stage and in celc_opt's last refinement,
+  /// for clusters that hold a few per cent of another edge's events
+  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
+  /// linear stage's Tukey stage").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
     s.linear.tukey_k = 3.0;
+    s.refine.tukey_scale = 3.0;
     s.ml.grid_starts = 8;
     s.ml.max_events = 40000;
     s.ml.screen_events = 4000;

@@ -76,6 +76,11 @@ struct RefineOptions {
   /// cauchy_min_tail of them lie beyond 3 robust scales (0 = off).
   double cauchy_scale = 1.0;      ///< [-]
   double cauchy_min_tail = 0.01;  ///< [-]
+  /// > 0: that last refinement uses Tukey's biweight at tukey_scale robust
+  /// scales instead of the Cauchy loss: an event beyond has no pull at all,
+  /// where under Cauchy many far events of other edges together still move v
+  /// (docs/solver.md). cauchy_scale = 0 still turns the last refinement off.
+  double tukey_scale = 0.0;       ///< [-]
   std::string validate() const;
 };
 
