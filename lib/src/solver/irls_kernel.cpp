@@ -36,34 +36,30 @@ CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double
       for (int r = 0; r < R; ++r)
         for (int k = 0; k < 3; ++k) N[r][k] = c[static_cast<size_t>(3 + 3 * r + k) * s + i];
       double w = 1.0;
-      if (kWeights == Weights::Tukey) {
+      if (!kPlain) {
+        // d = a.v and g2 = |N v|^2: the geometric residual is r = d / sqrt(g2).
         const double d = a0 * v0 + a1 * v1 + a2 * v2;
         double g2 = 0.0;
         for (int r = 0; r < R; ++r) {
           const double u = N[r][0] * v0 + N[r][1] * v1 + N[r][2] * v2;
           g2 += u * u;
         }
-        // (1 - r^2 / thr^2)^2 / g2 for |r| < thr, else 0; r^2 = d^2 / g2.
-        const double q = 1.0 - d * d / (thr2 * g2);
-        w = g2 > 0.0 && q > 0.0 ? q * q / g2 : 0.0;
-      }
-      if (kWeights == Weights::Huber) {
-        const double d = a0 * v0 + a1 * v1 + a2 * v2;
-        double g2 = 0.0;
-        for (int r = 0; r < R; ++r) {
-          const double u = N[r][0] * v0 + N[r][1] * v1 + N[r][2] * v2;
-          g2 += u * u;
-        }
-        // One square root and one division per row: w = T / sqrt(X) with
-        // (T, X) = (1, g2^2) for an inlier (sqrt(g2^2) == g2 exactly in IEEE
-        // arithmetic) and (thr, d^2 g2) for an outlier (|r| >= thr).
-        // Both sides computed, then selected: the loop has no branch.
         const double d2 = d * d;
-        const bool inlier = d2 < thr2 * g2;
-        const double T = inlier ? 1.0 : thr;
-        const double X = inlier ? g2 * g2 : d2 * g2;
-        const double weight = T / std::sqrt(X);
-        w = g2 > 0.0 ? weight : 0.0;
+        if (kWeights == Weights::Tukey) {
+          // (1 - r^2 / thr^2)^2 / g2 for |r| < thr, else 0.
+          const double q = 1.0 - d2 / (thr2 * g2);
+          w = g2 > 0.0 && q > 0.0 ? q * q / g2 : 0.0;
+        } else {
+          // One square root and one division per row: w = T / sqrt(X) with
+          // (T, X) = (1, g2^2) for an inlier (sqrt(g2^2) == g2 exactly in IEEE
+          // arithmetic) and (thr, d^2 g2) for an outlier (|r| >= thr).
+          // Both sides computed, then selected: the loop has no branch.
+          const bool inlier = d2 < thr2 * g2;
+          const double T = inlier ? 1.0 : thr;
+          const double X = inlier ? g2 * g2 : d2 * g2;
+          const double weight = T / std::sqrt(X);
+          w = g2 > 0.0 ? weight : 0.0;
+        }
       }
       const double wa0 = w * a0, wa1 = w * a1, wa2 = w * a2;
       acc[0][l] += wa0 * a0, acc[1][l] += wa1 * a1, acc[2][l] += wa2 * a2;
