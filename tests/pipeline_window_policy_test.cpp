@@ -257,6 +257,40 @@ TEST(WindowPolicy, ProbeBudgetGrowsPastMaxSeconds) {
   EXPECT_EQ(o.probeBudget(1.0), 100000u);
 }
 
+// The rest of the data after a window that showed the target is joined to
+// it when the rest alone would show less than no_parallax_px (D linear in the
+// length) and the joined window stays within the longest one: it would be
+// `degenerate` (no_parallax) on its own.
+TEST(WindowPolicy, JoinerJoinsARestTooShortToShowParallax) {
+  ParallaxWindowOptions o;  // 25 px, no_parallax 15 px, 0.05 .. 0.3 s, steps of 0.025 s
+  auto windows = [&](std::size_t n) {
+    TempDir d;
+    const auto ev = celc::test::randomEvents(n, 240, 180, 5, 1.0);  // 10 +- 6 us apart
+    writeEventsText(d.file("e.txt"), ev);
+    WindowTail tail;
+    const auto w = joinAll(d.file("e.txt"), o, 200.0, nullptr, &tail);  // windows of 0.125 s
+    std::size_t total = 0;
+    for (const auto& x : w) total += x.events;
+    EXPECT_EQ(total + (tail.emitted ? 0 : tail.events), ev.size());
+    return w;
+  };
+  // 0.54 s: four windows of 0.125 s and 0.04 s left (8 px; 15 px needs 0.075 s): joined.
+  auto w = windows(54000);
+  ASSERT_EQ(w.size(), 4u);
+  EXPECT_NEAR(w[3].t1 - w[3].t0, 0.175, 1e-9);
+  EXPECT_NEAR(w[2].t1 - w[2].t0, 0.125, 1e-9);
+  // 0.6 s: 0.1 s left shows 20 px: a window of its own.
+  w = windows(60000);
+  ASSERT_EQ(w.size(), 5u);
+  EXPECT_NEAR(w[3].t1 - w[3].t0, 0.125, 1e-9);
+  // A longest window of 0.15 s has no room for the 0.04 s: not joined.
+  o.max_seconds = 0.15;
+  o.slow_turn_max_seconds = 0.15;
+  w = windows(54000);
+  ASSERT_EQ(w.size(), 5u);
+  EXPECT_NEAR(w[3].t1 - w[3].t0, 0.125, 1e-9);
+}
+
 TEST(WindowPolicy, JoinerReportsTheShortLastWindow) {
   TempDir d;
   auto ev = celc::test::randomEvents(10000, 240, 180, 9, 1.0);  // ~0.1 s

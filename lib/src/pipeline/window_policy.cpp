@@ -131,6 +131,16 @@ int ParallaxWindowJoiner::contiguousSteps(int wanted) {
   return n;
 }
 
+int ParallaxWindowJoiner::tailToJoin(int steps, int longest) {
+  if (!(translation_px_ >= o_.target_px) || steps >= longest) return 0;
+  // With D linear in the length, the rest shows no_parallax_px only from
+  // `need` steps on; look that far ahead, or one step past the longest window.
+  const int need = static_cast<int>(std::ceil(steps * o_.no_parallax_px / translation_px_ - 1e-9));
+  const int look = std::min(std::max(1, need), longest - steps + 1);
+  const int have = contiguousSteps(steps + look);
+  return have < steps + look ? have - steps : 0;  // the run of data ends within it
+}
+
 void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
   window.events.clear();
   std::size_t n = 0;
@@ -191,6 +201,7 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     steps = nextWindowSteps(steps, translation_px_, o_.target_px, longest);
   }
   last_steps_ = std::isfinite(translation_px_) || measured ? steps : min_steps;
+  steps += tailToJoin(steps, longest);
   join(steps, window);
   const bool at_end = source_done_ && static_cast<int>(pending_.size()) == steps;
   if (at_end && steps < min_steps) {  // the end of the data cut the window short

@@ -85,9 +85,12 @@ int nextWindowSteps(int steps, double d_px, double target_px, int max_steps);
 /// nextWindowSteps, up to max_seconds (where D is measured once more), or
 /// up to slow_turn_max_seconds where the camera turns slowly. A gap the
 /// source skipped ends a window.
+/// A window that shows target_px is joined with the rest of the data (to its
+/// end or a gap) when that rest is too short to show no_parallax_px itself
+/// and the longest window allows: the rest would be `degenerate`.
 /// The last window, cut by the end of the data, is emitted when its events
 /// span at least partial_min_share of min_seconds (else tail() reports it).
-/// Memory: at most max(max_seconds, slow_turn_max_seconds) of events.
+/// Memory: at most max(max_seconds, slow_turn_max_seconds) of events, and one step.
 class ParallaxWindowJoiner {
  public:
   /// D [px] of the window [t0, t1) holding `events` (NaN: not measurable).
@@ -103,7 +106,8 @@ class ParallaxWindowJoiner {
   const WindowTail& tail() const { return tail_; }
   /// D [px] measured on the window next() returned last: >= target_px, or
   /// less when it stopped at max_seconds; NaN when not measured (cut short by
-  /// the data or a gap) or not measurable.
+  /// the data or a gap) or not measurable. With a rest of the data joined,
+  /// D of the window before it.
   double translationPx() const { return translation_px_; }
 
  private:
@@ -112,6 +116,11 @@ class ParallaxWindowJoiner {
   /// The longest window [steps] starting at t0: max_seconds, or longer up to
   /// slow_turn_max_seconds while the camera turns less than slow_turn_rad.
   int maxStepsFrom(double t0, int max_steps) const;
+  /// Steps to add to a window of `steps` that showed D >= target_px: the rest
+  /// of the data (to its end or to a gap), when that rest is too short to show
+  /// no_parallax_px itself (D linear in the length) and the joined window
+  /// stays within `longest` steps; else 0.
+  int tailToJoin(int steps, int longest);
   void join(int steps, EventWindow& window) const;
   WindowSource& source_;
   ParallaxWindowOptions o_;
