@@ -145,6 +145,25 @@ static void BM_CelcLinearPeers16(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
+// The same with the Tukey stage that `celc run` and `celc solve` add
+// (solver.linear.tukey_k 3): the issue-14 target as a user's run meets it.
+static void BM_CelcLinearPeers16Tukey(benchmark::State& state) {
+  const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
+  LinearOptions opt;
+  opt.tukey_k = 3.0;
+  size_t i = 0;
+  double iterations = 0.0;
+  for (auto _ : state) {
+    const auto& tr = trials[i++ % trials.size()];
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
+    iterations += r.iterations;
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["irls_iterations"] = iterations / static_cast<double>(std::max<size_t>(1, i));
+}
+BENCHMARK(BM_CelcLinearPeers16Tukey)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
 // celc_ml with the default options on the peers' scene (V = 2 m/s, 1 px
 // noise), as solveMethods runs it: its linear and npt starts, the line
 // profile's screen, the joint refinements. Cycles over 16 trials (the time

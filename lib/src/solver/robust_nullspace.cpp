@@ -123,7 +123,11 @@ double sampledMad(const PackedRows& P, const Vec3& v, double r_degenerate, std::
 // 2-cycle, whose end point then depends on the iteration count's parity. So
 // the step is relaxed: v moves by a share of the fixed-point step, 1 at
 // first and halved whenever a step reverses the previous one (negative dot
-// product); the fixed points are unchanged.
+// product); the fixed points are unchanged. In the Tukey stage a step that
+// shrinks along the previous one (ratio q = s_k.s_{k-1} / |s_{k-1}|^2 in
+// (0, 1): linear convergence at rate q) lengthens the share by 1 / (1 - q),
+// q taken at most 0.5 and the share at most 2, the extrapolation to the
+// fixed point of a linear map.
 NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt) {
   NullspaceSolution out;
   std::vector<double> sample, band;
@@ -131,7 +135,9 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
   Vec3 lambda;
   Mat3 X;
   Vec3 last_step = Vec3::Zero();
+  Vec3 last_raw_step = Vec3::Zero();
   double relax = 1.0;  // share of the fixed-point step taken, halved at every reversal
+  double scale = NAN;
   // Huber's IRLS to convergence, then (tukey_k > 0) Tukey's from its end point.
   const int huber_iterations = std::max(1, opt.max_iterations);
   const int iterations = huber_iterations * (opt.tukey_k > 0.0 ? 2 : 1);
@@ -139,9 +145,12 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
     const bool tukey = it >= huber_iterations;
     if (it == huber_iterations) {  // a new fixed-point map: its own relaxation
       last_step = Vec3::Zero();
+      last_raw_step = Vec3::Zero();
       relax = 1.0;
     }
-    const double scale = sampledMad(P, v, 0.0, sample, band, median_r2);
+    // Tukey's stage keeps the scale of the Huber end point (an MM-estimator's
+    // fixed scale): one fixed-point map, and no MAD per pass.
+    if (!tukey || it == huber_iterations) scale = sampledMad(P, v, 0.0, sample, band, median_r2);
     const double thr = (tukey ? opt.tukey_k : opt.huber_k) * std::max(scale, 1e-15);
     const PackedSums s = tukey ? tukeyWeightedSums(P, v, thr) : huberWeightedSums(P, v, thr);
     const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
@@ -157,7 +166,13 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
     out.sigma_second = std::sqrt(std::max(0.0, lambda(1)));
     ++out.iterations;
     const Vec3 step = next - v;
-    if (step.dot(last_step) < 0.0) relax *= 0.5;
+    const double ratio = step.dot(last_raw_step) / std::max(last_raw_step.squaredNorm(), 1e-300);
+    if (tukey && ratio > 0.0 && step.squaredNorm() < last_raw_step.squaredNorm()) {
+      relax = std::min(relax / (1.0 - std::min(ratio, 0.5)), 2.0);
+    } else if (step.dot(last_step) < 0.0) {
+      relax *= 0.5;
+    }
+    last_raw_step = step;
     next = (v + relax * step).normalized();
     last_step = next - v;
     const double delta = std::acos(std::min(1.0, next.dot(v)));
