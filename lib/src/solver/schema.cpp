@@ -108,6 +108,9 @@ void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"agreement", "", "sigma_deg at least the angle to a celc / celc_opt / celc_ml estimate of the window that "
                             "disagrees beyond 2 sigma"},
           o.agreement);
+  v.field({"witness_rows", "rows",
+           "with agreement: one more witness, celc on a second random subset of this many rows (0 = none)"},
+          o.witness_rows);
   v.field({"max_events", "events", "events per window used for it (0 = all)"}, o.max_events);
   v.field({"scale_celc", "-", "calibration factor of sigma_deg for celc"}, o.scale_celc);
   v.field({"scale_celc_opt", "-", "... for celc_opt"}, o.scale_celc_opt);

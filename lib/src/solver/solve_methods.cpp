@@ -20,6 +20,9 @@ namespace celc {
 
 namespace {
 
+/// Seeds the witness subset of UncertaintyOptions::witness_rows apart from the estimate's.
+constexpr std::uint64_t kWitnessSeed = 0x9e3779b97f4a7c15ULL;
+
 /// sigma_i at least the largest angle to a disagreeing witness
 /// (UncertaintyOptions::agreement). `witnesses` holds estimates with their
 /// Fisher sigma_deg; `self` is i's own witness index or -1.
@@ -149,6 +152,17 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     SolverResult w = linear;
     w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
     if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
+  }
+  if (u.witness_rows > 0 && have_linear) {
+    // The linear estimate again on another random subset of rows (a seed
+    // apart from the estimate's own): its sampling spread.
+    LinearOptions subset = options.linear;
+    subset.max_rows = u.witness_rows;
+    SolverResult w = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
+    if (w.ok()) {
+      w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
+      if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
+    }
   }
   for (size_t i = 0; i < out.size(); ++i)
     if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], witness_of[i], witnesses);

@@ -202,6 +202,11 @@ struct MlOptions {
 struct UncertaintyOptions {
   bool enabled = true;          ///< compute sigma_deg (off: NaN)
   bool agreement = true;        ///< raise sigma_deg to the angle to a disagreeing witness
+  /// > 0 (with agreement): one more witness, the linear celc estimate on a
+  /// second random subset of this many rows [rows]. Where the linear cost is
+  /// flat (model errors: impure clusters, an accelerating camera) such
+  /// subsets scatter, while the window's own estimates may share one bias.
+  int witness_rows = 0;
   int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
   double scale_celc = 2.5;      ///< [-] factor for method celc
   double scale_celc_opt = 2.5;  ///< [-] for celc_opt
