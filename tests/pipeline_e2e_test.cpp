@@ -190,9 +190,9 @@ TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
 // Huber end point, 0.010-0.034 (measured). celc_opt's last refinement under
 // Tukey's biweight (solver.refine.tukey_scale 3) instead of the Cauchy loss:
 // 0.055-0.083 against 0.111-0.158 rad (seed 1, the test's: 0.057 / 0.154).
-// celc's part runs on 1000 rows, `celc run`'s default until the twelfth
-// session; on its 4000 this window is 0.07-0.14 rad off with the Tukey
-// stage and 0.28-0.33 without (celc_opt does not move).
+// celc's part pins the linear stage's 1000 rows (`celc run`'s default): on
+// 4000 this window is 0.07-0.14 rad off with the Tukey stage and 0.28-0.33
+// without (celc_opt does not move; docs/results.md, twelfth session).
 TEST(EndToEnd, TukeyStageKeepsCelcOnTrackWithImpureClusters) {
   const fs::path d = test::freshTempDir("e2e_tukey");
   ASSERT_EQ(renderEditedScene(d, "e2e_davis346_room_fast.yaml",

@@ -71,18 +71,14 @@ struct RunConfig {
   /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
   /// with its three lowest screened basins refined to convergence; and
   /// Tukey's biweight in the linear stage and in celc_opt's last refinement,
-  /// for clusters that hold a few per cent of another edge's events; and
-  /// 4000 rows for the linear stage, with celc on another 1000 as a witness
-  /// of the agreement check (docs/solver.md, "celc_ml's event budget",
-  /// "celc_ml's finalists", "The linear stage's Tukey stage", "The linear
-  /// stage's rows and their witness").
+  /// for clusters that hold a few per cent of another edge's events
+  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
+  /// linear stage's Tukey stage").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
     s.linear.tukey_k = 3.0;
-    s.linear.max_rows = 4000;
-    s.uncertainty.witness_rows = 1000;
     s.refine.tukey_scale = 3.0;
     s.ml.grid_starts = 8;
     s.ml.max_events = 40000;
