@@ -265,6 +265,11 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.linear.tukey_k=-2", c); }),
             "--set solver.linear.tukey_k=-2: tukey_k must be finite and >= 0 (0 = off)");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=-1", c); }),
+            "--set solver.uncertainty.witness_rows=-1: uncertainty.witness_rows must be >= 0");
+  applyRunSetting("solver.uncertainty.agreement=false", c);
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=1000", c); }),
+            "--set solver.uncertainty.witness_rows=1000: uncertainty.witness_rows needs uncertainty.agreement: true");
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
   EXPECT_EQ(s.scene.camera.fx, 100.0);

@@ -129,9 +129,8 @@ BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 // The same cycling over 16 trials of the peers' scene (the IRLS's iteration
 // count, and so the time, depends on the trial): the mean time per solve, and
 // the mean iteration count.
-static void BM_CelcLinearPeers16(benchmark::State& state) {
+static void timeCelcLinearPeers16(benchmark::State& state, const LinearOptions& opt) {
   const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
-  const LinearOptions opt;
   size_t i = 0;
   double iterations = 0.0;
   for (auto _ : state) {
@@ -143,24 +142,16 @@ static void BM_CelcLinearPeers16(benchmark::State& state) {
   }
   state.counters["irls_iterations"] = iterations / static_cast<double>(std::max<size_t>(1, i));
 }
+
+static void BM_CelcLinearPeers16(benchmark::State& state) { timeCelcLinearPeers16(state, LinearOptions{}); }
 BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 // The same with the Tukey stage that `celc run` and `celc solve` add
 // (solver.linear.tukey_k 3): the issue-14 target as a user's run meets it.
 static void BM_CelcLinearPeers16Tukey(benchmark::State& state) {
-  const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
   LinearOptions opt;
   opt.tukey_k = 3.0;
-  size_t i = 0;
-  double iterations = 0.0;
-  for (auto _ : state) {
-    const auto& tr = trials[i++ % trials.size()];
-    const detail::WindowFrames frames(tr.observations, tr.given_motion);
-    const auto r = detail::solveCelcLinear(tr.observations, tr.given_motion, opt, frames, false, opt.seed);
-    iterations += r.iterations;
-    benchmark::DoNotOptimize(r);
-  }
-  state.counters["irls_iterations"] = iterations / static_cast<double>(std::max<size_t>(1, i));
+  timeCelcLinearPeers16(state, opt);
 }
 BENCHMARK(BM_CelcLinearPeers16Tukey)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 

@@ -60,6 +60,7 @@ std::string UncertaintyOptions::validate() const {
   std::string e;
   if (max_events < 0) e += "uncertainty.max_events must be >= 0; ";
   if (witness_rows < 0) e += "uncertainty.witness_rows must be >= 0; ";
+  if (witness_rows > 0 && !agreement) e += "uncertainty.witness_rows needs uncertainty.agreement: true; ";
   for (double s : {scale_celc, scale_celc_opt, scale_celc_ml, scale_ce3lc, scale_npt})
     if (!(s >= 0.0) || !std::isfinite(s)) {
       e += "uncertainty.scale_* must be finite and >= 0; ";
