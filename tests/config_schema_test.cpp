@@ -263,6 +263,10 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(c.solver.refine.cauchy_min_tail, RefineOptions{}.cauchy_min_tail);  // unchanged
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.tukey_scale=-1", c); }),
             "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.starts=0", c); }),
+            "--set solver.refine.starts=0: starts must be in [1, 64]");
+  applyRunSetting("solver.refine.starts=2", c);
+  EXPECT_EQ(c.solver.refine.starts, 2);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.linear.tukey_k=-2", c); }),
             "--set solver.linear.tukey_k=-2: tukey_k must be finite and >= 0 (0 = off)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=-1", c); }),

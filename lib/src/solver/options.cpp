@@ -35,6 +35,8 @@ std::string RefineOptions::validate() const {
   if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e << "cauchy_scale must be finite and >= 0; ";
   if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e << "cauchy_min_tail must be in [0, 1]; ";
   if (!(tukey_scale >= 0.0) || !std::isfinite(tukey_scale)) e << "tukey_scale must be finite and >= 0; ";
+  if (starts < 1 || starts > 64) e << "starts must be in [1, 64]; ";
+  if (screen_events < 0) e << "screen_events must be >= 0; ";
   return e.str();
 }
 

@@ -61,6 +61,12 @@ void describe(FieldVisitor& v, RefineOptions& o) {
            "celc_opt: > 0: that last refinement uses Tukey's biweight at this times the robust scale instead "
            "of the Cauchy loss (cauchy_scale 0 still turns it off)"},
           o.tukey_scale);
+  v.field({"starts", "",
+           "celc_opt: starts from celc's estimate on this many random row subsets (1 = celc's own); several are "
+           "screened, the lowest cost refined"},
+          o.starts);
+  v.field({"screen_events", "events", "... each start screened on this many events (0 = max_events)"},
+          o.screen_events);
 }
 
 void describe(FieldVisitor& v, NptOptions& o) {

@@ -37,6 +37,83 @@ void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResu
   r.sigma_deg = raised;
 }
 
+/// Seeds celc_opt's further starts (RefineOptions::starts): subset k's seed is
+/// the window's row seed XOR k times this.
+constexpr std::uint64_t kRestartSeed = 0xd1b54a32d192ed03ULL;
+/// celc_opt's further starts this close to one already refined are skipped [deg].
+constexpr double kSameStartDeg = 1.0;
+
+/// Whether celc_opt can start from a linear result: an answer, or an
+/// ambiguous nullspace (two near-equal singular values), which still points
+/// into the cost's valley.
+bool celcOptCanStart(const SolverResult& init) {
+  const bool ambiguous = init.degeneracy == Degeneracy::NullspaceNotUnique && init.v.norm() > 0.5;
+  return init.ok() || ambiguous;
+}
+
+/// celc_opt from one linear result: the Ceres refinement on the fixed lines;
+/// from an ambiguous nullspace the sign is resolved at the end point. Its
+/// time is the refinement's alone.
+SolverResult refineCelcOpt(const WindowObservations& obs, const MotionModel& motion, const SolverResult& init,
+                           const SolverOptions& options, const detail::WindowFrames& frames,
+                           std::uint64_t event_seed) {
+  SolverResult r = detail::refineVelocity(obs, motion, init.v, false, options.refine, frames,
+                                          options.refine.max_events, event_seed);
+  r.sigma_min = init.sigma_min;
+  r.sigma_second = init.sigma_second;
+  r.sign_margin = init.sign_margin;
+  if (!init.ok() && r.ok() && options.linear.resolve_sign) {
+    const auto t0 = detail::Clock::now();
+    const SignDecision s = detail::resolveSign(obs, motion, r.v, frames);
+    r.v *= s.sign;
+    r.sign_margin = s.margin * s.sign;
+    r.time_us += detail::microsecondsSince(t0);
+  }
+  return r;
+}
+
+/// celc_opt: refined from celc's estimate `init` and, with
+/// RefineOptions::starts > 1, from celc on further row subsets. Several
+/// distinct starts are screened (Huber refinement on screen_events events of
+/// the same seeded subset, costs compared there); the lowest end point is
+/// refined as one start is. Its time includes every linear stage it used.
+SolverResult solveCelcOpt(const WindowObservations& obs, const MotionModel& motion, const SolverResult& init,
+                          const SolverOptions& options, const detail::WindowFrames& frames,
+                          const SampleSeeds& seeds) {
+  const RefineOptions& ro = options.refine;
+  std::vector<SolverResult> starts{init};
+  double time_us = init.time_us;
+  for (int k = 1; k < ro.starts; ++k) {
+    const SolverResult alt = detail::solveCelcLinear(obs, motion, options.linear, frames, false,
+                                                     seeds.linear_rows ^ (kRestartSeed * static_cast<std::uint64_t>(k)));
+    time_us += alt.time_us;
+    const bool seen = std::any_of(starts.begin(), starts.end(), [&](const SolverResult& s) {
+      return angleBetweenSignAgnostic(s.v, alt.v) * 180.0 / M_PI < kSameStartDeg;
+    });
+    if (celcOptCanStart(alt) && !seen) starts.push_back(alt);
+  }
+  SolverResult start = init;
+  if (starts.size() > 1) {
+    RefineOptions screen = ro;
+    screen.cauchy_scale = 0.0;  // Huber only
+    const int screen_events = ro.screen_events > 0 ? ro.screen_events : ro.max_events;
+    double best_cost = INFINITY;
+    for (const SolverResult& s : starts) {
+      const SolverResult r =
+          detail::refineVelocity(obs, motion, s.v, false, screen, frames, screen_events, seeds.refine_events);
+      time_us += r.time_us;
+      if (r.ok() && r.residual_px < best_cost) {
+        best_cost = r.residual_px;
+        start = s;
+        start.v = r.v;  // the screen keeps the start's sign
+      }
+    }
+  }
+  SolverResult r = refineCelcOpt(obs, motion, start, options, frames, seeds.refine_events);
+  r.time_us += time_us;
+  return r;
+}
+
 }  // namespace
 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
@@ -87,29 +164,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       }
       case Method::CelcOpt: {
         const SolverResult& init = getLinear();
-        // An ambiguous nullspace (two near-equal singular values) still
-        // points into the cost's valley: the refinement starts from it and
-        // the sign is resolved at its end point. Its sigma_deg says how well
-        // the geometric cost fixes the direction there.
-        const bool ambiguous = init.degeneracy == Degeneracy::NullspaceNotUnique && init.v.norm() > 0.5;
-        if (!init.ok() && !ambiguous) {
-          out.push_back(init);
-          break;
-        }
-        SolverResult r = detail::refineVelocity(obs, motion, init.v, false, options.refine, frames,
-                                                options.refine.max_events, seeds.refine_events);
-        r.time_us += init.time_us;  // a refined estimate costs its initialisation too
-        r.sigma_min = init.sigma_min;
-        r.sigma_second = init.sigma_second;
-        r.sign_margin = init.sign_margin;
-        if (ambiguous && r.ok() && options.linear.resolve_sign) {
-          const auto t0 = detail::Clock::now();
-          const SignDecision s = detail::resolveSign(obs, motion, r.v, frames);
-          r.v *= s.sign;
-          r.sign_margin = s.margin * s.sign;
-          r.time_us += detail::microsecondsSince(t0);
-        }
-        out.push_back(r);
+        out.push_back(celcOptCanStart(init) ? solveCelcOpt(obs, motion, init, options, frames, seeds) : init);
         break;
       }
     }

@@ -71,15 +71,17 @@ struct RunConfig {
   /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
   /// with its three lowest screened basins refined to convergence; and
   /// Tukey's biweight in the linear stage and in celc_opt's last refinement,
-  /// for clusters that hold a few per cent of another edge's events
+  /// for clusters that hold a few per cent of another edge's events; and
+  /// celc_opt started from celc on 4 random row subsets, its lowest cost kept
   /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
-  /// linear stage's Tukey stage").
+  /// linear stage's Tukey stage", "celc_opt's starts").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;
     s.linear.tukey_k = 3.0;
     s.refine.tukey_scale = 3.0;
+    s.refine.starts = 4;
     s.ml.grid_starts = 8;
     s.ml.max_events = 40000;
     s.ml.screen_events = 4000;

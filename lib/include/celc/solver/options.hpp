@@ -81,6 +81,13 @@ struct RefineOptions {
   /// where under Cauchy many far events of other edges together still move v
   /// (docs/solver.md). cauchy_scale = 0 still turns the last refinement off.
   double tukey_scale = 0.0;       ///< [-]
+  /// celc_opt: starts of the refinement, the linear estimate on this many
+  /// random row subsets (the first is celc's own; one within 1 deg of an
+  /// earlier one is dropped). With several, each is refined under Huber on
+  /// screen_events events, and the one with the lowest cost there is refined
+  /// as a single start is.
+  int starts = 1;
+  int screen_events = 1000;  ///< [events] (0 = max_events)
   std::string validate() const;
 };
 
