@@ -68,9 +68,10 @@ SolverResult solveCelcLinear(const WindowObservations& obs, const MotionModel& m
       continue;
     }
     // A gyro-integrated model: across each run of events in one piece.
+    size_t next_piece = t.empty() ? 0 : motion.pieceIndex(t[0]);  // each event's piece found once
     for (size_t begin = 0, end; begin < t.size(); begin = end) {
-      const size_t piece = motion.pieceIndex(t[begin]);
-      for (end = begin + 1; end < t.size() && motion.pieceIndex(t[end]) == piece;) ++end;
+      const size_t piece = next_piece;
+      for (end = begin + 1; end < t.size() && (next_piece = motion.pieceIndex(t[end])) == piece;) ++end;
       if (!rows.appendGyroRows(terms.gyroPiece(piece), &t[begin], &fx[begin], &fy[begin], &fz[begin],
                                end - begin))
         appendOneByOne(begin, end);

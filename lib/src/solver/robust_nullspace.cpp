@@ -34,11 +34,19 @@ void jacobiPolish(const Mat3& C, Mat3& Y, Vec3& d) {
         const double theta = (D(q, q) - D(p, p)) / (2.0 * apq);
         const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
         const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
-        Mat3 J = Mat3::Identity();
-        J(p, p) = c, J(q, q) = c, J(p, q) = s, J(q, p) = -s;
-        D = (J.transpose() * D * J).eval();
+        // D <- J^T D J and Y <- Y J with J the rotation (c, s) in the
+        // (p, q) plane: only rows and columns p and q change.
+        for (int k = 0; k < 3; ++k) {  // columns: D J
+          const double dp = D(k, p), dq = D(k, q);
+          D(k, p) = c * dp - s * dq, D(k, q) = s * dp + c * dq;
+          const double yp = Y(k, p), yq = Y(k, q);
+          Y(k, p) = c * yp - s * yq, Y(k, q) = s * yp + c * yq;
+        }
+        for (int k = 0; k < 3; ++k) {  // rows: J^T (D J)
+          const double dp = D(p, k), dq = D(q, k);
+          D(p, k) = c * dp - s * dq, D(q, k) = s * dp + c * dq;
+        }
         D(p, q) = D(q, p) = 0.0;
-        Y = (Y * J).eval();
       }
     if (!rotated) break;
   }
@@ -139,6 +147,7 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
   double relax = 1.0;  // share of the fixed-point step taken, halved at every reversal
   double scale = NAN;
   // Huber's IRLS to convergence, then (tukey_k > 0) Tukey's from its end point.
+  const double chord_tolerance = 2.0 * std::sin(0.5 * opt.tolerance);
   const int huber_iterations = std::max(1, opt.max_iterations);
   const int iterations = huber_iterations * (opt.tukey_k > 0.0 ? 2 : 1);
   for (int it = 0; it < iterations; ++it) {
@@ -175,9 +184,11 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
     last_raw_step = step;
     next = (v + relax * step).normalized();
     last_step = next - v;
-    const double delta = std::acos(std::min(1.0, next.dot(v)));
+    // The step's angle is below the tolerance when its chord is below
+    // 2 sin(tolerance / 2) (both unit vectors; no acos per pass).
+    const bool converged = last_step.norm() < chord_tolerance;
     v = next;
-    if (delta < opt.tolerance) {
+    if (converged) {
       if (tukey || opt.tukey_k <= 0.0) break;
       it = huber_iterations - 1;  // converged under Huber: on to Tukey's weights
     }
