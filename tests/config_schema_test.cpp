@@ -265,6 +265,8 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.starts=0", c); }),
             "--set solver.refine.starts=0: starts must be in [1, 64]");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.screen_events=-1", c); }),
+            "--set solver.refine.screen_events=-1: screen_events must be >= 0");
   applyRunSetting("solver.refine.starts=2", c);
   EXPECT_EQ(c.solver.refine.starts, 2);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.linear.tukey_k=-2", c); }),

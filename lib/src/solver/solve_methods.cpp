@@ -83,7 +83,11 @@ SolverResult solveCelcOpt(const WindowObservations& obs, const MotionModel& moti
   const RefineOptions& ro = options.refine;
   std::vector<SolverResult> starts{init};
   double time_us = init.time_us;
-  for (int k = 1; k < ro.starts; ++k) {
+  // Where every event is a row, every subset is the same: no further start.
+  size_t events = 0;
+  for (const ClusterObservation& c : obs.clusters) events += c.size();
+  const bool subsets_differ = options.linear.max_rows > 0 && events > static_cast<size_t>(options.linear.max_rows);
+  for (int k = 1; subsets_differ && k < ro.starts; ++k) {
     const SolverResult alt = detail::solveCelcLinear(obs, motion, options.linear, frames, false,
                                                      seeds.linear_rows ^ (kRestartSeed * static_cast<std::uint64_t>(k)));
     time_us += alt.time_us;
