@@ -54,6 +54,9 @@ std::string ClusterOptions::validate() const {
   if (!(normal_reuse_px >= 0.0 && normal_reuse_px <= 2.0)) err << "normal_reuse_px must be in [0, 2]; ";
   if (min_neighbours < 3) err << "min_neighbours must be >= 3; ";
   if (!(smoothness_deg > 0.0 && smoothness_deg <= 90.0)) err << "smoothness_deg must be in (0, 90]; ";
+  if (!(smoothness_noise_factor >= 0.0) || !std::isfinite(smoothness_noise_factor))
+    err << "smoothness_noise_factor must be finite and >= 0; ";
+  if (!(smoothness_min_deg > 0.0 && smoothness_min_deg <= 90.0)) err << "smoothness_min_deg must be in (0, 90]; ";
   if (!(curvature_threshold > 0.0 && curvature_threshold <= 1.0))
     err << "curvature_threshold must be in (0, 1]; ";
   if (min_cluster_size < 3) err << "min_cluster_size must be >= 3; ";
@@ -194,6 +197,7 @@ struct GroupOutput {
   std::vector<ClusterStats> stats;
   int n_regions = 0, n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
   double ms_normals = 0.0, ms_grow = 0.0, ms_post = 0.0;
+  double smoothness_deg = 0.0;  // the growing's angle (0: the group did not grow)
 };
 
 GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
@@ -207,6 +211,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
                               ? detail::growPcl(g, c, opt, threads)
                               : detail::growGrid(*index, c, opt, threads, normals);
   out.ms_normals = regions.ms_normals;
+  out.smoothness_deg = opt.method == ClusterMethod::Pcl || index == nullptr ? opt.smoothness_deg : regions.smoothness_deg;
   out.ms_grow = msSince(t_start) - regions.ms_normals;
   t_start = Clock::now();
   // Index lists of the regions large enough to matter.
@@ -403,6 +408,7 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   };
   std::vector<Item> items;
   for (auto& o : outs) {
+    if (o.smoothness_deg > 0.0) res.smoothness_deg = std::max(res.smoothness_deg, o.smoothness_deg);
     res.n_regions += o.n_regions;
     res.n_split += o.n_split;
     res.n_rejected_planar += o.n_rejected_planar;

@@ -235,7 +235,8 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
   // found here with union-find in one sweep; each high-curvature point then
   // joins the region of its first low-curvature neighbour with a similar
   // normal (PCL gives it to the region that reaches it first).
-  const float cos_thr = static_cast<float>(std::cos(opt.smoothness_deg * M_PI / 180.0));
+  out.smoothness_deg = growingAngleDeg(index, c, opt, *normals);
+  const float cos_thr = static_cast<float>(std::cos(out.smoothness_deg * M_PI / 180.0));
   const float curv_thr = static_cast<float>(opt.curvature_threshold);
   std::vector<int> parent(n), attach(n, -1);
   std::iota(parent.begin(), parent.end(), 0);
@@ -272,6 +273,36 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
   }
   out.count = region;
   return out;
+}
+
+double medianNeighbourAngleDeg(const GridIndex& index, double c, const ClusterOptions& opt,
+                               const GridNormals& normals) {
+  const size_t n = index.size();
+  const size_t stride = std::max<size_t>(1, n / 4000);
+  const float curv_thr = static_cast<float>(opt.curvature_threshold);
+  const float dt = static_cast<float>(opt.grow_time_radius_px / c);
+  std::vector<float> cosines;
+  for (size_t k = stride / 2; k < n; k += stride) {
+    if (!(normals.curv[k] < curv_thr)) continue;
+    const float* a = &normals.nrm[3 * k];
+    index.forNeighbours(static_cast<int>(k), opt.grow_radius_px, dt, [&](int j) {
+      if (j == static_cast<int>(k) || !(normals.curv[j] < curv_thr)) return;
+      const float* b = &normals.nrm[3 * static_cast<size_t>(j)];
+      cosines.push_back(std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]));
+    });
+  }
+  if (cosines.empty()) return NAN;
+  auto mid = cosines.begin() + static_cast<std::ptrdiff_t>(cosines.size() / 2);
+  std::nth_element(cosines.begin(), mid, cosines.end());  // the median cosine: the median angle
+  return std::acos(std::min(1.0f, *mid)) * 180.0 / M_PI;
+}
+
+double growingAngleDeg(const GridIndex& index, double c, const ClusterOptions& opt, const GridNormals& normals) {
+  if (!(opt.smoothness_noise_factor > 0.0)) return opt.smoothness_deg;
+  const double median = medianNeighbourAngleDeg(index, c, opt, normals);
+  if (!std::isfinite(median)) return opt.smoothness_deg;
+  return std::clamp(opt.smoothness_noise_factor * median, std::min(opt.smoothness_min_deg, opt.smoothness_deg),
+                    opt.smoothness_deg);
 }
 
 double estimateTimeScaleOnIndex(const std::vector<const GridIndex*>& indexes, double c0,

@@ -23,6 +23,7 @@ struct Regions {
   std::vector<int> label;
   int count = 0;
   double ms_normals = 0.0;  ///< part of the time spent on normals [ms]
+  double smoothness_deg = 0.0;  ///< the angle the growing used [deg]
 };
 
 /// Events of a group bucketed per pixel, sorted by time inside each bucket.
@@ -126,6 +127,18 @@ struct GridNormals {
   double ms = 0.0;  ///< wall time [ms]
 };
 GridNormals computeGridNormals(const GridIndex& index, double c, const ClusterOptions& opt, int threads);
+
+/// The median angle between the normals of neighbouring low-curvature events
+/// [deg] (growing's neighbourhood), over the pairs of about 4000 sampled
+/// events: what noise alone gives on one edge's surface, since most pairs lie
+/// on one edge. NaN without such pairs.
+double medianNeighbourAngleDeg(const GridIndex& index, double c, const ClusterOptions& opt,
+                               const GridNormals& normals);
+
+/// The angle the grower uses [deg]: smoothness_deg, or with
+/// smoothness_noise_factor > 0 that factor times medianNeighbourAngleDeg,
+/// within [min(smoothness_min_deg, smoothness_deg), smoothness_deg].
+double growingAngleDeg(const GridIndex& index, double c, const ClusterOptions& opt, const GridNormals& normals);
 
 /// Own region grower on the grid index; normals computed here with `threads`
 /// workers unless given (then they are consumed).

@@ -23,6 +23,11 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
           o.normal_reuse_px);
   v.field({"min_neighbours", "events", "grid: fewer neighbours -> no normal"}, o.min_neighbours);
   v.field({"smoothness_deg", "deg", "max angle between neighbouring normals"}, o.smoothness_deg);
+  v.field({"smoothness_noise_factor", "-",
+           "grid: the angle is this times the window's median angle between neighbouring normals, within "
+           "[smoothness_min_deg, smoothness_deg] (0 = smoothness_deg)"},
+          o.smoothness_noise_factor);
+  v.field({"smoothness_min_deg", "deg", "grid: ... at least this"}, o.smoothness_min_deg);
   v.field({"curvature_threshold", "-", "max curvature of a point grown from (0..1/3)"}, o.curvature_threshold);
   v.field({"min_cluster_size", "events", "smaller clusters are dropped"}, o.min_cluster_size);
   v.field({"max_cluster_size", "events", "larger regions are not clusters"}, o.max_cluster_size);

@@ -70,6 +70,13 @@ struct ClusterOptions {
 
   // Region growing.
   double smoothness_deg = 20.0;       ///< max angle between neighbouring normals [deg]
+  /// Grid: the angle used is smoothness_noise_factor x the window's median
+  /// angle between neighbouring normals (what noise alone gives), within
+  /// [smoothness_min_deg, smoothness_deg]: on clean events a looser angle lets
+  /// regions cross where two edges meet (docs/clustering.md, "The smoothness
+  /// angle"); 0 = smoothness_deg always.
+  double smoothness_noise_factor = 3.0;  ///< [-]
+  double smoothness_min_deg = 3.0;       ///< [deg]
   double curvature_threshold = 0.15;  ///< max curvature of a point grown from [-] (0..1/3)
   int min_cluster_size = 60;          ///< [events]
   int max_cluster_size = 2000000;     ///< [events]
@@ -126,6 +133,9 @@ struct ClusterResult {
   int n_events = 0, n_clustered = 0;
   int n_regions = 0;               ///< regions grown before the checks
   int n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
+  /// The smoothness angle the growing used [deg] (the larger of the polarities'
+  /// with separate_polarity; ClusterOptions::smoothness_noise_factor).
+  double smoothness_deg = 0.0;
   double t0 = 0.0;                 ///< time origin of c*t [s] (first event)
   /// Timings [ms]: grid index + time scale estimate, normals, growing, checks,
   /// whole call (per-group phases summed over the groups, which may run in parallel).
