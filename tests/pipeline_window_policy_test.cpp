@@ -262,7 +262,8 @@ TEST(WindowPolicy, ProbeBudgetGrowsPastMaxSeconds) {
 // length) and the joined window stays within the longest one: it would be
 // `degenerate` (no_parallax) on its own.
 TEST(WindowPolicy, JoinerJoinsARestTooShortToShowParallax) {
-  ParallaxWindowOptions o;  // 25 px, no_parallax 15 px, 0.05 .. 0.3 s, steps of 0.025 s
+  ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s, steps of 0.025 s
+  o.no_parallax_px = 15.0;   // the arithmetic below (the default is 7 px)
   auto windows = [&](std::size_t n) {
     TempDir d;
     const auto ev = celc::test::randomEvents(n, 240, 180, 5, 1.0);  // 10 +- 6 us apart

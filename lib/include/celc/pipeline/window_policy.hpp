@@ -39,7 +39,7 @@ struct ParallaxWindowOptions {
   /// A window grown to its longest (max_seconds, or slow_turn_max_seconds
   /// where the camera turns slowly) with D below this [px] is degenerate
   /// (no_parallax) for every method; between it and target_px it is solved.
-  double no_parallax_px = 15.0;
+  double no_parallax_px = 7.0;
   double min_seconds = 0.05;   ///< first (shortest) window tried [s]
   double max_seconds = 0.3;    ///< longest window [s]; see no_parallax_px and the next two
   /// A window that turns slowly may grow past max_seconds, up to this [s]:
