@@ -176,6 +176,31 @@ TEST(WindowPolicy, JoinerShrinksWhenTheMotionSpeedsUp) {
   EXPECT_GE(joiner.translationPx(), o.target_px);
 }
 
+// A length is probed once per window: the room at 4 m/s shrinks a warm start
+// of 0.075 s (67.5 px) to 0.05 s (22.3 px: D is not linear in the length
+// there) and grows back to 0.075 s, whose D it already has.
+TEST(WindowPolicy, JoinerProbesEachLengthOnce) {
+  StepStream stream(30000);  // ~0.3 s from t = 1 s
+  WindowSource& source = *stream.source;
+  ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s, steps of 0.025 s
+  std::vector<double> probed;
+  ParallaxWindowJoiner joiner(source, o, 0.5, [&](double t0, double t1, const std::vector<Event>&) {
+    probed.push_back(t1 - t0);
+    if (t0 < 1.05) return 400.0 * (t1 - t0);  // the first window: 20 px at 0.05 s, 30 px at 0.075 s
+    return t1 - t0 < 0.06 ? 22.3 : 67.5;      // the second: the room's two lengths
+  });
+  EventWindow w;
+  ASSERT_TRUE(joiner.next(w));
+  EXPECT_NEAR(w.t1 - w.t0, 0.075, 1e-9);
+  ASSERT_EQ(probed.size(), 2u);
+  ASSERT_TRUE(joiner.next(w));  // 0.075 s: 67.5 px, shrunk to 0.05 s: 22.3 px, back to 0.075 s
+  EXPECT_NEAR(w.t1 - w.t0, 0.075, 1e-9);
+  EXPECT_NEAR(joiner.translationPx(), 67.5, 1e-12);
+  ASSERT_EQ(probed.size(), 4u);  // 0.075 s measured once
+  EXPECT_NEAR(probed[2], 0.075, 1e-9);
+  EXPECT_NEAR(probed[3], 0.05, 1e-9);
+}
+
 // A probe that finds no D on a longer window (fast motion ends the clusters
 // early, or its subsample is too sparse to cluster) does not grow the window
 // to max_seconds: after a finite D the window keeps the length aimed at from
@@ -198,7 +223,7 @@ TEST(WindowPolicy, JoinerStopsGrowingWhenALongerWindowCannotBeMeasured) {
   ASSERT_EQ(probed.size(), 2u);
   ASSERT_TRUE(joiner.next(w));  // warm start at 0.125 s: no D, so from 0.05 s again
   EXPECT_NEAR(w.t1 - w.t0, 0.125, 1e-9);
-  ASSERT_EQ(probed.size(), 5u);
+  ASSERT_EQ(probed.size(), 4u);  // 0.125 s, 0.05 s, then 0.125 s again from the first try
   EXPECT_NEAR(probed[2], 0.125, 1e-9);
   EXPECT_NEAR(probed[3], 0.05, 1e-9);
   // Never measurable: the window grows to max_seconds as before.

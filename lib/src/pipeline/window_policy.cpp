@@ -166,6 +166,9 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
   int steps = std::clamp(last_steps_, min_steps, longest);
   bool may_shrink = steps > min_steps;
   bool measured = false;  // a finite D on a shorter try of this window
+  // D of each length tried: a shrink followed by a grow can come back to a
+  // length already measured (the probe is seeded, so D would be the same).
+  std::vector<std::pair<int, double>> tried;
   translation_px_ = NAN;
   for (;;) {
     const int have = contiguousSteps(steps);
@@ -175,8 +178,14 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
       translation_px_ = NAN;
       break;
     }
-    join(steps, window);
-    translation_px_ = probe_(window.t0, window.t1, window.events);
+    const auto seen = std::find_if(tried.begin(), tried.end(), [&](const auto& x) { return x.first == steps; });
+    if (seen != tried.end()) {
+      translation_px_ = seen->second;
+    } else {
+      join(steps, window);
+      translation_px_ = probe_(window.t0, window.t1, window.events);
+      tried.emplace_back(steps, translation_px_);
+    }
     if (may_shrink && translation_px_ >= 2.0 * o_.target_px) {
       may_shrink = false;
       steps = std::max(min_steps, static_cast<int>(std::ceil(steps * o_.target_px / translation_px_ - 1e-9)));
