@@ -51,19 +51,37 @@ GridIndex::GridIndex(const Group& g) {
 namespace {
 
 /// Normal (eigenvector of the smallest eigenvalue) and curvature from the
-/// central moments of a neighbourhood; false when degenerate.
+/// central moments of a neighbourhood; false when degenerate. The eigenvalues
+/// of the symmetric A are q + 2 p cos(phi + 2 pi k / 3), with q = tr(A) / 3,
+/// p^2 = |A - q I|_F^2 / 6 and cos(3 phi) = det((A - q I) / p) / 2; the
+/// smallest one's eigenvector is orthogonal to every row of A - lambda_0 I,
+/// the largest cross product of two of them (a third of Eigen's
+/// computeDirect's time, which also finds the other two eigenvectors).
 bool normalFromCovariance(const Eigen::Matrix3d& cov, float* out_n, float* out_curv) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-  es.computeDirect(cov);
-  const Eigen::Vector3d ev = es.eigenvalues();  // ascending
-  const double sum = ev.sum();
+  const double a = cov(0, 0), b = cov(1, 1), c = cov(2, 2), d = cov(0, 1), e = cov(1, 2), f = cov(0, 2);
+  const double sum = a + b + c, q = sum / 3.0;
+  const double off = d * d + e * e + f * f;
+  const double p = std::sqrt(((a - q) * (a - q) + (b - q) * (b - q) + (c - q) * (c - q) + 2.0 * off) / 6.0);
   // Degenerate: all points on one spot or one line (e.g. a single hot pixel).
-  if (!(sum > 1e-9) || ev(1) < 1e-3 * sum || ev(1) < 1e-4) return false;
-  const Eigen::Vector3d nrm = es.eigenvectors().col(0);
+  if (!(sum > 1e-9) || !(p > 0.0)) return false;
+  const double ba = (a - q) / p, bb = (b - q) / p, bc = (c - q) / p, bd = d / p, be = e / p, bf = f / p;
+  const double det = ba * (bb * bc - be * be) - bd * (bd * bc - be * bf) + bf * (bd * be - bb * bf);
+  const double phi = std::acos(std::clamp(0.5 * det, -1.0, 1.0)) / 3.0;
+  const double l2 = q + 2.0 * p * std::cos(phi);                     // largest
+  const double l0 = q + 2.0 * p * std::cos(phi + 2.0 * M_PI / 3.0);  // smallest
+  const double l1 = sum - l0 - l2;
+  if (l1 < 1e-3 * sum || l1 < 1e-4) return false;
+  const Eigen::Vector3d r0(a - l0, d, f), r1(d, b - l0, e), r2(f, e, c - l0);
+  const Eigen::Vector3d c01 = r0.cross(r1), c02 = r0.cross(r2), c12 = r1.cross(r2);
+  const double n01 = c01.squaredNorm(), n02 = c02.squaredNorm(), n12 = c12.squaredNorm();
+  const Eigen::Vector3d& best = n01 >= n02 && n01 >= n12 ? c01 : (n02 >= n12 ? c02 : c12);
+  const double norm2 = std::max({n01, n02, n12});
+  if (!(norm2 > 0.0)) return false;
+  const Eigen::Vector3d nrm = best / std::sqrt(norm2);
   out_n[0] = static_cast<float>(nrm(0));
   out_n[1] = static_cast<float>(nrm(1));
   out_n[2] = static_cast<float>(nrm(2));
-  *out_curv = static_cast<float>(std::max(0.0, ev(0)) / sum);
+  *out_curv = static_cast<float>(std::max(0.0, l0) / sum);
   return true;
 }
 

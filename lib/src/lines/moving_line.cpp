@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace celc::detail {
@@ -61,37 +62,53 @@ FittedLine fitMovingLine(const std::vector<double>& times, const DerotatedEvents
   for (std::size_t j = begin; j < end; ++j) reach = std::max(reach, std::fabs(times[j] - t_line));
   const double scale = reach > 0.0 ? 1.0 / reach : 0.0;
 
-  std::vector<double> weight(n, 1.0), residual(n, 0.0), abs_residual(n);
+  // Per event: its time s in those units and the six products of g, so that
+  // M = sum w [g g^T, s g g^T; s g g^T, s^2 g g^T] is three weighted sums of them.
+  std::vector<double> s(n), weight(n, 1.0), d2(n), abs_residual(n);
+  std::vector<std::array<double, 6>> gg(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& g = ev.g[begin + i];
+    s[i] = (times[begin + i] - t_line) * scale;
+    gg[i] = {g.x() * g.x(), g.x() * g.y(), g.x() * g.z(), g.y() * g.y(), g.y() * g.z(), g.z() * g.z()};
+  }
+  auto symmetric = [](const std::array<double, 6>& u) {
+    Mat3 m;
+    m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
+    return m;
+  };
   Vec6 x = Vec6::Zero();
   double sigma = 0.0;
   constexpr int kIterations = 6;
   for (int it = 0; it < kIterations; ++it) {
-    Mat6 M = Mat6::Zero();
-    for (std::size_t j = begin; j < end; ++j) {
-      Vec6 a;
-      a.head<3>() = ev.g[j];
-      a.tail<3>() = (times[j] - t_line) * scale * ev.g[j];
-      M.selfadjointView<Eigen::Lower>().rankUpdate(a, weight[j - begin]);
+    std::array<double, 6> a{}, b{}, c{};
+    for (std::size_t i = 0; i < n; ++i) {
+      const double w0 = weight[i], w1 = w0 * s[i], w2 = w1 * s[i];
+      for (int k = 0; k < 6; ++k) {
+        a[k] += w0 * gg[i][k];
+        b[k] += w1 * gg[i][k];
+        c[k] += w2 * gg[i][k];
+      }
     }
-    M = M.selfadjointView<Eigen::Lower>();
+    Mat6 M;
+    M.topLeftCorner<3, 3>() = symmetric(a);
+    M.topRightCorner<3, 3>() = M.bottomLeftCorner<3, 3>() = symmetric(b);
+    M.bottomRightCorner<3, 3>() = symmetric(c);
     x = solveConstrained(M);
     // Pixel distances to the line at each event's time; Huber weights over
     // the squared normaliser turn the algebraic fit into a geometric one.
-    for (std::size_t j = begin; j < end; ++j) {
-      const Vec3 nt = x.head<3>() + (times[j] - t_line) * scale * x.tail<3>();
-      const double d2 = std::max(nt.squaredNorm() - std::pow(nt.dot(ev.z[j]), 2), 1e-300);
-      residual[j - begin] = focal_px * nt.dot(ev.g[j]) / std::sqrt(d2);
-      abs_residual[j - begin] = std::fabs(residual[j - begin]);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 nt = x.head<3>() + s[i] * x.tail<3>();
+      d2[i] = std::max(nt.squaredNorm() - std::pow(nt.dot(ev.z[begin + i]), 2), 1e-300);
+      abs_residual[i] = std::fabs(focal_px * nt.dot(ev.g[begin + i]) / std::sqrt(d2[i]));
+      weight[i] = abs_residual[i];  // the residual until the scale is known
     }
     auto mid = abs_residual.begin() + static_cast<std::ptrdiff_t>(n / 2);
     std::nth_element(abs_residual.begin(), mid, abs_residual.end());
     sigma = 1.4826 * *mid;
     const double k = 1.345 * std::max(sigma, 0.05);
-    for (std::size_t j = begin; j < end; ++j) {
-      const Vec3 nt = x.head<3>() + (times[j] - t_line) * scale * x.tail<3>();
-      const double d2 = std::max(nt.squaredNorm() - std::pow(nt.dot(ev.z[j]), 2), 1e-300);
-      const double r = std::fabs(residual[j - begin]);
-      weight[j - begin] = (r <= k ? 1.0 : k / r) / d2;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = weight[i];
+      weight[i] = (r <= k ? 1.0 : k / r) / d2[i];
     }
   }
   const Vec3 n0 = x.head<3>();
