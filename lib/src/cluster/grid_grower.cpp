@@ -55,8 +55,8 @@ namespace {
 /// of the symmetric A are q + 2 p cos(phi + 2 pi k / 3), with q = tr(A) / 3,
 /// p^2 = |A - q I|_F^2 / 6 and cos(3 phi) = det((A - q I) / p) / 2; the
 /// smallest one's eigenvector is orthogonal to every row of A - lambda_0 I,
-/// the largest cross product of two of them (a third of Eigen's
-/// computeDirect's time, which also finds the other two eigenvectors).
+/// the largest cross product of two of them (Eigen's computeDirect also
+/// finds the other two eigenvectors, which the grower does not use).
 bool normalFromCovariance(const Eigen::Matrix3d& cov, float* out_n, float* out_curv) {
   const double a = cov(0, 0), b = cov(1, 1), c = cov(2, 2), d = cov(0, 1), e = cov(1, 2), f = cov(0, 2);
   const double sum = a + b + c, q = sum / 3.0;
