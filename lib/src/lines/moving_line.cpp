@@ -64,7 +64,7 @@ FittedLine fitMovingLine(const std::vector<double>& times, const DerotatedEvents
 
   // Per event: its time s in those units and the six products of g, so that
   // M = sum w [g g^T, s g g^T; s g g^T, s^2 g g^T] is three weighted sums of them.
-  std::vector<double> s(n), weight(n, 1.0), d2(n), abs_residual(n);
+  std::vector<double> s(n), weight(n, 1.0), d2(n), abs_residual(n), scratch(n);
   std::vector<std::array<double, 6>> gg(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3& g = ev.g[begin + i];
@@ -100,14 +100,14 @@ FittedLine fitMovingLine(const std::vector<double>& times, const DerotatedEvents
       const Vec3 nt = x.head<3>() + s[i] * x.tail<3>();
       d2[i] = std::max(nt.squaredNorm() - std::pow(nt.dot(ev.z[begin + i]), 2), 1e-300);
       abs_residual[i] = std::fabs(focal_px * nt.dot(ev.g[begin + i]) / std::sqrt(d2[i]));
-      weight[i] = abs_residual[i];  // the residual until the scale is known
     }
-    auto mid = abs_residual.begin() + static_cast<std::ptrdiff_t>(n / 2);
-    std::nth_element(abs_residual.begin(), mid, abs_residual.end());
+    scratch = abs_residual;  // the median reorders its input
+    auto mid = scratch.begin() + static_cast<std::ptrdiff_t>(n / 2);
+    std::nth_element(scratch.begin(), mid, scratch.end());
     sigma = 1.4826 * *mid;
     const double k = 1.345 * std::max(sigma, 0.05);
     for (std::size_t i = 0; i < n; ++i) {
-      const double r = weight[i];
+      const double r = abs_residual[i];
       weight[i] = (r <= k ? 1.0 : k / r) / d2[i];
     }
   }
