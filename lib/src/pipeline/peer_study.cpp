@@ -83,12 +83,7 @@ std::string PeerStudyConfig::validate() const {
   return e;
 }
 
-namespace {
-
-
-
-
-std::uint32_t cellHash(const PeerCell& c) {
+std::uint32_t peerCellKey(const PeerCell& c) {
   std::ostringstream k;
   k << c.speed << "|" << c.sigma_px << "|" << c.omega_error_deg_s << "|" << c.lines << "|"
     << c.events_per_line << "|" << c.outliers;
@@ -96,8 +91,6 @@ std::uint32_t cellHash(const PeerCell& c) {
   for (char ch : k.str()) h = (h ^ static_cast<unsigned char>(ch)) * 16777619u;
   return h;
 }
-
-}  // namespace
 
 std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
                                          const PeerStudyConfig& config, int threads,
@@ -108,7 +101,7 @@ std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,
   constexpr double kDeg = 180.0 / M_PI;
 
   StudyPlan plan;
-  for (const PeerCell& cell : cells) plan.cells.push_back({cellHash(cell)});
+  for (const PeerCell& cell : cells) plan.cells.push_back({peerCellKey(cell)});
   plan.trials = n_trials;
   plan.methods = n_methods;
   plan.seed = config.seed;

@@ -33,6 +33,13 @@ bool rejectInput(const WindowObservations& obs, const MotionModel& motion,
   return false;
 }
 
+double impliedNullspaceSigmaDeg(double sigma_min, double sigma_second, int rows) {
+  if (!(sigma_second > 0.0)) return HUGE_VAL;
+  const double ratio = sigma_min / sigma_second;
+  const double gap = rows * (1.0 / (ratio * ratio) - 1.0);
+  return gap > 0.0 ? 180.0 / M_PI / std::sqrt(gap) : HUGE_VAL;
+}
+
 SolverResult nullspaceResult(const NullspaceSolution& ns, const WindowObservations& obs,
                              const MotionModel& motion, const LinearOptions& opt, int rows,
                              const WindowFrames& frames) {
@@ -43,11 +50,9 @@ SolverResult nullspaceResult(const NullspaceSolution& ns, const WindowObservatio
   r.iterations = ns.iterations;
   r.rows_used = rows;
   r.residual_px = ns.scale * obs.focal_px;
-  // Direction standard deviation implied by the gap (options.hpp) [deg].
   const double ratio = ns.sigma_second > 0.0 ? ns.sigma_min / ns.sigma_second : 1.0;
-  const double gap = rows * (1.0 / (ratio * ratio) - 1.0);
-  const double implied_deg = gap > 0.0 ? 180.0 / M_PI / std::sqrt(gap) : HUGE_VAL;
-  if (ns.sigma_second <= 0.0 || !(implied_deg <= opt.max_nullspace_sigma_deg)) {
+  const double implied_deg = impliedNullspaceSigmaDeg(ns.sigma_min, ns.sigma_second, rows);
+  if (!(implied_deg <= opt.max_nullspace_sigma_deg)) {
     r.status = SolveStatus::Degenerate;
     r.degeneracy = Degeneracy::NullspaceNotUnique;
     r.message = "two smallest singular values too close (ratio " + std::to_string(ratio) + " over " +

@@ -18,6 +18,12 @@ SolverResult failure(SolveStatus status, Degeneracy reason, std::string message)
 bool rejectInput(const WindowObservations& obs, const MotionModel& motion,
                  const LinearOptions& options, SolverResult& result);
 
+/// The direction standard deviation [deg] that a linear result's two smallest
+/// singular values imply over its rows_used rows (options.hpp,
+/// max_nullspace_sigma_deg): 1 / sqrt(n (sigma_second^2 / sigma_min^2 - 1));
+/// +inf when they are equal or sigma_second is not positive.
+double impliedNullspaceSigmaDeg(double sigma_min, double sigma_second, int rows);
+
 /// The result of a nullspace solution over `rows` rows: Failed when it did not
 /// converge; Degenerate (NullspaceNotUnique) when
 /// the direction std the singular values imply exceeds

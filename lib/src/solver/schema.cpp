@@ -22,6 +22,10 @@ void describe(FieldVisitor& v, LinearOptions& o) {
   v.field({"max_nullspace_sigma_deg", "deg",
            "degenerate when the two smallest singular values imply a direction std above this"},
           o.max_nullspace_sigma_deg);
+  v.field({"answer_when_observable", "",
+           "answer such an ambiguous nullspace when the events' bound at its direction is below that std "
+           "(sigma_deg then at least the rows' std)"},
+          o.answer_when_observable);
   v.field({"min_parallax_ratio", "-", "static-line / moving-line residual below this -> no parallax"},
           o.min_parallax_ratio);
   v.field({"min_parallax_px", "px", "and the static-line residual must exceed this"}, o.min_parallax_px);

@@ -2,6 +2,7 @@
 // then every requested method (celc computed once for the methods it starts).
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "ce3lc.hpp"
@@ -11,6 +12,7 @@
 #include "celc_linear.hpp"
 #include "celc_ml.hpp"
 #include "constraint_rows.hpp"
+#include "linear_method.hpp"
 #include "refine.hpp"
 #include "sign_test.hpp"
 #include "stopwatch.hpp"
@@ -35,6 +37,32 @@ void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResu
     if (angle_deg > 2.0 * std::hypot(sigma, witnesses[j].sigma_deg)) raised = std::max(raised, angle_deg);
   }
   r.sigma_deg = raised;
+}
+
+/// LinearOptions::answer_when_observable: a linear method's ambiguous
+/// nullspace becomes an answer when the events' bound at its direction (unit
+/// method scale) is within max_nullspace_sigma_deg; its sign is then resolved.
+/// Returns the std the rows imply [deg], the floor of the answer's sigma_deg,
+/// or 0 when `r` is left as it was.
+double answerIfObservable(const WindowObservations& obs, const MotionModel& motion, const LinearOptions& opt,
+                          int bound_events, const detail::WindowFrames& frames, SolverResult& r) {
+  if (r.degeneracy != Degeneracy::NullspaceNotUnique || !r.v.allFinite() || !(r.v.norm() > 0.5)) return 0.0;
+  const auto t0 = detail::Clock::now();
+  const double bound_deg = directionSigmaDeg(obs, motion, r.v, 1.0, bound_events);
+  r.time_us += detail::microsecondsSince(t0);
+  if (!(bound_deg <= opt.max_nullspace_sigma_deg)) return 0.0;
+  const double rows_deg = detail::impliedNullspaceSigmaDeg(r.sigma_min, r.sigma_second, r.rows_used);
+  if (opt.resolve_sign) {
+    const SignDecision s = detail::resolveSign(obs, motion, r.v, frames);
+    r.v *= s.sign;
+    r.sign_margin = s.margin * s.sign;
+  }
+  r.time_us += detail::microsecondsSince(t0);
+  r.status = SolveStatus::Ok;
+  r.degeneracy = Degeneracy::None;
+  r.message = "ambiguous nullspace (the rows imply a direction std of " + std::to_string(rows_deg) +
+              " deg) answered: the events' bound there is " + std::to_string(bound_deg) + " deg";
+  return std::isfinite(rows_deg) ? rows_deg : 180.0;
 }
 
 /// Seeds celc_opt's further starts (RefineOptions::starts): subset k's seed is
@@ -173,9 +201,14 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       }
     }
   }
+  const UncertaintyOptions& u = options.uncertainty;
+  // The linear methods' ambiguous verdicts checked against the events' bound.
+  std::vector<double> sigma_floor_deg(out.size(), 0.0);
+  for (size_t i = 0; i < out.size(); ++i)
+    if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc))
+      sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, u.max_events, frames, out[i]);
   // What every method shares (the window's verdict), and each estimate's
   // uncertainty at its own direction.
-  const UncertaintyOptions& u = options.uncertainty;
   for (size_t i = 0; i < out.size(); ++i) {
     SolverResult& r = out[i];
     r.parallax = window.parallax;
@@ -190,7 +223,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
     }
-    r.sigma_deg = directionSigmaDeg(obs, motion, r.v, scale, u.max_events);
+    r.sigma_deg = std::max(directionSigmaDeg(obs, motion, r.v, scale, u.max_events), sigma_floor_deg[i]);
   }
   if (!u.enabled || !u.agreement) return out;
   // The witnesses: the ok estimates of the celc family with their Fisher

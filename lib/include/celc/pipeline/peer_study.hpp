@@ -41,6 +41,11 @@ struct PeerCell {
 /// The study's cells, in output order.
 std::vector<PeerCell> peerStudyCells();
 
+/// The cell's key in the study's seeding (pipeline/study_engine.hpp): trial i
+/// of a cell draws its scene from trialRng(seed, {peerCellKey(cell)}, i), then
+/// the seed of its linear rows from the same generator.
+std::uint32_t peerCellKey(const PeerCell& cell);
+
 /// One CSV row: a cell and a method.
 struct PeerCellResult {
   PeerCell cell;

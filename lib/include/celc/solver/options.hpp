@@ -45,6 +45,16 @@ struct LinearOptions {
   /// 1 / sqrt(n (sigma_second^2 / sigma_min^2 - 1)) [rad]: a fixed ratio would
   /// call a window with many events degenerate though it fixes v well.
   double max_nullspace_sigma_deg = 30.0;
+  /// An ambiguous nullspace (above) is still answered when the window's
+  /// events fix the direction: the bound at the ambiguous direction
+  /// (direction_information.hpp: Fisher information of every event with the
+  /// lines as nuisance, at the residuals' robust scale) is at most
+  /// max_nullspace_sigma_deg. These rows then determine v poorly although the
+  /// data do not, so the answer's sigma_deg is at least the std the rows imply.
+  /// A step of solveMethods (the standalone solveCelcLinear / solveCe3lc give
+  /// the rows' own verdict). Off: such a window is degenerate
+  /// (nullspace_not_unique) for the method.
+  bool answer_when_observable = true;
   /// A cluster shows parallax when its events, rotation-compensated, are this
   /// many times farther from one static line than from a line moving linearly
   /// in time (robust scales); fewer than min_clusters such clusters -> degenerate.

@@ -58,7 +58,10 @@ struct SampleSeeds {
 /// point), the window checks run once, and the
 /// clusters' frames are computed once and shared by every method and sign test.
 /// npt's sign is resolved with resolveSign when options.linear.resolve_sign.
-/// Results are in the order of `methods`.
+/// celc's and ce3lc's ambiguous nullspaces are then answered where the
+/// events fix the direction (LinearOptions::answer_when_observable). Every ok
+/// result gets its sigma_deg (UncertaintyOptions). Results are in the order
+/// of `methods`.
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options, const SampleSeeds& seeds);
