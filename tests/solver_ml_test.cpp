@@ -30,13 +30,42 @@ namespace {
 
 constexpr double kDeg = 180.0 / M_PI;
 
-PeerSceneTrial peerTrial(std::uint64_t seed, double speed, double sigma, int events) {
+/// A cell of the peers' scene: V [m/s], pixel noise [px], events per line.
+PeerSceneOptions peerCell(double speed, double sigma, int events = 200) {
   PeerSceneOptions o;
   o.speed = speed;
   o.event_noise_px = sigma;
   o.events_per_line = events;
+  return o;
+}
+
+/// A trial as `celc solve` sees it (peer_solve_path.hpp): the scene, the
+/// constant twist it solves with and its observations.
+struct SolvePathTrial {
+  PeerSceneTrial scene;
+  MotionModel motion;
+  WindowObservations obs;
+};
+
+/// n trials of a cell drawn from one generator of the given seed; a trial
+/// the scene could not generate is left out (the tests check the count).
+std::vector<SolvePathTrial> solvePathTrials(const PeerSceneOptions& cell, std::uint64_t seed,
+                                            const RunConfig& config, int n) {
   std::mt19937_64 rng(seed);
-  return generatePeerScene(o, rng);
+  std::vector<SolvePathTrial> out;
+  for (int t = 0; t < n; ++t) {
+    PeerSceneTrial tr = generatePeerScene(cell, rng);
+    if (!tr.ok) continue;
+    MotionModel motion = tr.given_motion;
+    WindowObservations obs = test::solvePathObservations(tr, config, motion);
+    out.push_back({std::move(tr), motion, std::move(obs)});
+  }
+  return out;
+}
+
+PeerSceneTrial peerTrial(std::uint64_t seed, double speed, double sigma, int events) {
+  std::mt19937_64 rng(seed);
+  return generatePeerScene(peerCell(speed, sigma, events), rng);
 }
 
 /// J at the truth against its median over a lattice: noise-free events fit
@@ -309,29 +338,24 @@ TEST(CelcMl, AnswersWhenTheLinearStageIsAmbiguous) {
   defaults.solver.linear.tukey_k = 0.0;
   defaults.solver.linear.answer_when_observable = false;  // celc's verdict as the linear stage gives it
   const std::vector<Method> methods{Method::Celc, Method::CelcMl};
-  PeerSceneOptions o;
-  o.speed = 1.0;
-  o.event_noise_px = 1.0;
-  std::mt19937_64 rng(4242);
-  int linear_failed = 0, ml_ok = 0, trials = 0, ml_far = 0;
-  for (int t = 0; t < 100; ++t) {
-    const PeerSceneTrial tr = generatePeerScene(o, rng);
-    ASSERT_TRUE(tr.ok) << tr.message;
-    ++trials;
-    MotionModel motion = tr.given_motion;
-    const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
-    const auto res = solveMethods(obs, motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
+  const std::vector<SolvePathTrial> trials = solvePathTrials(peerCell(1.0, 1.0), 4242, defaults, 100);
+  ASSERT_EQ(trials.size(), 100u);
+  int linear_failed = 0, ml_ok = 0, ml_far = 0;
+  for (size_t t = 0; t < trials.size(); ++t) {
+    const SolvePathTrial& tr = trials[t];
+    const auto res =
+        solveMethods(tr.obs, tr.motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
     if (res[1].ok()) ++ml_ok;
     if (!res[0].ok()) {
       ++linear_failed;
       EXPECT_EQ(res[0].degeneracy, Degeneracy::NullspaceNotUnique) << "trial " << t << ": " << res[0].message;
       ASSERT_TRUE(res[1].ok()) << "trial " << t << ": " << res[1].message;
-      ml_far += angleBetweenSignAgnostic(res[1].v, tr.true_direction) > 30.0 * M_PI / 180.0;
+      ml_far += angleBetweenSignAgnostic(res[1].v, tr.scene.true_direction) > 30.0 * M_PI / 180.0;
     }
   }
   EXPECT_GE(linear_failed, 1);
   EXPECT_LE(ml_far, 2) << "of " << linear_failed << " ambiguous trials";
-  EXPECT_EQ(ml_ok, trials);
+  EXPECT_EQ(ml_ok, 100);
 }
 
 // celc_opt refines from an ambiguous linear nullspace and resolves the sign
@@ -358,23 +382,18 @@ TEST(CelcOpt, AnswersWhenTheLinearStageIsAmbiguous) {
   const size_t celc = index(Method::Celc), opt = index(Method::CelcOpt);
   ASSERT_LT(celc, methods.size());
   ASSERT_LT(opt, methods.size());
-  PeerSceneOptions o;
-  o.speed = 2.0;
-  o.event_noise_px = 1.0;
-  o.events_per_line = 20;
-  std::mt19937_64 rng(4242);
+  const std::vector<SolvePathTrial> trials = solvePathTrials(peerCell(2.0, 1.0, 20), 4242, defaults, 100);
+  ASSERT_EQ(trials.size(), 100u);
   int ambiguous = 0, opt_ok = 0, beyond_sigma = 0;
-  for (int t = 0; t < 100; ++t) {
-    const PeerSceneTrial tr = generatePeerScene(o, rng);
-    ASSERT_TRUE(tr.ok) << tr.message;
-    MotionModel motion = tr.given_motion;
-    const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
-    const auto res = solveMethods(obs, motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
+  for (size_t t = 0; t < trials.size(); ++t) {
+    const SolvePathTrial& tr = trials[t];
+    const auto res =
+        solveMethods(tr.obs, tr.motion, methods, defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
     opt_ok += res[opt].ok();
     if (res[celc].degeneracy != Degeneracy::NullspaceNotUnique) continue;
     ++ambiguous;
     ASSERT_TRUE(res[opt].ok()) << "trial " << t << ": " << res[opt].message;
-    const double angle_deg = angleBetween(res[opt].v, tr.true_direction) * 180.0 / M_PI;
+    const double angle_deg = angleBetween(res[opt].v, tr.scene.true_direction) * 180.0 / M_PI;
     beyond_sigma += !(angle_deg <= 2.0 * res[opt].sigma_deg);
   }
   EXPECT_GE(ambiguous, 3);
@@ -393,18 +412,13 @@ TEST(CelcOpt, AnswersWhenTheLinearStageIsAmbiguous) {
 TEST(Ce3lc, AnswersAnAmbiguousNullspaceWhenTheEventsFixTheDirection) {
   RunConfig defaults;
   const std::vector<Method> methods{Method::Ce3lc};
-  PeerSceneOptions o;
-  o.speed = 1.0;
-  o.event_noise_px = 1.0;
-  std::mt19937_64 rng(4242);
+  const std::vector<SolvePathTrial> trials = solvePathTrials(peerCell(1.0, 1.0), 4242, defaults, 100);
+  ASSERT_EQ(trials.size(), 100u);
   int ok = 0, answered = 0, beyond_sigma = 0, degenerate_when_off = 0;
-  for (int t = 0; t < 100; ++t) {
-    const PeerSceneTrial tr = generatePeerScene(o, rng);
-    ASSERT_TRUE(tr.ok) << tr.message;
-    MotionModel motion = tr.given_motion;
-    const WindowObservations obs = test::solvePathObservations(tr, defaults, motion);
+  for (size_t t = 0; t < trials.size(); ++t) {
+    const SolvePathTrial& tr = trials[t];
     const SampleSeeds seeds{defaults.seed, defaults.seed};
-    const SolverResult r = solveMethods(obs, motion, methods, defaults.solver, seeds)[0];
+    const SolverResult r = solveMethods(tr.obs, tr.motion, methods, defaults.solver, seeds)[0];
     ok += r.ok();
     if (r.message.rfind("ambiguous nullspace", 0) != 0) continue;
     ++answered;
@@ -413,10 +427,10 @@ TEST(Ce3lc, AnswersAnAmbiguousNullspaceWhenTheEventsFixTheDirection) {
     const double rows_deg = 180.0 / M_PI / std::sqrt(r.rows_used * (1.0 / (ratio * ratio) - 1.0));
     EXPECT_GT(rows_deg, defaults.solver.linear.max_nullspace_sigma_deg) << "trial " << t;
     EXPECT_GE(r.sigma_deg, rows_deg) << "trial " << t;
-    beyond_sigma += !(angleBetween(r.v, tr.true_direction) * 180.0 / M_PI <= 2.0 * r.sigma_deg);
+    beyond_sigma += !(angleBetween(r.v, tr.scene.true_direction) * 180.0 / M_PI <= 2.0 * r.sigma_deg);
     SolverOptions off = defaults.solver;
     off.linear.answer_when_observable = false;
-    degenerate_when_off += solveMethods(obs, motion, methods, off, seeds)[0].degeneracy ==
+    degenerate_when_off += solveMethods(tr.obs, tr.motion, methods, off, seeds)[0].degeneracy ==
                            Degeneracy::NullspaceNotUnique;
   }
   EXPECT_GE(answered, 3);
@@ -550,10 +564,7 @@ TEST(CelcOpt, FurtherStartsKeepTheLowerCostMinimum) {
   one.solver.refine.starts = 1;
   RunConfig four = one;
   four.solver.refine.starts = 4;
-  PeerSceneOptions o;
-  o.speed = 2.0;
-  o.event_noise_px = 1.0;
-  o.events_per_line = 1000;
+  const PeerSceneOptions o = peerCell(2.0, 1.0, 1000);
   std::mt19937_64 rng(4243);
   int lowered = 0, raised = 0, far1 = 0, far4 = 0;
   std::vector<double> e1, e4;
