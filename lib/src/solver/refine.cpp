@@ -16,6 +16,30 @@ namespace detail {
 
 namespace {
 constexpr size_t kChunk = 256;  // events per residual block
+
+/// The event terms of this thread's refinements, kept between calls:
+/// allocated per call, their pages were mapped afresh every time (page
+/// faults were a quarter of a refinement's time on a virtual machine).
+std::vector<EventTerm>& threadTerms() {
+  thread_local std::vector<EventTerm> buffer;
+  return buffer;
+}
+
+/// Holds the thread's buffer for one call and gives it back (with whatever
+/// capacity it grew to) on every return.
+class BorrowedTerms {
+ public:
+  BorrowedTerms() {
+    terms.swap(threadTerms());
+    terms.clear();
+  }
+  ~BorrowedTerms() {
+    if (terms.capacity() > threadTerms().capacity()) terms.swap(threadTerms());
+  }
+  BorrowedTerms(const BorrowedTerms&) = delete;
+  BorrowedTerms& operator=(const BorrowedTerms&) = delete;
+  std::vector<EventTerm> terms;
+};
 }  // namespace
 
 SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& motion,
@@ -46,8 +70,15 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     m1[i] = frames[usable[i]].m1.normalized();
     m3[i] = frames[usable[i]].m3.normalized();
   }
-  // Per-event terms grouped by cluster (a seeded subset of each).
-  std::vector<std::vector<EventTerm>> terms(usable.size());
+  // Per-event terms grouped by cluster (a seeded subset of each): cluster
+  // ci's are terms[begin[ci], begin[ci + 1]). Declared before the problem,
+  // whose costs point into them.
+  BorrowedTerms borrowed;
+  std::vector<EventTerm>& terms = borrowed.terms;
+  size_t total = 0;
+  for (size_t q : quota) total += q;
+  terms.reserve(total);
+  std::vector<size_t> begin{0};
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
     for (size_t k : sampleIndices(cl.size(), quota[ci], event_seed + ci)) {
@@ -56,8 +87,9 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
       if (!f.allFinite() || !std::isfinite(t)) continue;
       const Mat3 Rk = motion.rotation(t), Pk = motion.positionMatrix(t);
       const EventTerm e = makeEventTerm(frames[usable[ci]], Rk, Pk, f);
-      if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms[ci].push_back(e);
+      if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms.push_back(e);
     }
+    begin.push_back(terms.size());
   }
 
   ceres::Problem::Options problem_options;
@@ -66,14 +98,11 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   ceres::SphereManifold<3> sphere;
   int n_res = 0;
   std::vector<EventChunkCost*> costs;
-  for (size_t c = 0; c < terms.size(); ++c) {
-    for (size_t b = 0; b < terms[c].size(); b += kChunk) {
-      std::vector<EventTerm> chunk(
-          terms[c].begin() + static_cast<long>(b),
-          terms[c].begin() + static_cast<long>(std::min(terms[c].size(), b + kChunk)));
-      n_res += static_cast<int>(chunk.size());
-      auto* cost = new EventChunkCost(std::move(chunk), obs.focal_px, opt.huber_px,
-                                              refine_lines);
+  for (size_t c = 0; c < usable.size(); ++c) {
+    for (size_t b = begin[c]; b < begin[c + 1]; b += kChunk) {
+      const size_t count = std::min(begin[c + 1], b + kChunk) - b;
+      n_res += static_cast<int>(count);
+      auto* cost = new EventChunkCost(terms.data() + b, count, obs.focal_px, opt.huber_px, refine_lines);
       costs.push_back(cost);
       if (refine_lines) {
         problem.AddResidualBlock(cost, nullptr, v.data(), m1[c].data(), m3[c].data());
@@ -120,9 +149,9 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
     const Vec3 huber_v = v, vh = v.normalized();
     std::vector<double> d;
     d.reserve(static_cast<size_t>(n_res));
-    for (size_t c = 0; c < terms.size(); ++c)
-      for (const EventTerm& e : terms[c])
-        d.push_back(eventDistance(e, vh, m1[c], m3[c], obs.focal_px, nullptr, nullptr, nullptr));
+    for (size_t c = 0; c < usable.size(); ++c)
+      for (size_t k = begin[c]; k < begin[c + 1]; ++k)
+        d.push_back(eventDistance(terms[k], vh, m1[c], m3[c], obs.focal_px, nullptr, nullptr, nullptr));
     const ResidualSpread spread = residualSpread(std::move(d));
     const double cauchy_px = spread.cauchyScale(opt.cauchy_scale, opt.cauchy_min_tail);
     if (cauchy_px > 0.0) {

@@ -60,13 +60,14 @@ inline double sqrtTukey(double d, double c, double* slope) {
   return d < 0 ? -r : r;
 }
 
-/// A chunk of one cluster's events. Parameters: v (3), and with joint lines
-/// also m1 (3), m3 (3) of the cluster.
+/// A chunk of one cluster's events: `count` terms from `first`, which must
+/// outlive the cost (they are not copied). Parameters: v (3), and with joint
+/// lines also m1 (3), m3 (3) of the cluster.
 class EventChunkCost final : public ceres::CostFunction {
  public:
-  EventChunkCost(std::vector<EventTerm> terms, double focal, double huber_px, bool joint)
-      : terms_(std::move(terms)), focal_(focal), huber_(huber_px), joint_(joint) {
-    set_num_residuals(static_cast<int>(terms_.size()));
+  EventChunkCost(const EventTerm* first, size_t count, double focal, double huber_px, bool joint)
+      : terms_(first), count_(count), focal_(focal), huber_(huber_px), joint_(joint) {
+    set_num_residuals(static_cast<int>(count_));
     mutable_parameter_block_sizes()->push_back(3);
     if (joint_) {
       mutable_parameter_block_sizes()->push_back(3);
@@ -90,7 +91,7 @@ class EventChunkCost final : public ceres::CostFunction {
     const Vec3 m1 = joint_ ? Vec3(Eigen::Map<const Vec3>(p[1])) : m1_;
     const Vec3 m3 = joint_ ? Vec3(Eigen::Map<const Vec3>(p[2])) : m3_;
     const bool want = jac != nullptr;
-    for (size_t i = 0; i < terms_.size(); ++i) {
+    for (size_t i = 0; i < count_; ++i) {
       Vec3 gv, g1, g3;
       const double d = eventDistance(terms_[i], v, m1, m3, focal_, want ? &gv : nullptr,
                                      want && joint_ ? &g1 : nullptr, want && joint_ ? &g3 : nullptr);
@@ -109,7 +110,8 @@ class EventChunkCost final : public ceres::CostFunction {
   }
 
  private:
-  std::vector<EventTerm> terms_;
+  const EventTerm* terms_;
+  size_t count_;
   double focal_, huber_;
   double cauchy_ = 0.0;  // > 0: the Cauchy loss replaces Huber
   double tukey_ = 0.0;   // > 0: Tukey's biweight replaces both
