@@ -49,8 +49,10 @@ double answerIfObservable(const WindowObservations& obs, const MotionModel& moti
   if (r.degeneracy != Degeneracy::NullspaceNotUnique || !r.v.allFinite() || !(r.v.norm() > 0.5)) return 0.0;
   const auto t0 = detail::Clock::now();
   const double bound_deg = directionSigmaDeg(obs, motion, r.v, 1.0, bound_events);
-  r.time_us += detail::microsecondsSince(t0);
-  if (!(bound_deg <= opt.max_nullspace_sigma_deg)) return 0.0;
+  if (!(bound_deg <= opt.max_nullspace_sigma_deg)) {
+    r.time_us += detail::microsecondsSince(t0);
+    return 0.0;
+  }
   const double rows_deg = detail::impliedNullspaceSigmaDeg(r.sigma_min, r.sigma_second, r.rows_used);
   if (opt.resolve_sign) {
     const SignDecision s = detail::resolveSign(obs, motion, r.v, frames);
