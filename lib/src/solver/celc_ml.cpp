@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "joint_refine.hpp"
 #include "ml_screen.hpp"
+#include "rate_offset.hpp"
 #include "refine.hpp"
 #include "robust_nullspace.hpp"
 #include "sign_test.hpp"
@@ -153,22 +156,51 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       }
     }
   }
+  // ml.rate_offset: where the events ask for an offset of the given rate
+  // (rate_offset.hpp), the rest runs with the gyro shifted by it.
+  std::optional<MotionModel> shifted_motion;
+  std::optional<WindowFrames> shifted_frames;
+  std::optional<JointProblem> shifted_problem;
+  JointProblem* active = &problem;
+  std::string note;
+  if (options.ml.rate_offset) {
+    const RateOffsetFit fit = searchRateOffset(obs, motion, best.state.v, options, event_seed, problem.lossScale());
+    if (fit.accepted) {
+      shifted_motion.emplace(motion.withOmegaOffset(fit.delta));
+      shifted_frames.emplace(obs, *shifted_motion);
+      shifted_problem.emplace(obs, *shifted_motion, *shifted_frames, options.ml.max_events,
+                              options.refine.balance_clusters, event_seed, problem.lossScale());
+      JointProblem::Result r = shifted_problem->refine(shifted_problem->start(fit.v), iterations, tolerance, 1);
+      if (r.ok) {
+        best = std::move(r);
+        active = &*shifted_problem;
+        const Vec3 d = fit.delta * 180.0 / M_PI;
+        char text[160];
+        std::snprintf(text, sizeof text, "rate offset (%.2f, %.2f, %.2f) deg/s estimated (likelihood ratio %.1f)",
+                      d.x(), d.y(), d.z(), fit.likelihood_ratio);
+        note = text;
+      }
+    }
+  }
+  const MotionModel& used_motion = shifted_motion ? *shifted_motion : motion;
+  const WindowFrames& used_frames = shifted_frames ? *shifted_frames : frames;
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));
   // A last refinement under a redescending loss (ml.cauchy_scale), from the
   // winner (the basin is chosen under Huber, whose cost has fewer minima),
   // where the residuals have a heavier tail than Gaussian noise gives.
   const double cauchy_px = options.ml.cauchy_scale > 0.0
-                               ? problem.spread(best.state).cauchyScale(options.ml.cauchy_scale,
+                               ? active->spread(best.state).cauchyScale(options.ml.cauchy_scale,
                                                                         options.ml.cauchy_min_tail)
                                : 0.0;
   if (cauchy_px > 0.0) {
-    problem.setLoss(JointProblem::Loss::Cauchy, cauchy_px);
-    JointProblem::Result r = problem.refine(best.state, iterations, tolerance, 1);
+    active->setLoss(JointProblem::Loss::Cauchy, cauchy_px);
+    JointProblem::Result r = active->refine(best.state, iterations, tolerance, 1);
     if (r.ok) best = std::move(r);
   }
   SolverResult out;
   out.status = SolveStatus::Ok;
+  out.message = note;
   out.v = best.state.v.dot(best_start->v) < 0 ? Vec3(-best.state.v) : best.state.v;  // keep the start's sign
   out.residual_px = residual_px;
   out.iterations = best.iterations;
@@ -183,7 +215,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     out.sigma_min = linear.sigma_min;
     out.sigma_second = linear.sigma_second;
     if (options.linear.resolve_sign) {
-      const SignDecision sd = resolveSign(obs, motion, out.v, frames);
+      const SignDecision sd = resolveSign(obs, used_motion, out.v, used_frames);
       out.v *= sd.sign;
       out.sign_margin = sd.margin * sd.sign;
     }

@@ -72,6 +72,7 @@ class JointProblem {
     scale_ = scale_px;
   }
   void setHuber(double huber_px) { setLoss(Loss::Huber, huber_px); }
+  double lossScale() const { return scale_; }  ///< the loss's threshold or scale [px]
 
  private:
   /// The terms of cluster c: terms_[begin_[c], begin_[c + 1]). The buffer's

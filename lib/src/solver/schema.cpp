@@ -111,6 +111,9 @@ void describe(FieldVisitor& v, MlOptions& o) {
                       "then a last refinement under a Cauchy loss at this times the residuals' robust scale: "
                       "other edges' events in a cluster stop pulling (0 = off)",
                       o.cauchy_scale, o.cauchy_min_tail);
+  v.field({"rate_offset", "", "also estimate a constant gyro-rate offset with v, kept where a likelihood-ratio test "
+                              "(p = 0.001) finds one (30-60 joint refinements more)"},
+          o.rate_offset);
 }
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {

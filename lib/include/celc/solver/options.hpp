@@ -195,6 +195,11 @@ struct MlOptions {
   /// Huber's estimate is kept, since Cauchy's cost is flatter where a window
   /// is weakly observed.
   double cauchy_min_tail = 0.01;  ///< [-]
+  /// Also estimate a constant offset of the given angular velocity (a
+  /// gyroscope bias) with v, kept where a likelihood-ratio test (p = 0.001)
+  /// finds one (solver/rate_offset.hpp; docs/solver.md): some 30-60 joint
+  /// refinements more per window.
+  bool rate_offset = false;
   std::string validate() const;  ///< empty when valid
 };
 
