@@ -125,6 +125,7 @@ void runSolve(const SolveArgs& a) {
     else std::cout << ",,";
     std::cout << fmt::format(",{:.1f}\n", r.time_us);
     if (!r.ok()) spdlog::info("{}: {} ({})", toString(methods[i]), toString(r.status), r.message);
+    else if (!r.message.empty()) spdlog::info("{}: {}", toString(methods[i]), r.message);
   }
 }
 

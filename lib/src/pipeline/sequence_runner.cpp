@@ -297,6 +297,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   for (size_t i = 0; i < cfg.methods.size(); ++i) {
     MethodRow& row = rec.rows[i];
     row.result = results[i];
+    // An answer with a note (an estimated rate offset, an answered ambiguous nullspace).
+    if (row.result.ok() && !row.result.message.empty())
+      spdlog::debug("window {}: {}: {}", index, toString(cfg.methods[i]), row.result.message);
     if (row.result.ok() && rec.has_gt) {
       row.has_metrics = true;
       row.eps = directionDistance(rec.gt, row.result.v);
