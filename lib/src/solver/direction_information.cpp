@@ -32,36 +32,63 @@ M pinvSymmetric(const M& A) {
 
 }  // namespace
 
-DirectionInformation directionInformation(const WindowObservations& obs, const MotionModel& motion,
-                                          const Vec3& direction, int max_events, bool keep_residuals) {
-  DirectionInformation out;
-  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(obs.focal_px > 0.0)) {
-    out.message = "invalid direction or focal length";
-    return out;
-  }
+namespace {
+std::vector<EventTerm>& threadTerms() {
+  thread_local std::vector<EventTerm> buffer;
+  return buffer;
+}
+}  // namespace
+
+DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events)
+    : focal_px_(obs.focal_px) {
+  terms_.swap(threadTerms());
+  terms_.clear();
   std::size_t total = 0;
   for (const auto& c : obs.clusters) total += c.size();
   const std::size_t stride =
       max_events > 0 ? std::max<std::size_t>(1, total / static_cast<std::size_t>(max_events)) : 1;
-  const Vec3 v = direction.normalized();
-  const Mat32 Bv = tangentBasis(v);
+  terms_.reserve(total / stride + obs.clusters.size());
   for (const auto& c : obs.clusters) {
     if (!c.has_lines || !(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
     if (!(c.l1.normal.norm() > 0.0) || !(c.l3.normal.norm() > 0.0)) continue;
     const ClusterFrame fr = makeClusterFrame(c, motion);
-    const Vec3 m1 = fr.m1.normalized(), m3 = fr.m3.normalized();
+    for (size_t k = 0; k < c.size() && k < c.bearings.size(); k += stride) {
+      if (!std::isfinite(c.times[k]) || !c.bearings[k].allFinite()) continue;
+      Mat3 Rk, Pk;
+      motion.pose(c.times[k], Rk, Pk);
+      terms_.push_back(makeEventTerm(fr, Rk, Pk, c.bearings[k]));
+    }
+    begin_.push_back(terms_.size());
+    m1_.push_back(fr.m1.normalized());
+    m3_.push_back(fr.m3.normalized());
+  }
+}
+
+DirectionTerms::~DirectionTerms() {
+  // Hand the memory back for the thread's next window (an empty buffer when
+  // another DirectionTerms of this thread holds it).
+  if (terms_.capacity() > threadTerms().capacity()) terms_.swap(threadTerms());
+}
+
+DirectionInformation DirectionTerms::information(const Vec3& direction, bool keep_residuals) const {
+  DirectionInformation out;
+  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(focal_px_ > 0.0)) {
+    out.message = "invalid direction or focal length";
+    return out;
+  }
+  const Vec3 v = direction.normalized();
+  const Mat32 Bv = tangentBasis(v);
+  for (size_t c = 0; c < m1_.size(); ++c) {
+    const Vec3& m1 = m1_[c];
+    const Vec3& m3 = m3_[c];
     const Mat32 B1 = tangentBasis(m1), B3 = tangentBasis(m3);
     Eigen::Matrix2d Ivv = Eigen::Matrix2d::Zero();
     Mat24 Ivl = Mat24::Zero();
     Mat4 Ill = Mat4::Zero();
     int n = 0;
-    for (size_t k = 0; k < c.size() && k < c.bearings.size(); k += stride) {
-      if (!std::isfinite(c.times[k]) || !c.bearings[k].allFinite()) continue;
-      Mat3 Rk, Pk;
-      motion.pose(c.times[k], Rk, Pk);
-      const EventTerm e = makeEventTerm(fr, Rk, Pk, c.bearings[k]);
+    for (size_t k = begin_[c]; k < begin_[c + 1]; ++k) {
       Vec3 gv, g1, g3;
-      const double d = eventDistance(e, v, m1, m3, obs.focal_px, &gv, &g1, &g3);
+      const double d = eventDistance(terms_[k], v, m1, m3, focal_px_, &gv, &g1, &g3);
       if (!std::isfinite(d) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite()) continue;
       const Eigen::Vector2d jv = Bv.transpose() * gv;
       Eigen::Vector4d jl;
@@ -83,6 +110,26 @@ DirectionInformation directionInformation(const WindowObservations& obs, const M
   }
   out.ok = true;
   return out;
+}
+
+double DirectionTerms::sigmaDeg(const Vec3& direction, double scale) const {
+  DirectionInformation info = information(direction, true);
+  if (!info.ok) return NAN;
+  const double s = 1.4826 * detail::medianAbs(info.residuals_px);
+  if (!(s > 0.0) || !std::isfinite(s)) return NAN;
+  const DirectionCovariance c = directionCovariance(info.schur, s);
+  if (!c.observable) return std::numeric_limits<double>::infinity();
+  return scale * c.rms_rad * 180.0 / M_PI;
+}
+
+DirectionInformation directionInformation(const WindowObservations& obs, const MotionModel& motion,
+                                          const Vec3& direction, int max_events, bool keep_residuals) {
+  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(obs.focal_px > 0.0)) {
+    DirectionInformation out;
+    out.message = "invalid direction or focal length";
+    return out;
+  }
+  return DirectionTerms(obs, motion, max_events).information(direction, keep_residuals);
 }
 
 DirectionCovariance directionCovariance(const Eigen::Matrix2d& schur, double sigma_px) {
@@ -107,13 +154,8 @@ DirectionCovariance directionCovariance(const Eigen::Matrix2d& schur, double sig
 
 double directionSigmaDeg(const WindowObservations& obs, const MotionModel& motion,
                          const Vec3& direction, double scale, int max_events) {
-  DirectionInformation info = directionInformation(obs, motion, direction, max_events, true);
-  if (!info.ok) return NAN;
-  const double s = 1.4826 * detail::medianAbs(info.residuals_px);
-  if (!(s > 0.0) || !std::isfinite(s)) return NAN;
-  const DirectionCovariance c = directionCovariance(info.schur, s);
-  if (!c.observable) return std::numeric_limits<double>::infinity();
-  return scale * c.rms_rad * 180.0 / M_PI;
+  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(obs.focal_px > 0.0)) return NAN;
+  return DirectionTerms(obs, motion, max_events).sigmaDeg(direction, scale);
 }
 
 }  // namespace celc

@@ -2,6 +2,7 @@
 // then every requested method (celc computed once for the methods it starts).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,10 +46,10 @@ void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResu
 /// Returns the std the rows imply [deg], the floor of the answer's sigma_deg,
 /// or 0 when `r` is left as it was.
 double answerIfObservable(const WindowObservations& obs, const MotionModel& motion, const LinearOptions& opt,
-                          int bound_events, const detail::WindowFrames& frames, SolverResult& r) {
+                          const DirectionTerms& bound_terms, const detail::WindowFrames& frames, SolverResult& r) {
   if (r.degeneracy != Degeneracy::NullspaceNotUnique || !r.v.allFinite() || !(r.v.norm() > 0.5)) return 0.0;
   const auto t0 = detail::Clock::now();
-  const double bound_deg = directionSigmaDeg(obs, motion, r.v, 1.0, bound_events);
+  const double bound_deg = bound_terms.sigmaDeg(r.v, 1.0);
   if (!(bound_deg <= opt.max_nullspace_sigma_deg)) {
     r.time_us += detail::microsecondsSince(t0);
     return 0.0;
@@ -204,11 +205,18 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
   }
   const UncertaintyOptions& u = options.uncertainty;
+  // The events' terms of the bound, formed once for every direction asked about.
+  std::optional<DirectionTerms> direction_terms;
+  auto terms = [&]() -> const DirectionTerms& {
+    if (!direction_terms) direction_terms.emplace(obs, motion, u.max_events);
+    return *direction_terms;
+  };
   // The linear methods' ambiguous verdicts checked against the events' bound.
   std::vector<double> sigma_floor_deg(out.size(), 0.0);
   for (size_t i = 0; i < out.size(); ++i)
-    if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc))
-      sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, u.max_events, frames, out[i]);
+    if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc) &&
+        out[i].degeneracy == Degeneracy::NullspaceNotUnique)
+      sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, terms(), frames, out[i]);
   // What every method shares (the window's verdict), and each estimate's
   // uncertainty at its own direction.
   for (size_t i = 0; i < out.size(); ++i) {
@@ -225,7 +233,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
     }
-    r.sigma_deg = std::max(directionSigmaDeg(obs, motion, r.v, scale, u.max_events), sigma_floor_deg[i]);
+    r.sigma_deg = std::max(terms().sigmaDeg(r.v, scale), sigma_floor_deg[i]);
   }
   if (!u.enabled || !u.agreement) return out;
   // The witnesses: the ok estimates of the celc family with their Fisher
@@ -244,7 +252,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
   }
   if (!celc_asked && have_linear && linear.ok()) {
     SolverResult w = linear;
-    w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
+    w.sigma_deg = terms().sigmaDeg(w.v, u.scale_celc);
     if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
   }
   if (u.witness_rows > 0 && have_linear) {
@@ -254,7 +262,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     subset.max_rows = u.witness_rows;
     SolverResult w = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
     if (w.ok()) {
-      w.sigma_deg = directionSigmaDeg(obs, motion, w.v, u.scale_celc, u.max_events);
+      w.sigma_deg = terms().sigmaDeg(w.v, u.scale_celc);
       if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
     }
   }

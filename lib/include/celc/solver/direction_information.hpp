@@ -23,6 +23,7 @@
 
 #include "celc/core/observations.hpp"
 #include "celc/geometry/motion_model.hpp"
+#include "celc/solver/celc_residual.hpp"
 
 namespace celc {
 
@@ -43,6 +44,34 @@ struct DirectionInformation {
 DirectionInformation directionInformation(const WindowObservations& obs, const MotionModel& motion,
                                           const Vec3& direction, int max_events = 0,
                                           bool keep_residuals = false);
+
+/// What directionInformation needs of a window that does not depend on the
+/// direction: each usable cluster's frame and its events' terms (one pose of
+/// the motion model per event), built once for the several directions a
+/// window's estimates ask about.
+class DirectionTerms {
+ public:
+  /// `max_events` as for directionInformation.
+  DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events = 0);
+  ~DirectionTerms();
+  DirectionTerms(const DirectionTerms&) = delete;
+  DirectionTerms& operator=(const DirectionTerms&) = delete;
+  /// directionInformation(obs, motion, direction, max_events, keep_residuals),
+  /// the same numbers.
+  DirectionInformation information(const Vec3& direction, bool keep_residuals = false) const;
+  /// directionSigmaDeg(obs, motion, direction, scale, max_events).
+  double sigmaDeg(const Vec3& direction, double scale) const;
+
+ private:
+  /// Cluster c's events: terms_[begin_[c], begin_[c + 1]); its plane
+  /// normals m1_[c], m3_[c] (unit). The terms' memory is kept per thread
+  /// across windows (as JointProblem's: a fresh block per window made the
+  /// kernel map its pages every time).
+  std::vector<EventTerm> terms_;
+  std::vector<size_t> begin_{0};
+  std::vector<Vec3> m1_, m3_;
+  double focal_px_ = 0.0;
+};
 
 /// The covariance C = sigma_px^2 S^-1 [rad^2] and the RMS angle
 /// sqrt(trace C) [rad]; +inf (and C infinite) when S is singular (the
