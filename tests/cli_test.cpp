@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -163,4 +164,45 @@ TEST(Cli, SolveBadInputNamesFileAndLine) {
   EXPECT_NE(runCelc("solve '" + (d / "header.csv").string() + "' --normalized", d).status, 0);
   EXPECT_NE(readAll(d / "stderr.txt").find("header.csv:1"), std::string::npos);
   fs::remove_all(d);
+}
+
+// `celc run --dump-windows`: a window written out and solved alone by its
+// command gives the run's answers (the bundled sample, window 1: the same
+// events, clusters, gyro samples, configuration, seed and reference time;
+// bearings differ by the undistortion table's rounding, ~1e-8 measured).
+TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
+  const fs::path d = tempDir("dump");
+  const std::string out = (d / "run").string(), dump = (d / "windows").string();
+  ASSERT_EQ(runCelc("run '" CELC_SOURCE_DIR "/data/sample_seq' -q --no-plots -o '" + out + "' --dump-windows '" + dump +
+                        "'",
+                    d)
+                .status,
+            0);
+  ASSERT_TRUE(fs::exists(d / "windows" / "window_00001.csv"));
+  ASSERT_TRUE(fs::exists(d / "windows" / "window_00001_gyro.csv"));
+  const std::string solved = (d / "solved.csv").string();
+  ASSERT_EQ(std::system(("sh '" + (d / "windows" / "window_00001.sh").string() + "' -q > '" + solved + "'").c_str()), 0);
+  // method -> v, from the run's windows.csv (window 1) and from the solve.
+  auto directions = [](const std::string& path, bool run_rows) {
+    std::map<std::string, Vec3> v;
+    std::istringstream in(readAll(path));
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::stringstream ss(line);
+      for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+      const std::size_t o = run_rows ? 5 : 0;  // windows.csv: window,t_start,t_end,n_events,n_clusters,method,...
+      if (f.size() < o + 5 || (run_rows && f[0] != "1") || f[o + 1] != "ok") continue;
+      v[f[o]] = Vec3(std::stod(f[o + 2]), std::stod(f[o + 3]), std::stod(f[o + 4]));
+    }
+    return v;
+  };
+  const auto run = directions(out + "/windows.csv", true), alone = directions(solved, false);
+  ASSERT_EQ(run.size(), 5u);
+  ASSERT_EQ(alone.size(), 5u);
+  for (const auto& [method, v] : run) {
+    ASSERT_TRUE(alone.count(method)) << method;
+    EXPECT_LT(angleBetween(v, alone.at(method)), 1e-6) << method;
+  }
 }

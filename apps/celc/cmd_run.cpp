@@ -17,7 +17,7 @@ namespace {
 
 struct RunArgs {
   RunOverrides o;
-  std::string input, outdir, calib, groundtruth, imu;
+  std::string input, outdir, calib, groundtruth, imu, dump_windows;
 };
 
 void runRun(const RunArgs& a) {
@@ -28,6 +28,12 @@ void runRun(const RunArgs& a) {
   defaultContainerInputs(job.inputs, job.config.reader);
   job.mode = outputMode(a.o);
   job.threads = a.o.threads;
+  job.dump_windows = a.dump_windows;
+  {
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) job.dump_program = self.string();
+  }
   if (!a.o.shard.empty()) std::tie(job.shard_index, job.shard_count) = parseShard(a.o.shard);
   const std::string name = fs::path(a.input).filename().string().empty()
                                ? fs::path(a.input).parent_path().filename().string()
@@ -67,6 +73,10 @@ void registerRun(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--imu", a->imu, "IMU text file (when not in the sequence directory)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--dump-windows", a->dump_windows,
+                  "also write each clustered window into this folder: window_NNNNN.csv (t,x,y,cluster: `celc "
+                  "solve`'s input), window_NNNNN_gyro.csv and window_NNNNN.sh, the `celc solve` command that gives "
+                  "this run's answers on it");
   addRunOptions(cmd, a->o);
   cmd->callback([a]() { runRun(*a); });
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "celc/cluster/to_observations.hpp"
@@ -27,6 +28,7 @@ struct SolveArgs {
   std::vector<std::string> sets;
   bool normalized = false, quiet = false, verbose = false;
   double focal = 320.0;
+  std::optional<double> t_ref;  ///< the motion's reference time [s]; default the first clustered event
 };
 
 Vec3 parseVec3(const std::string& text, const std::string& what) {
@@ -99,8 +101,9 @@ void runSolve(const SolveArgs& a) {
   };
   const LabelledObservations in = observeLabelledEvents(
       events, labels, bearing, cam.focal(), cfg.observations, [&](double t_first) {
-        return a.gyro.empty() ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_first)
-                              : loadGyro(a.gyro, t_first);
+        const double t_ref = a.t_ref.value_or(t_first);
+        return a.gyro.empty() ? MotionModel::constantTwist(parseVec3(a.omega, "--omega"), t_ref)
+                              : loadGyro(a.gyro, t_ref);
       });
   const ClusterResult& clusters = in.clusters;
   const ObservationReport& report = in.report;
@@ -150,6 +153,9 @@ void registerSolve(CLI::App& app) {
   cmd->add_flag("--normalized", a->normalized, "x, y are normalised (undistorted) coordinates");
   cmd->add_option("--focal", a->focal, "focal length [px] for pixel thresholds with --normalized")
       ->capture_default_str();
+  cmd->add_option("--t-ref", a->t_ref,
+                  "reference time of the motion [s]: v is in the camera frame at this time (default: the first "
+                  "clustered event; `celc run` uses the window's start)");
   cmd->add_option("-c,--config", a->config, "YAML run configuration (config/run.yaml): its lines, "
                   "observations, solver, methods and seed are used")->check(CLI::ExistingFile);
   cmd->add_option("--set", a->sets,

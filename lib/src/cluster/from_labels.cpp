@@ -38,6 +38,19 @@ ClusterResult clustersFromLabels(const std::vector<Event>& events, const std::ve
     out.labels.push_back(it->second);
     ++out.n_clustered;
   }
+  // Clusters in ascending label order (the order a clustering's indices
+  // give, so that a window dumped by `celc run --dump-windows` is observed
+  // in the run's order), the labels renumbered to match.
+  std::vector<int> rank(out.clusters.size());
+  {
+    int r = 0;
+    for (const auto& [label, index] : index_of) rank[static_cast<std::size_t>(index)] = r++;
+  }
+  std::vector<ClusterStats> ordered(out.clusters.size());
+  for (std::size_t i = 0; i < out.clusters.size(); ++i) ordered[static_cast<std::size_t>(rank[i])] = out.clusters[i];
+  out.clusters = std::move(ordered);
+  for (int& l : out.labels)
+    if (l >= 0) l = rank[static_cast<std::size_t>(l)];
   out.status = out.clusters.empty() ? ClusterStatus::NoClusters : ClusterStatus::Ok;
   if (!events.empty()) out.t0 = std::min_element(events.begin(), events.end(), [](const Event& a, const Event& b) {
                                   return a.t < b.t;

@@ -253,6 +253,16 @@ SequenceOutcome runSequence(const SequenceJob& job,
   SequenceOutcome out;
   SequenceRunner runner(job.inputs, job.config);  // opens the inputs: nothing written yet
   RunOutput output(job.outdir, job.mode, job.config);
+  if (!job.dump_windows.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(job.dump_windows, ec);
+    if (ec) throw std::runtime_error(job.dump_windows + ": cannot create the folder (" + ec.message() + ")");
+    WindowDumpContext context;
+    context.dir = job.dump_windows;
+    context.program = job.dump_program;
+    context.config = std::filesystem::absolute(std::filesystem::path(job.outdir) / "config.yaml").string();
+    runner.dumpWindows(context);
+  }
   try {
     runInto(runner, output, job, progress, out);
   } catch (const std::exception& e) {

@@ -38,6 +38,7 @@ struct SequenceRunner::Impl {
   Vec3 gyro_bias = Vec3::Zero();  ///< subtracted from every gyro sample [rad/s], IMU frame
   std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
+  std::optional<WindowDumpContext> dump;  ///< dumpWindows()
 
   /// Unit-plane bearing (x, y, 1) of a pixel: the undistortion table at whole
   /// pixels, the camera model elsewhere.
@@ -210,6 +211,15 @@ std::vector<std::string> SequenceRunner::describe() const {
   return d;
 }
 
+void SequenceRunner::dumpWindows(WindowDumpContext context) {
+  Impl& m = *impl_;
+  context.calib = fs::absolute(m.inputs.calib).string();
+  context.seed = m.config.seed;
+  context.gyro_integrated =
+      m.config.omega_source == OmegaSource::Gyro && m.config.motion == MotionModelKind::GyroIntegrated;
+  m.dump = std::move(context);
+}
+
 WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, double t1,
                                            const std::vector<Event>& events, std::optional<double> probe_px) const {
   const Impl& m = *impl_;
@@ -247,6 +257,11 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   start = Clock::now();
   const ClusterResult clusters = clusterEvents(events, cfg.cluster);
   rec.times.cluster = secondsSince(start);
+  if (m.dump) {
+    const GyroWindow gw = cfg.omega_source == OmegaSource::Gyro && !m.gyro.empty() ? m.gyro.window(t0, t1)
+                                                                                 : GyroWindow{};
+    dumpWindow(*m.dump, index, t0, events, clusters.labels, &gw, rec.omega);
+  }
   if (clusters.status != ClusterStatus::Ok) {
     rec.window_status = toString(clusters.status);
     return rec;

@@ -49,7 +49,7 @@ struct ObservationReport {
 };
 
 /// Events already labelled by cluster (`celc solve`, the Python module) as a
-/// clustering result: clusters numbered in order of first appearance, each
+/// clustering result: clusters numbered in ascending label order, each
 /// ClusterStats::id the given label, size / t_begin / t_end [s] / on (the
 /// polarity of its first event) filled in; a negative label = unassigned (-1).
 /// Status Ok, NoClusters when no event is labelled. Throws

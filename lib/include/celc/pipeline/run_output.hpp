@@ -83,6 +83,10 @@ struct SequenceJob {
   int shard_index = 0, shard_count = 1;  ///< process windows with index % count == index
   int threads = 0;                       ///< 0 = all cores
   std::string title;                     ///< summary.md title
+  /// Also write each clustered window for `celc solve` into this folder
+  /// (pipeline/window_dump.hpp; created when missing; empty: no).
+  std::string dump_windows;
+  std::string dump_program = "celc";  ///< the executable the dumped commands call
 };
 
 struct SequenceOutcome {

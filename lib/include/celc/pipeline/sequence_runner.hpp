@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "celc/pipeline/run_config.hpp"
+#include "celc/pipeline/window_dump.hpp"
 
 namespace celc {
 
@@ -118,6 +119,11 @@ class SequenceRunner {
   /// (no_parallax) for every method.
   WindowRecord processWindow(std::uint64_t index, double t0, double t1, const std::vector<Event>& events,
                              std::optional<double> probe_px = std::nullopt) const;
+
+  /// Also write every clustered window for `celc solve` (window_dump.hpp)
+  /// into context.dir; context.calib, gyro_integrated and seed are filled
+  /// from the run's own.
+  void dumpWindows(WindowDumpContext context);
 
  private:
   struct Impl;
