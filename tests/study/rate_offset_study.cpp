@@ -6,7 +6,7 @@
 // (no estimator has it: the floor the search aims at); how often the offset
 // was kept, the median error of the kept offsets [deg/s] and the median time
 // per solve [ms] with the option off and on.
-//   build/celc_rate_offset_study [--trials N] [--seed S]      (defaults 500, 1)
+//   build/celc_rate_offset_study [--trials N] [--seed S]      (defaults 500, 1; 25 s)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
