@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
@@ -78,6 +79,7 @@ void runSolve(const SolveArgs& a) {
   if (!a.methods.empty()) cfg.methods = parseMethodList(a.methods);
   if (const std::string err = cfg.validate(); !err.empty()) throw std::runtime_error("configuration: " + err);
 
+  if (a.t_ref && !std::isfinite(*a.t_ref)) throw std::runtime_error("--t-ref: must be a finite time [s]");
   const auto labelled = readLabelledEvents(a.events);
   if (a.calib.empty() && !a.normalized)
     throw std::runtime_error("solve: pixel events need --calib FILE (or pass --normalized)");
