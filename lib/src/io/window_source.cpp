@@ -1,4 +1,5 @@
 #include "celc/io/window_source.hpp"
+#include "celc/core/memory.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -148,6 +149,14 @@ bool WindowSource::next(EventWindow& w) {
     if (!(o_.keep_partial || tail_.share >= o_.partial_min_share)) return false;
     tail_.emitted = true;
   }
+  // Counted first: grown push by push, a window's vector was copied and its
+  // new pages faulted in about log2(n) times.
+  std::size_t count = 0;
+  for (const Event& e : buf_) {
+    if (e.t >= t1) break;
+    count += e.t >= t0;
+  }
+  reserveLarge(w.events, count);
   for (const Event& e : buf_) {
     if (e.t >= t1) break;
     if (e.t >= t0) w.events.push_back(e);

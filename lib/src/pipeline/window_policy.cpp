@@ -1,4 +1,5 @@
 #include "celc/pipeline/window_policy.hpp"
+#include "celc/core/memory.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -145,7 +146,7 @@ void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
   window.events.clear();
   std::size_t n = 0;
   for (int i = 0; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
-  window.events.reserve(n);
+  reserveLarge(window.events, n);
   for (int i = 0; i < steps; ++i) {
     const auto& e = pending_[static_cast<std::size_t>(i)].events;
     window.events.insert(window.events.end(), e.begin(), e.end());

@@ -9,6 +9,7 @@
 #include "celc/solver/celc_residual.hpp"
 #include "sampling.hpp"
 #include "sphere_tangent.hpp"
+#include "thread_buffer.hpp"
 
 namespace celc {
 namespace {
@@ -32,22 +33,14 @@ M pinvSymmetric(const M& A) {
 
 }  // namespace
 
-namespace {
-std::vector<EventTerm>& threadTerms() {
-  thread_local std::vector<EventTerm> buffer;
-  return buffer;
-}
-}  // namespace
-
 DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events)
     : focal_px_(obs.focal_px) {
-  terms_.swap(threadTerms());
-  terms_.clear();
+  detail::borrowThreadVector<DirectionTerms>(terms_);
   std::size_t total = 0;
   for (const auto& c : obs.clusters) total += c.size();
   const std::size_t stride =
       max_events > 0 ? std::max<std::size_t>(1, total / static_cast<std::size_t>(max_events)) : 1;
-  terms_.reserve(total / stride + obs.clusters.size());
+  reserveWithHeadroom(terms_, total / stride + obs.clusters.size());
   for (const auto& c : obs.clusters) {
     if (!c.has_lines || !(c.l3.t > c.l1.t) || !c.l1.normal.allFinite() || !c.l3.normal.allFinite()) continue;
     if (!(c.l1.normal.norm() > 0.0) || !(c.l3.normal.norm() > 0.0)) continue;
@@ -65,9 +58,8 @@ DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel&
 }
 
 DirectionTerms::~DirectionTerms() {
-  // Hand the memory back for the thread's next window (an empty buffer when
-  // another DirectionTerms of this thread holds it).
-  if (terms_.capacity() > threadTerms().capacity()) terms_.swap(threadTerms());
+  // Hand the memory back for the thread's next window.
+  detail::returnThreadVector<DirectionTerms>(terms_);
 }
 
 DirectionInformation DirectionTerms::information(const Vec3& direction, bool keep_residuals) const {

@@ -8,35 +8,40 @@
 #include <limits>
 
 #include "isa_clones.hpp"
+#include "thread_buffer.hpp"
 
 namespace celc::detail {
+
+JointColumns::JointColumns() { borrowThreadVector<JointColumns>(data_); }
+
+JointColumns::~JointColumns() { returnThreadVector<JointColumns>(data_); }
 
 void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
                           std::vector<size_t>& strided_begin) {
   step = std::max<size_t>(1, step);
-  std::vector<size_t> keep;
   strided_begin.assign(1, 0);
-  for (size_t c = 0; c + 1 < begin.size(); ++c) {
-    for (size_t k = begin[c]; k < begin[c + 1]; k += step) keep.push_back(k);
-    strided_begin.push_back(keep.size());
-  }
-  n_ = keep.size();
+  for (size_t c = 0; c + 1 < begin.size(); ++c)
+    strided_begin.push_back(strided_begin.back() + (begin[c + 1] - begin[c] + step - 1) / step);
+  n_ = strided_begin.back();
   const size_t s = stride();
+  reserveWithHeadroom(data_, static_cast<size_t>(kColumns) * s);
   data_.assign(static_cast<size_t>(kColumns) * s, 0.0);
-  for (size_t row = 0; row < n_; ++row) {
-    const EventTerm& e = terms[keep[row]];
-    double* c = data_.data() + row;
-    for (int j = 0; j < 3; ++j) {
-      c[static_cast<size_t>(j) * s] = e.fp(j);
-      c[static_cast<size_t>(3 + j) * s] = e.Rt01(0, j);
-      c[static_cast<size_t>(6 + j) * s] = e.Rt01(1, j);
-    }
-    for (int i = 0; i < 3; ++i)
+  size_t row = 0;
+  for (size_t cl = 0; cl + 1 < begin.size(); ++cl)
+    for (size_t k = begin[cl]; k < begin[cl + 1]; k += step, ++row) {
+      const EventTerm& e = terms[k];
+      double* c = data_.data() + row;
       for (int j = 0; j < 3; ++j) {
-        c[static_cast<size_t>(9 + 3 * i + j) * s] = e.De(i, j);
-        c[static_cast<size_t>(18 + 3 * i + j) * s] = e.Ds(i, j);
+        c[static_cast<size_t>(j) * s] = e.fp(j);
+        c[static_cast<size_t>(3 + j) * s] = e.Rt01(0, j);
+        c[static_cast<size_t>(6 + j) * s] = e.Rt01(1, j);
       }
-  }
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          c[static_cast<size_t>(9 + 3 * i + j) * s] = e.De(i, j);
+          c[static_cast<size_t>(18 + 3 * i + j) * s] = e.Ds(i, j);
+        }
+    }
 }
 
 namespace {

@@ -16,6 +16,12 @@ namespace celc::detail {
 class JointColumns {
  public:
   static constexpr int kColumns = 27;
+  /// The storage is the thread's spare columns, given back on destruction
+  /// (thread_buffer.hpp).
+  JointColumns();
+  ~JointColumns();
+  JointColumns(const JointColumns&) = delete;
+  JointColumns& operator=(const JointColumns&) = delete;
   /// Every step-th event of each cluster c, terms[begin[c], begin[c + 1]);
   /// strided_begin gets the clusters' ranges in the columns.
   void assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
@@ -26,9 +32,6 @@ class JointColumns {
   size_t size() const { return n_; }
   const double* data() const { return data_.data(); }
   size_t stride() const { return n_ + kPadding; }  ///< between columns [doubles]
-  /// Exchanges the column storage with `buffer` (to keep its memory across
-  /// problems).
-  void swapStorage(std::vector<double>& buffer) { data_.swap(buffer); }
 
  private:
   size_t n_ = 0;

@@ -9,6 +9,7 @@
 #include "refine_costs.hpp"
 #include "sampling.hpp"
 #include "sphere_tangent.hpp"
+#include "thread_buffer.hpp"
 
 namespace celc::detail {
 
@@ -23,16 +24,6 @@ constexpr double kStepTolerance = 1e-8;  // [rad]
 /// x moved by the tangent step B delta, back on the sphere.
 Vec3 retract(const Vec3& x, const Mat32& B, const Eigen::Vector2d& delta) {
   return (x + B * delta).normalized();
-}
-
-std::vector<EventTerm>& threadBuffer() {
-  thread_local std::vector<EventTerm> buffer;
-  return buffer;
-}
-
-std::vector<double>& threadColumns() {
-  thread_local std::vector<double> buffer;
-  return buffer;
 }
 
 /// a and b within the angle of cosine min_cos in v and in every line
@@ -55,11 +46,10 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
   const std::vector<size_t> quota =
       rowQuota(sizes, static_cast<size_t>(std::max(0, max_events)), balance_clusters);
-  terms_.swap(threadBuffer());
-  terms_.clear();
+  borrowThreadVector<JointProblem>(terms_);
   size_t total = 0;
   for (size_t q : quota) total += q;
-  terms_.reserve(total);
+  reserveWithHeadroom(terms_, total);
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const ClusterObservation& cl = obs.clusters[usable[ci]];
     const ClusterFrame& frame = frames[usable[ci]];
@@ -78,7 +68,6 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
     m1_.push_back(frame.m1.normalized());
     m3_.push_back(frame.m3.normalized());
   }
-  columns_.swapStorage(threadColumns());
 }
 
 const JointColumns& JointProblem::columns(int stride) const {
@@ -90,8 +79,7 @@ const JointColumns& JointProblem::columns(int stride) const {
 }
 
 JointProblem::~JointProblem() {
-  if (terms_.capacity() > threadBuffer().capacity()) terms_.swap(threadBuffer());
-  columns_.swapStorage(threadColumns());
+  returnThreadVector<JointProblem>(terms_);
 }
 
 size_t JointProblem::events() const { return terms_.size(); }

@@ -9,6 +9,7 @@
 #include "refine.hpp"
 #include "refine_costs.hpp"
 #include "sampling.hpp"
+#include "thread_buffer.hpp"
 
 namespace celc {
 
@@ -17,25 +18,12 @@ namespace detail {
 namespace {
 constexpr size_t kChunk = 256;  // events per residual block
 
-/// The event terms of this thread's refinements, kept between calls:
-/// allocated per call, their pages were mapped afresh every time (page
-/// faults were a quarter of a refinement's time on a virtual machine).
-std::vector<EventTerm>& threadTerms() {
-  thread_local std::vector<EventTerm> buffer;
-  return buffer;
-}
-
-/// Holds the thread's buffer for one call and gives it back (with whatever
-/// capacity it grew to) on every return.
+/// Holds the thread's event-term buffer for one call and gives it back
+/// (with whatever capacity it grew to) on every return.
 class BorrowedTerms {
  public:
-  BorrowedTerms() {
-    terms.swap(threadTerms());
-    terms.clear();
-  }
-  ~BorrowedTerms() {
-    if (terms.capacity() > threadTerms().capacity()) terms.swap(threadTerms());
-  }
+  BorrowedTerms() { borrowThreadVector<BorrowedTerms>(terms); }
+  ~BorrowedTerms() { returnThreadVector<BorrowedTerms>(terms); }
   BorrowedTerms(const BorrowedTerms&) = delete;
   BorrowedTerms& operator=(const BorrowedTerms&) = delete;
   std::vector<EventTerm> terms;
@@ -77,7 +65,7 @@ SolverResult refineVelocity(const WindowObservations& obs, const MotionModel& mo
   std::vector<EventTerm>& terms = borrowed.terms;
   size_t total = 0;
   for (size_t q : quota) total += q;
-  terms.reserve(total);
+  reserveWithHeadroom(terms, total);
   std::vector<size_t> begin{0};
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const auto& cl = obs.clusters[usable[ci]];
