@@ -1,6 +1,4 @@
 // celc: event-camera linear velocity from the Continuous Event-Line Constraint.
-#include <malloc.h>
-
 #include <glog/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -8,6 +6,7 @@
 #include <exception>
 #include <iostream>
 
+#include "celc/core/memory.hpp"
 #include "commands.hpp"
 
 namespace celc::app {
@@ -18,15 +17,10 @@ void configureLogging(bool quiet, bool verbose) {
 }  // namespace celc::app
 
 int main(int argc, char** argv) {
+  celc::tuneHeapForLargeBuffers();
   // Ceres logs through glog: its warnings and its "evaluation failed" errors
   // are not for users (a refinement that fails is reported as a per-window
   // status with Ceres' message); only fatal errors are printed.
-  // Windows of events are megabytes, allocated on one thread and freed on
-  // another: with glibc's defaults each one is a fresh mmap whose pages are
-  // faulted in again (a few microseconds each on a virtual machine). Blocks
-  // below 64 MB come from the heap, which keeps up to 256 MB of freed memory.
-  mallopt(M_MMAP_THRESHOLD, 64 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
   FLAGS_minloglevel = google::GLOG_FATAL;
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);

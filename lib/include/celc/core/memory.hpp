@@ -11,6 +11,15 @@
 
 namespace celc {
 
+/// Process-wide malloc settings for long runs; call once, first thing in
+/// main (glibc only, elsewhere nothing):
+/// - blocks below 64 MB come from the heap, and up to 256 MB of freed memory
+///   stays there (a window's events, megabytes allocated on one thread and
+///   freed on another, were each a fresh mmap faulted in page by page);
+/// - the first 60 MB of the heap are advised into huge pages
+///   (adviseHugePages), so the buffers carved from them fault once per 2 MB.
+void tuneHeapForLargeBuffers();
+
 /// Asks the kernel to back the whole 2 MB blocks inside [p, p + bytes) with
 /// transparent huge pages where it allows them on request ("madvise"): one
 /// fault per 2 MB instead of 512. Only memory not yet touched is affected; a
