@@ -8,7 +8,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${CELC_BUILD_DIR:-$root/build}"
 packages=(build-essential cmake pkg-config
-  libeigen3-dev libceres-dev libopencv-dev libpcl-dev libcli11-dev libyaml-cpp-dev
+  libeigen3-dev libceres-dev libopencv-dev libpcl-dev libpng-dev libcli11-dev libyaml-cpp-dev
   libspdlog-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   liblz4-dev libzstd-dev libflatbuffers-dev flatbuffers-compiler
   librosbag-storage-dev libroslz4-dev libbz2-dev libhdf5-dev hdf5-filter-plugin-blosc-serial

@@ -1,6 +1,7 @@
 // `celc cluster` end to end: a real ECD slice (skipped when absent) and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -48,6 +49,19 @@ TEST(ClusterCli, ClustersAnEcdSliceAndDumps) {
   EXPECT_EQ(r.out.find("no_clusters"), std::string::npos) << r.out;
   for (const char* f : {"window_00000.png", "window_00000.ply", "window_00001.png", "window_00001.ply"})
     EXPECT_GT(fs::file_size(dir / f), 1000u) << f;
+  {  // a PNG (libpng): the signature, then IHDR with the image's size, 8-bit RGB
+    std::ifstream png(dir / "window_00000.png", std::ios::binary);
+    unsigned char head[26] = {};
+    png.read(reinterpret_cast<char*>(head), sizeof head);
+    const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    EXPECT_TRUE(std::equal(signature, signature + 8, head));
+    EXPECT_EQ(std::string(reinterpret_cast<const char*>(head + 12), 4), "IHDR");
+    const auto be32 = [&](int at) { return (head[at] << 24) | (head[at + 1] << 16) | (head[at + 2] << 8) | head[at + 3]; };
+    EXPECT_GT(be32(16), 100);  // width [px]: x-y view and x-t view side by side
+    EXPECT_GT(be32(20), 100);  // height [px]
+    EXPECT_EQ(head[24], 8);    // bit depth
+    EXPECT_EQ(head[25], 2);    // colour type RGB
+  }
   std::ifstream ply(dir / "window_00000.ply");
   std::string line;
   int vertices = -1, rows = 0, labelled = 0;

@@ -3,12 +3,29 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include <png.h>
+
 namespace celc {
 namespace {
+
+/// Writes an 8-bit BGR image as PNG with libpng's simplified API (OpenCV's
+/// imgcodecs would load 118 more shared libraries at every start of celc).
+void writePng(const std::string& path, const cv::Mat& bgr) {
+  if (bgr.type() != CV_8UC3) throw std::runtime_error(path + ": cannot write PNG: not an 8-bit BGR image");
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(bgr.cols);
+  image.height = static_cast<png_uint_32>(bgr.rows);
+  image.format = PNG_FORMAT_BGR;
+  const int ok = png_image_write_to_file(&image, path.c_str(), 0, bgr.data, static_cast<png_int_32>(bgr.step[0]),
+                                         nullptr);
+  const std::string why = image.message;
+  png_image_free(&image);
+  if (!ok) throw std::runtime_error(path + ": cannot write PNG: " + why);
+}
 
 cv::Scalar clusterColour(int id) {
   // Hues spread by the golden angle; full saturation and value (BGR out).
@@ -122,13 +139,7 @@ void writeClusterPng(const std::string& path, const std::vector<Event>& events,
                 (t1 > t0 ? t1 - t0 : 0.0) * 1e3);
   cv::putText(img, info, cv::Point(4, 16), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, img);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot write PNG: " + e.what());
-  }
-  if (!ok) throw std::runtime_error(path + ": cannot write PNG");
+  writePng(path, img);
 }
 
 void writeClusterPly(const std::string& path, const std::vector<Event>& events,
