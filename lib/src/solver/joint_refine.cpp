@@ -147,6 +147,7 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
   std::vector<Mat24> W(nc);
   std::vector<Vec4> bc(nc);
   std::vector<Mat32> B1(nc), B3(nc);
+  std::vector<Eigen::LDLT<Mat4>> Uinv(nc);
   double lambda = 1e-4;
   State trial = s;
   for (int it = 0; it < max_iterations; ++it) {
@@ -180,7 +181,6 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
       Eigen::Matrix2d S = V;
       S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
       Eigen::Vector2d rhs = -bv;
-      std::vector<Eigen::LDLT<Mat4>> Uinv(nc);
       for (size_t c = 0; c < nc; ++c) {
         Mat4 Ud = U[c];
         Ud.diagonal() += lambda * U[c].diagonal().cwiseMax(1e-12);

@@ -140,7 +140,7 @@ std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice
                                          double tolerance_deg, double separation_deg) {
   std::vector<ScreenMinimum> out;
   if (profile.size() == 0 || lattice < 1 || keep < 1) return out;
-  const std::vector<Vec3> dirs = hemisphereDirections(lattice);
+  const std::vector<Vec3>& dirs = hemisphereDirections(lattice);
   std::vector<ScreenMinimum> grid;
   grid.reserve(dirs.size());
   for (const Vec3& d : dirs) grid.push_back({d, profile(d)});

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <utility>
 
 #include "irls_kernel.hpp"
@@ -221,8 +222,11 @@ std::vector<Vec3> gridStarts(const PackedRows& P, int n, int keep_max, int rows)
 }
 }  // namespace
 
-std::vector<Vec3> hemisphereDirections(int n) {
-  std::vector<Vec3> dirs;
+const std::vector<Vec3>& hemisphereDirections(int n) {
+  thread_local std::map<int, std::vector<Vec3>> lattices;  // nodes: references stay valid
+  const auto found = lattices.find(n);
+  if (found != lattices.end()) return found->second;
+  std::vector<Vec3>& dirs = lattices[n];
   const double golden = M_PI * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < n; ++i) {
     const double z = 1.0 - (i + 0.5) / n;  // (0, 1)

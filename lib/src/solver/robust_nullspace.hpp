@@ -40,7 +40,9 @@ NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
                                   const LinearOptions& options);
 
 /// n directions of a Fibonacci lattice on the upper hemisphere (z > 0): v and
-/// -v are one solution of a homogeneous system.
-std::vector<Vec3> hemisphereDirections(int n);
+/// -v are one solution of a homogeneous system. Computed once per thread and
+/// n (celc_ml's screen asks for the same 100 in every window); the reference
+/// stays valid for the thread's life.
+const std::vector<Vec3>& hemisphereDirections(int n);
 
 }  // namespace celc::detail
