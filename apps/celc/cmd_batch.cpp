@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "celc/core/memory.hpp"
 #include "celc/pipeline/batch.hpp"
 #include "celc/eval/run_tables.hpp"
 #include "celc/io/labelled_events.hpp"
@@ -24,6 +25,7 @@ struct BatchArgs {
 
 void runBatch(const BatchArgs& a) {
   configureLogging(a.o.quiet, a.o.verbose);
+  useOneMallocArena();  // windows of megabytes: the heap in huge pages for every thread
   RunOverrides o = a.o;
   // The base: -c FILE, else the batch file's `config:`, then the command line's options.
   const BatchSpec spec = readBatch(a.batch, [&](const std::string& base_config) {

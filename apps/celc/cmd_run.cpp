@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "celc/core/memory.hpp"
 #include "celc/io/sequence_layout.hpp"
 #include "commands.hpp"
 #include "plots.hpp"
@@ -22,6 +23,7 @@ struct RunArgs {
 
 void runRun(const RunArgs& a) {
   configureLogging(a.o.quiet, a.o.verbose);
+  useOneMallocArena();  // windows of megabytes: the heap in huge pages for every thread
   SequenceJob job;
   job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
   job.config = buildRunConfig(a.o);

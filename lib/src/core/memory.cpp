@@ -24,4 +24,10 @@ void tuneHeapForLargeBuffers() {
 #endif
 }
 
+void useOneMallocArena() {
+#if defined(__GLIBC__)
+  mallopt(M_ARENA_MAX, 1);
+#endif
+}
+
 }  // namespace celc

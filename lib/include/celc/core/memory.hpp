@@ -20,6 +20,13 @@ namespace celc {
 ///   (adviseHugePages), so the buffers carved from them fault once per 2 MB.
 void tuneHeapForLargeBuffers();
 
+/// Every thread allocates from the one heap of tuneHeapForLargeBuffers (its
+/// huge pages) instead of an arena of its own; call before the threads
+/// start. For runs over windows, whose threads allocate megabytes: measured
+/// faster there, slower where threads make many small allocations at once
+/// (the simulation studies' Ceres problems). glibc only.
+void useOneMallocArena();
+
 /// Asks the kernel to back the whole 2 MB blocks inside [p, p + bytes) with
 /// transparent huge pages where it allows them on request ("madvise"): one
 /// fault per 2 MB instead of 512. Only memory not yet touched is affected; a
