@@ -1,7 +1,6 @@
 // Fisher information about the velocity direction, lines as nuisance.
 #include "celc/solver/direction_information.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -30,19 +29,6 @@ M pinvSymmetric(const M& A) {
   for (int i = 0; i < ev.size(); ++i)
     if (ev(i) > tol) D(i, i) = 1.0 / ev(i);
   return es.eigenvectors() * D * es.eigenvectors().transpose();
-}
-
-/// Ill^+ R for the lines' information Ill (symmetric positive semi-definite):
-/// by LDL^T where its pivots are within 1e-8 of each other (full rank, as
-/// almost always), else by the pseudo-inverse (an eigen-decomposition, six
-/// times the time).
-Eigen::Matrix<double, 4, 2> lineSolve(const Mat4& Ill, const Eigen::Matrix<double, 4, 2>& R) {
-  const Eigen::LDLT<Mat4> ldlt(Ill);
-  if (ldlt.info() == Eigen::Success) {
-    const Eigen::Vector4d d = ldlt.vectorD();
-    if (d.minCoeff() > 1e-8 * d.maxCoeff()) return ldlt.solve(R);
-  }
-  return pinvSymmetric(Ill) * R;
 }
 
 }  // namespace
@@ -108,7 +94,7 @@ DirectionInformation DirectionTerms::information(const Vec3& direction, bool kee
     if (n == 0) continue;
     out.events += n;
     ++out.lines;
-    out.schur += Ivv - Ivl * lineSolve(Ill, Ivl.transpose());
+    out.schur += Ivv - Ivl * pinvSymmetric(Ill) * Ivl.transpose();
   }
   if (out.events == 0) {
     out.message = "no usable events (clusters need l1, l3 with l3.t > l1.t)";
