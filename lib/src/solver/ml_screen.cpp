@@ -25,6 +25,36 @@ Mat3 skew(const Vec3& a) {
 
 }  // namespace
 
+double smallestEigenvalueClamped(const Mat3& Q) {
+  const double c2 = Q.trace();
+  const double c1 = Q(0, 0) * Q(1, 1) - Q(0, 1) * Q(0, 1) + Q(0, 0) * Q(2, 2) - Q(0, 2) * Q(0, 2) +
+                    Q(1, 1) * Q(2, 2) - Q(1, 2) * Q(1, 2);
+  const double c0 = Q.determinant();
+  if (!(c0 > 0.0 && c1 > 0.0 && c2 > 0.0)) return 0.0;  // a root at or below 0 (or NaN)
+  // In Newton's quadratic convergence a step s leaves an error of about
+  // s^2 / (r2 - r1) <= s^2 / l: a step below 1e-8 l that is also below
+  // 1e-3 of the one before (not the halving of a double root) leaves less
+  // than 1e-16 l. Where rounding stops the climb first, the step before must
+  // have been below 1e-6 l. A near-multiple root (linear convergence, good to
+  // eps^(1/2) or eps^(1/3) only) is left to the closed form.
+  double l = 0.0, last_step = HUGE_VAL;
+  for (int it = 0; it < 10; ++it) {
+    const double p = ((l - c2) * l + c1) * l - c0;
+    const double dp = (3.0 * l - 2.0 * c2) * l + c1;
+    const double step = dp > 0.0 && p < 0.0 ? -p / dp : 0.0;
+    if (!(step > 0.0)) {  // at r1 to rounding
+      if (last_step <= 1e-6 * l) return l;
+      break;
+    }
+    l += step;
+    if (step <= 1e-8 * l && step <= 1e-3 * last_step) return l;
+    last_step = step;
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(Q, Eigen::EigenvaluesOnly);
+  return std::max(0.0, eig.eigenvalues()(0));
+}
+
 LineProfile::LineProfile(const WindowObservations& obs, const MotionModel& motion,
                          const std::vector<int>& clusters, int max_events, std::uint64_t seed) {
   for (size_t i = 0; i < clusters.size(); ++i) {
@@ -72,24 +102,23 @@ void LineProfile::forms(const Sums& s, const Vec3& v, Mat3& H, Mat3& B) {
 
 double LineProfile::operator()(const Vec3& v) const {
   double total = 0.0;
-  Eigen::SelfAdjointEigenSolver<Mat3> eig;
   for (const Sums& s : sums_) {
     Mat3 H, B;
     forms(s, v, H, B);
     // S - B H^-1 B^T = S - X^T X with H = L L^T and X = L^-1 B^T (H is
     // positive definite: the ridge in forms()).
-    const double l00 = std::sqrt(H(0, 0)), l10 = H(1, 0) / l00, l20 = H(2, 0) / l00;
-    const double l11 = std::sqrt(H(1, 1) - l10 * l10), l21 = (H(2, 1) - l20 * l10) / l11;
-    const double l22 = std::sqrt(H(2, 2) - l20 * l20 - l21 * l21);
+    // (i00, i11, i22: the reciprocals of L's diagonal, one division each.)
+    const double i00 = 1.0 / std::sqrt(H(0, 0)), l10 = H(1, 0) * i00, l20 = H(2, 0) * i00;
+    const double i11 = 1.0 / std::sqrt(H(1, 1) - l10 * l10), l21 = (H(2, 1) - l20 * l10) * i11;
+    const double i22 = 1.0 / std::sqrt(H(2, 2) - l20 * l20 - l21 * l21);
     Mat3 X;  // row r of X = L^-1 B^T, by forward substitution
     for (int j = 0; j < 3; ++j) {
-      X(0, j) = B(j, 0) / l00;
-      X(1, j) = (B(j, 1) - l10 * X(0, j)) / l11;
-      X(2, j) = (B(j, 2) - l20 * X(0, j) - l21 * X(1, j)) / l22;
+      X(0, j) = B(j, 0) * i00;
+      X(1, j) = (B(j, 1) - l10 * X(0, j)) * i11;
+      X(2, j) = (B(j, 2) - l20 * X(0, j) - l21 * X(1, j)) * i22;
     }
     const Mat3 Q = s.S - X.transpose() * X;
-    eig.computeDirect(0.5 * (Q + Q.transpose()), Eigen::EigenvaluesOnly);
-    total += std::max(0.0, eig.eigenvalues()(0));
+    total += smallestEigenvalueClamped(0.5 * (Q + Q.transpose()));
   }
   return total;
 }

@@ -27,6 +27,18 @@
 
 namespace celc::detail {
 
+/// The smallest eigenvalue of a symmetric 3x3 matrix, clamped at 0 below.
+/// Its characteristic polynomial p(l) = l^3 - c2 l^2 + c1 l - c0 (c2 the
+/// trace, c1 the sum of the principal 2x2 minors, c0 the determinant) has
+/// only positive roots when c0, c1, c2 > 0 (Descartes), and otherwise a root
+/// at or below 0. Below its smallest root r1, p rises and is concave, so
+/// Newton's iteration from l = 0 climbs to r1 without overshoot: quadratically
+/// where r1 is apart from the other roots (the profile's case: a line's
+/// residual against two large spreads). Near a double or triple root it
+/// converges linearly and only to eps^(1/2) or eps^(1/3): Eigen's closed form
+/// answers there instead.
+double smallestEigenvalueClamped(const Mat3& Q);
+
 /// The profile J(v) of a window's clusters.
 class LineProfile {
  public:
