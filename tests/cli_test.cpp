@@ -167,9 +167,12 @@ TEST(Cli, SolveBadInputNamesFileAndLine) {
 }
 
 // `celc run --dump-windows`: a window written out and solved alone by its
-// command gives the run's answers (the bundled sample, window 1: the same
+// command gives the run's answers (the bundled sample, window 0: the same
 // events, clusters, gyro samples, configuration, seed and reference time;
 // bearings differ by the undistortion table's rounding, ~1e-8 measured).
+// Window 1 (0.175 s since the twentieth session) does not serve: its
+// celc_opt is decided by that rounding (0.009 rad between run and solve),
+// as docs/runs.md describes for a window at a tie between basins.
 TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
   const fs::path d = tempDir("dump");
   const std::string out = (d / "run").string(), dump = (d / "windows").string();
@@ -178,11 +181,11 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
                     d)
                 .status,
             0);
-  ASSERT_TRUE(fs::exists(d / "windows" / "window_00001.csv"));
-  ASSERT_TRUE(fs::exists(d / "windows" / "window_00001_gyro.csv"));
+  ASSERT_TRUE(fs::exists(d / "windows" / "window_00000.csv"));
+  ASSERT_TRUE(fs::exists(d / "windows" / "window_00000_gyro.csv"));
   const std::string solved = (d / "solved.csv").string();
-  ASSERT_EQ(std::system(("sh '" + (d / "windows" / "window_00001.sh").string() + "' -q > '" + solved + "'").c_str()), 0);
-  // method -> v, from the run's windows.csv (window 1) and from the solve.
+  ASSERT_EQ(std::system(("sh '" + (d / "windows" / "window_00000.sh").string() + "' -q > '" + solved + "'").c_str()), 0);
+  // method -> v, from the run's windows.csv (window 0) and from the solve.
   auto directions = [](const std::string& path, bool run_rows) {
     std::map<std::string, Vec3> v;
     std::istringstream in(readAll(path));
@@ -193,7 +196,7 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
       std::stringstream ss(line);
       for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
       const std::size_t o = run_rows ? 5 : 0;  // windows.csv: window,t_start,t_end,n_events,n_clusters,method,...
-      if (f.size() < o + 5 || (run_rows && f[0] != "1") || f[o + 1] != "ok") continue;
+      if (f.size() < o + 5 || (run_rows && f[0] != "0") || f[o + 1] != "ok") continue;
       v[f[o]] = Vec3(std::stod(f[o + 2]), std::stod(f[o + 3]), std::stod(f[o + 4]));
     }
     return v;

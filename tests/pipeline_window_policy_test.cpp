@@ -283,36 +283,64 @@ TEST(WindowPolicy, ProbeBudgetGrowsPastMaxSeconds) {
 }
 
 // The rest of the data after a window that showed the target is joined to
-// it when the rest alone would show less than no_parallax_px (D linear in the
-// length) and the joined window stays within the longest one: it would be
-// `degenerate` (no_parallax) on its own.
-TEST(WindowPolicy, JoinerJoinsARestTooShortToShowParallax) {
+// it when the rest is too short to show the target itself (D linear in the
+// length) and the joined window stays within the longest one. Until the
+// twentieth session only a rest too short for no_parallax_px was joined.
+TEST(WindowPolicy, JoinerJoinsARestTooShortToShowTheTarget) {
   ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s, steps of 0.025 s
-  o.no_parallax_px = 15.0;   // the arithmetic below (the default is 7 px)
-  auto windows = [&](std::size_t n) {
+  auto windows = [&](std::size_t n, double rate_px_s) {
     TempDir d;
     const auto ev = celc::test::randomEvents(n, 240, 180, 5, 1.0);  // 10 +- 6 us apart
     writeEventsText(d.file("e.txt"), ev);
     WindowTail tail;
-    const auto w = joinAll(d.file("e.txt"), o, 200.0, nullptr, &tail);  // windows of 0.125 s
+    const auto w = joinAll(d.file("e.txt"), o, rate_px_s, nullptr, &tail);
     std::size_t total = 0;
     for (const auto& x : w) total += x.events;
     EXPECT_EQ(total + (tail.emitted ? 0 : tail.events), ev.size());
     return w;
   };
-  // 0.54 s: four windows of 0.125 s and 0.04 s left (8 px; 15 px needs 0.075 s): joined.
-  auto w = windows(54000);
+  // 200 px/s: windows of 0.125 s. 0.54 s: four windows and 0.04 s left: joined.
+  auto w = windows(54000, 200.0);
   ASSERT_EQ(w.size(), 4u);
   EXPECT_NEAR(w[3].t1 - w[3].t0, 0.175, 1e-9);
   EXPECT_NEAR(w[2].t1 - w[2].t0, 0.125, 1e-9);
-  // 0.6 s: 0.1 s left shows 20 px: a window of its own.
-  w = windows(60000);
+  // 0.58 s: 0.08 s left (16 px), still shorter than the window: joined.
+  w = windows(58000, 200.0);
+  ASSERT_EQ(w.size(), 4u);
+  EXPECT_NEAR(w[3].t1 - w[3].t0, 0.225, 1e-9);
+  // 0.64 s: five windows and 0.015 s left: joined.
+  w = windows(64000, 200.0);
   ASSERT_EQ(w.size(), 5u);
-  EXPECT_NEAR(w[3].t1 - w[3].t0, 0.125, 1e-9);
+  EXPECT_NEAR(w[4].t1 - w[4].t0, 0.15, 1e-9);
+  // 50 px/s: every window is 0.3 s long and below the target; what is left
+  // after them is a window of its own.
+  w = windows(54000, 50.0);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_NEAR(w[0].t1 - w[0].t0, 0.3, 1e-9);
+  EXPECT_NEAR(w[1].t0 - w[0].t0, 0.3, 1e-9);
+  // D of 60 px whatever the length: windows of min_seconds (0.05 s), and a
+  // rest of one step would show the target: a window of its own (emitted at
+  // a quarter of min_seconds here).
+  {
+    TempDir d;
+    writeEventsText(d.file("e.txt"), celc::test::randomEvents(51500, 240, 180, 5, 1.0));  // 0.515 s
+    auto reader = openEventSource(d.file("e.txt"));
+    WindowOptions steps;
+    steps.seconds_per_window = o.step_seconds;
+    steps.keep_partial = true;
+    WindowSource source(*reader, steps);
+    ParallaxWindowJoiner joiner(source, o, 0.25, [](double, double, const std::vector<Event>&) { return 60.0; });
+    std::vector<double> lengths;
+    EventWindow ew;
+    while (joiner.next(ew)) lengths.push_back(ew.t1 - ew.t0);
+    ASSERT_EQ(lengths.size(), 11u);
+    EXPECT_NEAR(lengths[9], 0.05, 1e-9);
+    EXPECT_NEAR(lengths[10], 0.025, 1e-9);
+  }
   // A longest window of 0.15 s has no room for the 0.04 s: not joined.
   o.max_seconds = 0.15;
   o.slow_turn_max_seconds = 0.15;
-  w = windows(54000);
+  w = windows(54000, 200.0);
   ASSERT_EQ(w.size(), 5u);
   EXPECT_NEAR(w[3].t1 - w[3].t0, 0.125, 1e-9);
 }

@@ -134,9 +134,9 @@ int ParallaxWindowJoiner::contiguousSteps(int wanted) {
 
 int ParallaxWindowJoiner::tailToJoin(int steps, int longest) {
   if (!(translation_px_ >= o_.target_px) || steps >= longest) return 0;
-  // With D linear in the length, the rest shows no_parallax_px only from
-  // `need` steps on; look that far ahead, or one step past the longest window.
-  const int need = static_cast<int>(std::ceil(steps * o_.no_parallax_px / translation_px_ - 1e-9));
+  // With D linear in the length, the rest shows target_px only from `need`
+  // steps on; look that far ahead, or one step past the longest window.
+  const int need = static_cast<int>(std::ceil(steps * o_.target_px / translation_px_ - 1e-9));
   const int look = std::min(std::max(1, need), longest - steps + 1);
   const int have = contiguousSteps(steps + look);
   return have < steps + look ? have - steps : 0;  // the run of data ends within it

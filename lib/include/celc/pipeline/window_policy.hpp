@@ -86,8 +86,8 @@ int nextWindowSteps(int steps, double d_px, double target_px, int max_steps);
 /// up to slow_turn_max_seconds where the camera turns slowly. A gap the
 /// source skipped ends a window.
 /// A window that shows target_px is joined with the rest of the data (to its
-/// end or a gap) when that rest is too short to show no_parallax_px itself
-/// and the longest window allows: the rest would be `degenerate`.
+/// end or a gap) when that rest is too short to show target_px itself (D
+/// linear in the length) and the longest window allows.
 /// The last window, cut by the end of the data, is emitted when its events
 /// span at least partial_min_share of min_seconds (else tail() reports it).
 /// Memory: at most max(max_seconds, slow_turn_max_seconds) of events, and one step.
@@ -117,8 +117,8 @@ class ParallaxWindowJoiner {
   /// slow_turn_max_seconds while the camera turns less than slow_turn_rad.
   int maxStepsFrom(double t0, int max_steps) const;
   /// Steps to add to a window of `steps` that showed D >= target_px: the rest
-  /// of the data (to its end or to a gap), when that rest is too short to show
-  /// no_parallax_px itself (D linear in the length) and the joined window
+  /// of the data (to its end or to a gap), when that rest is too short to
+  /// show target_px itself (D linear in the length) and the joined window
   /// stays within `longest` steps; else 0.
   int tailToJoin(int steps, int longest);
   void join(int steps, EventWindow& window) const;
