@@ -124,6 +124,35 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   if (screened.empty()) return fallback();
   std::stable_sort(screened.begin(), screened.end(),
                    [](const End& a, const End& b) { return a.result.cost < b.result.cost; });
+  // ml.cheiral_tie: among end points tied in cost with the lowest, the one
+  // whose clusters agree best on the cheirality sign; returns its index.
+  auto cheiralChoice = [&](const std::vector<const JointProblem::Result*>& by_cost) -> size_t {
+    if (!(options.ml.cheiral_tie > 0.0) || by_cost.size() < 2) return 0;
+    const JointProblem::Result& low = *by_cost.front();
+    auto tied = [&](const JointProblem::Result& r) {
+      return r.events * (r.cost - low.cost) / std::max(low.cost, 1e-300) <= options.ml.cheiral_tie;
+    };
+    if (!tied(*by_cost[1])) return 0;  // no tie: no sign test
+    size_t chosen = 0;
+    double best_margin = std::abs(resolveSign(obs, motion, low.state.v, frames).margin);
+    for (size_t i = 1; i < by_cost.size(); ++i) {
+      const JointProblem::Result& r = *by_cost[i];
+      if (!tied(r)) break;
+      const double margin = std::abs(resolveSign(obs, motion, r.state.v, frames).margin);
+      if (margin > best_margin + 1e-9) {
+        best_margin = margin;
+        chosen = i;
+      }
+    }
+    return chosen;
+  };
+  {
+    std::vector<const JointProblem::Result*> by_cost;
+    for (const End& e : screened) by_cost.push_back(&e.result);
+    const size_t c = cheiralChoice(by_cost);
+    if (c > 0) std::rotate(screened.begin(), screened.begin() + static_cast<std::ptrdiff_t>(c),
+                           screened.begin() + static_cast<std::ptrdiff_t>(c) + 1);
+  }
   JointProblem::Result best = screened.front().result;
   const Start* best_start = screened.front().start;
   if (stride > 1 || start_iterations < iterations) {
@@ -135,13 +164,15 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     // continues only while it is below the best so far, and one heading
     // into a basin an earlier finalist ended in stops there.
     std::vector<JointProblem::State> converged;
+    std::vector<std::pair<JointProblem::Result, const Start*>> finals;
     bool have = false;
     const double merge_rad = kMergeDeg * M_PI / 180.0;
     const size_t finalists = static_cast<size_t>(std::max(1, options.ml.finalists));
     for (size_t i = 0; i < screened.size() && i < finalists; ++i) {
       JointProblem::Result r = problem.refine(screened[i].result.state, have ? start_iterations : iterations,
                                               tolerance, 1, converged, merge_rad);
-      if (!r.ok || r.merged || (have && r.cost >= best.cost)) continue;
+      const double tie = options.ml.cheiral_tie > 0.0 ? 1.0 + options.ml.cheiral_tie / std::max(1, r.events) : 1.0;
+      if (!r.ok || r.merged || (have && r.cost >= best.cost * tie)) continue;
       if (have && r.iterations == start_iterations && start_iterations < iterations) {
         JointProblem::Result rest = problem.refine(r.state, iterations, tolerance, 1, converged, merge_rad);
         if (!rest.ok || rest.merged) continue;
@@ -149,10 +180,22 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
         r = std::move(rest);
       }
       converged.push_back(r.state);
+      finals.emplace_back(r, screened[i].start);
       if (!have || r.cost < best.cost) {
         best = std::move(r);
         best_start = screened[i].start;
         have = true;
+      }
+    }
+    if (finals.size() > 1) {
+      std::stable_sort(finals.begin(), finals.end(),
+                       [](const auto& a, const auto& b) { return a.first.cost < b.first.cost; });
+      std::vector<const JointProblem::Result*> by_cost;
+      for (const auto& f : finals) by_cost.push_back(&f.first);
+      const size_t c = cheiralChoice(by_cost);
+      if (c > 0) {
+        best = finals[c].first;
+        best_start = finals[c].second;
       }
     }
   }

@@ -52,6 +52,7 @@ std::string MlOptions::validate() const {
   if (profile_events < 0) e += "profile_events must be >= 0; ";
   if (start_iterations < 0) e += "start_iterations must be >= 0; ";
   if (finalists < 1 || finalists > 100) e += "finalists must be in [1, 100]; ";
+  if (!(cheiral_tie >= 0.0) || !std::isfinite(cheiral_tie)) e += "cheiral_tie must be finite and >= 0; ";
   if (!(huber_scale >= 0.0) || !std::isfinite(huber_scale)) e += "huber_scale must be finite and >= 0; ";
   if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e += "cauchy_scale must be finite and >= 0; ";
   if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e += "cauchy_min_tail must be in [0, 1]; ";

@@ -104,6 +104,10 @@ void describe(FieldVisitor& v, MlOptions& o) {
           o.start_iterations);
   v.field({"finalists", "", "... then this many lowest end points refined to convergence, the lowest cost kept"},
           o.finalists);
+  v.field({"cheiral_tie", "-",
+           "end points within this of the lowest robust cost, N (C - C_min) / C_min, are tied: the one whose "
+           "clusters agree best on the cheirality sign wins (0 = lowest cost)"},
+          o.cheiral_tie);
   v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
                                 "refine.huber_px (0 = off)"},
           o.huber_scale);

@@ -177,6 +177,13 @@ struct MlOptions {
   /// are each refined to convergence on all max_events events and the
   /// lowest converged cost wins (1 = the screen's winner alone).
   int finalists = 1;
+  /// End points whose robust cost is within cheiral_tie units of the lowest,
+  /// N (C - C_min) / C_min over the N events of the cost (a likelihood-ratio
+  /// scale under Gaussian noise), are tied: among them the one whose
+  /// clusters agree best on the side of the camera their lines lie
+  /// (|sign margin| of resolveSign, sign.hpp) wins, in the screen and among
+  /// the finalists (0 = the lowest cost always).
+  double cheiral_tie = 4.0;  ///< [-]
   /// The Huber threshold of the joint cost becomes huber_scale times the
   /// robust scale (1.4826 MAD) of the residuals at the first start's end
   /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
