@@ -57,13 +57,30 @@ for s in "${scenes[@]}"; do
   echo "$row"
 done
 # Over every window of every scene: ok / windows, the median phi of the ok
-# windows and the shares within 0.05 and 0.1 rad.
+# windows and the shares within 0.05 and 0.1 rad; then the share of the
+# scenes' time covered by ok windows within 0.1 rad (a window's end clipped to
+# its scene's last event; a refused window counts as a miss), which compares
+# runs whose windows differ in number or length.
+spans="$out/run/.spans"
+: >"$spans"
+for d in "$out"/run/*/; do
+  name=$(basename "$d")
+  ev="$out/seq/$name/events.txt"
+  [ -f "$ev" ] && [ -f "$d/windows.csv" ] || continue
+  printf '%s %s %s\n' "$d/windows.csv" "$(head -n 1 "$ev" | cut -d' ' -f1)" "$(tail -n 1 "$ev" | cut -d' ' -f1)" >>"$spans"
+done
 echo
-printf '| method | ok / windows | median phi [rad] | phi <= 0.05 | phi <= 0.1 |\n|---|---|---|---|---|\n'
+printf '| method | ok / windows | median phi [rad] | phi <= 0.05 | phi <= 0.1 | time within 0.1 rad |\n'
+printf '|---|---|---|---|---|---|\n'
 for m in $methods; do
+  time_share=$(while read -r csv t_first t_last; do
+      awk -F, -v m="$m" -v f="$t_first" -v l="$t_last" 'NR == 1 { print "span", l - f }
+        $1 != "window" && $6 == m && $7 == "ok" && $15 != "" && $15 <= 0.1 {
+          e = $3 < l ? $3 : l; print "in", e - $2 }' "$csv"
+    done <"$spans" | awk '$1 == "span" { s += $2 } $1 == "in" { i += $2 } END { printf "%.3f", (s > 0 ? i / s : 0) }')
   cat "$out"/run/*/windows.csv | awk -F, -v m="$m" '$1 != "window" && $6 == m { n++; if ($7 == "ok" && $15 != "") print $15 }
-    END { print "n", n }' | sort -g | awk -v m="$m" '
+    END { print "n", n }' | sort -g | awk -v m="$m" -v ts="$time_share" '
     $1 == "n" { n = $2; next } { p[++k] = $1; if ($1 <= 0.05) a++; if ($1 <= 0.1) b++ }
     END { med = k ? (k % 2 ? p[(k + 1) / 2] : (p[k / 2] + p[k / 2 + 1]) / 2) : 0
-          printf "| %s | %d / %d | %.3f | %.2f | %.2f |\n", m, k, n, med, k ? a / k : 0, k ? b / k : 0 }'
+          printf "| %s | %d / %d | %.3f | %.2f | %.2f | %s |\n", m, k, n, med, k ? a / k : 0, k ? b / k : 0, ts }'
 done
