@@ -345,7 +345,7 @@ TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
   const double speed = 1.0;
   for (const double sigma : {0.5, 1.0}) {
     double ss_tie = 0.0, ss_lowest = 0.0;
-    int n = 0, changed = 0;
+    int n = 0, changed = 0, noted = 0;
     for (std::uint64_t t = 0; t < 100; ++t) {
       const PeerSceneTrial tr = peerTrial(300 + t, speed, sigma, 200);
       if (!tr.ok) continue;
@@ -357,14 +357,21 @@ TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
       ss_lowest += pa * pa;
       ss_tie += pb * pb;
       changed += angleBetweenSignAgnostic(a.v, b.v) * kDeg > 1.0;
+      // A basin the sign test chose says so (celc solve prints it).
+      if (!b.message.empty()) {
+        EXPECT_NE(b.message.find("basin chosen by cheirality: sign margin"), std::string::npos) << b.message;
+        ++noted;
+      }
+      EXPECT_TRUE(a.message.empty()) << a.message;
       ++n;
     }
     ASSERT_GE(n, 95);
     const double rms_lowest = std::sqrt(ss_lowest / n), rms_tie = std::sqrt(ss_tie / n);
-    std::printf("sigma %g px: RMS %.2f -> %.2f deg, %d of %d trials changed\n", sigma, rms_lowest, rms_tie, changed,
-                n);
+    std::printf("sigma %g px: RMS %.2f -> %.2f deg, %d of %d trials changed, %d noted\n", sigma, rms_lowest, rms_tie,
+                changed, n, noted);
     EXPECT_LT(rms_tie, 0.9 * rms_lowest) << "sigma " << sigma;
     EXPECT_GE(changed, 2) << "sigma " << sigma;
+    EXPECT_GE(noted, changed / 2) << "sigma " << sigma;
     EXPECT_LE(changed, 30) << "sigma " << sigma;  // a tie-break, not a new estimator
   }
   tie.ml.cheiral_tie = -1.0;

@@ -125,16 +125,20 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   std::stable_sort(screened.begin(), screened.end(),
                    [](const End& a, const End& b) { return a.result.cost < b.result.cost; });
   // ml.cheiral_tie: among end points tied in cost with the lowest, the one
-  // whose clusters agree best on the cheirality sign; returns its index.
+  // whose clusters agree best on the cheirality sign; returns its index and,
+  // when that is not the lowest, says so in `tie_note`.
+  std::string tie_note;
   auto cheiralChoice = [&](const std::vector<const JointProblem::Result*>& by_cost) -> size_t {
     if (!(options.ml.cheiral_tie > 0.0) || by_cost.size() < 2) return 0;
+    tie_note.clear();  // the last choice made is the one that stands
     const JointProblem::Result& low = *by_cost.front();
     auto tied = [&](const JointProblem::Result& r) {
       return r.events * (r.cost - low.cost) / std::max(low.cost, 1e-300) <= options.ml.cheiral_tie;
     };
     if (!tied(*by_cost[1])) return 0;  // no tie: no sign test
     size_t chosen = 0;
-    double best_margin = std::abs(resolveSign(obs, motion, low.state.v, frames).margin);
+    const double low_margin = std::abs(resolveSign(obs, motion, low.state.v, frames).margin);
+    double best_margin = low_margin;
     for (size_t i = 1; i < by_cost.size(); ++i) {
       const JointProblem::Result& r = *by_cost[i];
       if (!tied(r)) break;
@@ -143,6 +147,16 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
         best_margin = margin;
         chosen = i;
       }
+    }
+    if (chosen > 0) {
+      const JointProblem::Result& r = *by_cost[chosen];
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "basin chosen by cheirality: sign margin %.2f against %.2f at the lowest cost, %.2f units "
+                    "above it (%.1f deg away)",
+                    best_margin, low_margin, r.events * (r.cost - low.cost) / std::max(low.cost, 1e-300),
+                    angleBetweenSignAgnostic(r.state.v, low.state.v) * 180.0 / M_PI);
+      tie_note = text;
     }
     return chosen;
   };
@@ -243,7 +257,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   }
   SolverResult out;
   out.status = SolveStatus::Ok;
-  out.message = note;
+  out.message = tie_note.empty() ? note : note.empty() ? tie_note : tie_note + "; " + note;
   out.v = best.state.v.dot(best_start->v) < 0 ? Vec3(-best.state.v) : best.state.v;  // keep the start's sign
   out.residual_px = residual_px;
   out.iterations = best.iterations;
