@@ -127,14 +127,16 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   // ml.cheiral_tie: among end points tied in cost with the lowest, the one
   // whose clusters agree best on the cheirality sign; returns its index and,
   // when that is not the lowest, says so in `tie_note`.
+  // How far r's cost lies above low_cost, N (C - C_low) / C_low (the tie's units).
+  auto unitsAbove = [](const JointProblem::Result& r, double low_cost) {
+    return r.events * (r.cost - low_cost) / std::max(low_cost, 1e-300);
+  };
   std::string tie_note;
   auto cheiralChoice = [&](const std::vector<const JointProblem::Result*>& by_cost) -> size_t {
     if (!(options.ml.cheiral_tie > 0.0) || by_cost.size() < 2) return 0;
     tie_note.clear();  // the last choice made is the one that stands
     const JointProblem::Result& low = *by_cost.front();
-    auto tied = [&](const JointProblem::Result& r) {
-      return r.events * (r.cost - low.cost) / std::max(low.cost, 1e-300) <= options.ml.cheiral_tie;
-    };
+    auto tied = [&](const JointProblem::Result& r) { return unitsAbove(r, low.cost) <= options.ml.cheiral_tie; };
     if (!tied(*by_cost[1])) return 0;  // no tie: no sign test
     size_t chosen = 0;
     const double low_margin = std::abs(resolveSign(obs, motion, low.state.v, frames).margin);
@@ -154,7 +156,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       std::snprintf(text, sizeof text,
                     "basin chosen by cheirality: sign margin %.2f against %.2f at the lowest cost, %.2f units "
                     "above it (%.1f deg away)",
-                    best_margin, low_margin, r.events * (r.cost - low.cost) / std::max(low.cost, 1e-300),
+                    best_margin, low_margin, unitsAbove(r, low.cost),
                     angleBetweenSignAgnostic(r.state.v, low.state.v) * 180.0 / M_PI);
       tie_note = text;
     }
@@ -185,8 +187,8 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     for (size_t i = 0; i < screened.size() && i < finalists; ++i) {
       JointProblem::Result r = problem.refine(screened[i].result.state, have ? start_iterations : iterations,
                                               tolerance, 1, converged, merge_rad);
-      const double tie = options.ml.cheiral_tie > 0.0 ? 1.0 + options.ml.cheiral_tie / std::max(1, r.events) : 1.0;
-      if (!r.ok || r.merged || (have && r.cost >= best.cost * tie)) continue;
+      // A later finalist goes on only while within the tie of the best (below it, with no tie).
+      if (!r.ok || r.merged || (have && unitsAbove(r, best.cost) >= options.ml.cheiral_tie)) continue;
       if (have && r.iterations == start_iterations && start_iterations < iterations) {
         JointProblem::Result rest = problem.refine(r.state, iterations, tolerance, 1, converged, merge_rad);
         if (!rest.ok || rest.merged) continue;
