@@ -171,6 +171,27 @@ TEST(LineProfile, SmallestEigenvalueByNewtonMatchesTheSpectrum) {
   EXPECT_EQ(detail::smallestEigenvalueClamped(bad), 0.0);
 }
 
+// The profile at many directions in one call (lanes of 8, a last block
+// part-filled) gives, bit for bit, its value at each direction alone: the
+// screen's lattice and its descent compare values from both.
+TEST(LineProfile, ValuesInOneCallEqualEachAlone) {
+  for (std::uint64_t seed : {21, 22}) {
+    const PeerSceneTrial tr = peerTrial(seed, 2.0, 1.0, 20 + 180 * static_cast<int>(seed % 2));
+    ASSERT_TRUE(tr.ok);
+    const detail::WindowFrames frames(tr.observations, tr.given_motion);
+    const detail::LineProfile profile(tr.observations, tr.given_motion, frames.clusters(), 0, 1);
+    std::vector<Vec3> dirs = detail::hemisphereDirections(100);
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> g;
+    for (int k = 0; k < 37; ++k) dirs.push_back(Vec3(g(rng), g(rng), g(rng)).normalized());
+    dirs.push_back(tr.true_direction);
+    std::vector<double> values(dirs.size());
+    profile.values(dirs.data(), dirs.size(), values.data());
+    for (size_t i = 0; i < dirs.size(); ++i) EXPECT_EQ(values[i], profile(dirs[i])) << "seed " << seed << " direction " << i;
+    EXPECT_LT(values.back(), *std::max_element(values.begin(), values.end()));  // not all equal
+  }
+}
+
 // The joint Levenberg-Marquardt minimises the same cost as the Ceres
 // refinement (refine.hpp): from the same start both end at the same point.
 TEST(JointProblem, ReachesTheCeresRefinementsMinimum) {

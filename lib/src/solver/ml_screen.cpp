@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "celc/solver/result.hpp"
+#include "profile_kernel.hpp"
 #include "robust_nullspace.hpp"
 #include "sampling.hpp"
 #include "sphere_tangent.hpp"
@@ -25,41 +26,15 @@ Mat3 skew(const Vec3& a) {
 
 }  // namespace
 
-double smallestEigenvalueClamped(const Mat3& Q) {
-  const double c2 = Q.trace();
-  const double c1 = Q(0, 0) * Q(1, 1) - Q(0, 1) * Q(0, 1) + Q(0, 0) * Q(2, 2) - Q(0, 2) * Q(0, 2) +
-                    Q(1, 1) * Q(2, 2) - Q(1, 2) * Q(1, 2);
-  const double c0 = Q.determinant();
-  if (!(c0 > 0.0 && c1 > 0.0 && c2 > 0.0)) return 0.0;  // a root at or below 0 (or NaN)
-  // In Newton's quadratic convergence a step s leaves an error of about
-  // s^2 / (r2 - r1) <= s^2 / l: a step below 1e-8 l that is also below
-  // 1e-3 of the one before (not the halving of a double root) leaves less
-  // than 1e-16 l. Where rounding stops the climb first, the step before must
-  // have been below 1e-6 l. A near-multiple root (linear convergence, good to
-  // eps^(1/2) or eps^(1/3) only) is left to the closed form.
-  double l = 0.0, last_step = HUGE_VAL;
-  for (int it = 0; it < 10; ++it) {
-    const double p = ((l - c2) * l + c1) * l - c0;
-    const double dp = (3.0 * l - 2.0 * c2) * l + c1;
-    const double step = dp > 0.0 && p < 0.0 ? -p / dp : 0.0;
-    if (!(step > 0.0)) {  // at r1 to rounding
-      if (last_step <= 1e-6 * l) return l;
-      break;
-    }
-    l += step;
-    if (step <= 1e-8 * l && step <= 1e-3 * last_step) return l;
-    last_step = step;
-  }
-  Eigen::SelfAdjointEigenSolver<Mat3> eig;
-  eig.computeDirect(Q, Eigen::EigenvaluesOnly);
-  return std::max(0.0, eig.eigenvalues()(0));
-}
-
 LineProfile::LineProfile(const WindowObservations& obs, const MotionModel& motion,
                          const std::vector<int>& clusters, int max_events, std::uint64_t seed) {
   for (size_t i = 0; i < clusters.size(); ++i) {
     const ClusterObservation& cl = obs.clusters[static_cast<size_t>(clusters[i])];
-    Sums s;
+    struct {
+      Mat3 S;
+      Vec3 beta[3][3];
+      Mat3 Hq[6];
+    } s;
     s.S.setZero();
     for (auto& row : s.beta)
       for (Vec3& b : row) b.setZero();
@@ -81,46 +56,32 @@ LineProfile::LineProfile(const WindowObservations& obs, const MotionModel& motio
     }
     if (n < 5) continue;  // fewer events than a line and a plane need
     for (Mat3& h : s.Hq) h = 0.5 * (h + h.transpose()).eval();
-    sums_.push_back(s);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) sums_.push_back(s.S(r, c));
+    for (int a = 0; a < 3; ++a)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k) sums_.push_back(s.beta[a][j](k));
+    for (int p = 0; p < 6; ++p)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) sums_.push_back(s.Hq[p](r, c));
+    ++clusters_;
   }
 }
 
-void LineProfile::forms(const Sums& s, const Vec3& v, Mat3& H, Mat3& B) {
-  for (int p = 0; p < 6; ++p) {
-    const double q = v.dot(s.Hq[p] * v);
-    H(kPairs[p][0], kPairs[p][1]) = q;
-    H(kPairs[p][1], kPairs[p][0]) = q;
+void LineProfile::values(const Vec3* dirs, size_t n, double* out) const {
+  constexpr size_t kBatch = 128;  // directions per kernel call (on the stack)
+  double x[kBatch], y[kBatch], z[kBatch];
+  for (size_t b = 0; b < n; b += kBatch) {
+    const size_t m = std::min(kBatch, n - b);
+    for (size_t i = 0; i < m; ++i) x[i] = dirs[b + i].x(), y[i] = dirs[b + i].y(), z[i] = dirs[b + i].z();
+    profileValues(sums_.data(), clusters_, x, y, z, m, out + b);
   }
-  for (int a = 0; a < 3; ++a)
-    for (int j = 0; j < 3; ++j) B(a, j) = s.beta[a][j].dot(v);
-  // H is singular along the direction that moves the line along the
-  // camera's path (exactly v when P = tau I), and B(v) vanishes there too:
-  // a relative ridge of 1e-9 leaves the minimum over d unchanged but for
-  // rounding.
-  H.diagonal().array() += 1e-9 * H.trace() + 1e-300;
 }
 
 double LineProfile::operator()(const Vec3& v) const {
-  double total = 0.0;
-  for (const Sums& s : sums_) {
-    Mat3 H, B;
-    forms(s, v, H, B);
-    // S - B H^-1 B^T = S - X^T X with H = L L^T and X = L^-1 B^T (H is
-    // positive definite: the ridge in forms()).
-    // (i00, i11, i22: the reciprocals of L's diagonal, one division each.)
-    const double i00 = 1.0 / std::sqrt(H(0, 0)), l10 = H(1, 0) * i00, l20 = H(2, 0) * i00;
-    const double i11 = 1.0 / std::sqrt(H(1, 1) - l10 * l10), l21 = (H(2, 1) - l20 * l10) * i11;
-    const double i22 = 1.0 / std::sqrt(H(2, 2) - l20 * l20 - l21 * l21);
-    Mat3 X;  // row r of X = L^-1 B^T, by forward substitution
-    for (int j = 0; j < 3; ++j) {
-      X(0, j) = B(j, 0) * i00;
-      X(1, j) = (B(j, 1) - l10 * X(0, j)) * i11;
-      X(2, j) = (B(j, 2) - l20 * X(0, j) - l21 * X(1, j)) * i22;
-    }
-    const Mat3 Q = s.S - X.transpose() * X;
-    total += smallestEigenvalueClamped(0.5 * (Q + Q.transpose()));
-  }
-  return total;
+  double out;
+  values(&v, 1, &out);
+  return out;
 }
 
 namespace {
@@ -135,8 +96,12 @@ void descend(const LineProfile& profile, ScreenMinimum& s, double max_step, doub
   const double h = std::max(tol, 1e-4);
   for (int it = 0; it < 20; ++it) {
     const Mat32 B = tangentBasis(s.v);
-    auto at = [&](double a, double b) { return profile((s.v + a * B.col(0) + b * B.col(1)).normalized()); };
-    const double jp1 = at(h, 0), jm1 = at(-h, 0), jp2 = at(0, h), jm2 = at(0, -h), jpp = at(h, h);
+    auto at = [&](double a, double b) -> Vec3 { return (s.v + a * B.col(0) + b * B.col(1)).normalized(); };
+    // The stencil's 5 values in one call.
+    const Vec3 stencil[5] = {at(h, 0), at(-h, 0), at(0, h), at(0, -h), at(h, h)};
+    double j5[5];
+    profile.values(stencil, 5, j5);
+    const double jp1 = j5[0], jm1 = j5[1], jp2 = j5[2], jm2 = j5[3], jpp = j5[4];
     const Eigen::Vector2d g((jp1 - jm1) / (2 * h), (jp2 - jm2) / (2 * h));
     Eigen::Matrix2d H;
     H(0, 0) = (jp1 - 2 * s.cost + jm1) / (h * h);
@@ -148,16 +113,21 @@ void descend(const LineProfile& profile, ScreenMinimum& s, double max_step, doub
     else step = -g.normalized() * max_step;
     if (!step.allFinite()) return;
     if (step.norm() > max_step) step *= max_step / step.norm();
-    // Halve until J falls; a step below tol ends the descent.
+    // Halve until J falls; a step below tol ends the descent. The halvings
+    // are evaluated up to 8 at a time and the first that falls is taken.
     bool moved = false;
-    for (; step.norm() >= tol; step *= 0.5) {
-      const Vec3 c = (s.v + B * step).normalized();
-      const double j = profile(c);
-      if (j < s.cost) {
-        s = {c, j};
-        moved = true;
-        break;
-      }
+    constexpr int kHalvings = 8;
+    while (!moved && step.norm() >= tol) {
+      Vec3 c[kHalvings];
+      int n = 0;
+      for (; n < kHalvings && step.norm() >= tol; ++n, step *= 0.5) c[n] = (s.v + B * step).normalized();
+      double j[kHalvings];
+      profile.values(c, static_cast<size_t>(n), j);
+      for (int k = 0; k < n && !moved; ++k)
+        if (j[k] < s.cost) {
+          s = {c[k], j[k]};
+          moved = true;
+        }
     }
     if (!moved) return;
   }
@@ -170,9 +140,11 @@ std::vector<ScreenMinimum> screenProfile(const LineProfile& profile, int lattice
   std::vector<ScreenMinimum> out;
   if (profile.size() == 0 || lattice < 1 || keep < 1) return out;
   const std::vector<Vec3>& dirs = hemisphereDirections(lattice);
+  std::vector<double> values(dirs.size());
+  profile.values(dirs.data(), dirs.size(), values.data());
   std::vector<ScreenMinimum> grid;
   grid.reserve(dirs.size());
-  for (const Vec3& d : dirs) grid.push_back({d, profile(d)});
+  for (size_t i = 0; i < dirs.size(); ++i) grid.push_back({dirs[i], values[i]});
   std::sort(grid.begin(), grid.end(),
             [](const ScreenMinimum& a, const ScreenMinimum& b) { return a.cost < b.cost; });
   // Lattice spacing on the hemisphere (2 pi sr): the longest descent step,

@@ -36,7 +36,8 @@ namespace celc::detail {
 /// where r1 is apart from the other roots (the profile's case: a line's
 /// residual against two large spreads). Near a double or triple root it
 /// converges linearly and only to eps^(1/2) or eps^(1/3): Eigen's closed form
-/// answers there instead.
+/// answers there instead. (profile_kernel.cpp: the profile runs the same
+/// iteration on 8 directions at a time.)
 double smallestEigenvalueClamped(const Mat3& Q);
 
 /// The profile J(v) of a window's clusters.
@@ -48,21 +49,19 @@ class LineProfile {
               const std::vector<int>& clusters, int max_events, std::uint64_t seed);
   /// J(v) for a unit v [rad^2: squared angles up to |n_k| / |m|].
   double operator()(const Vec3& v) const;
+  /// out[i] = J(dirs[i]), i < n: the same values, up to 8 directions in
+  /// about the time of one (profile_kernel.hpp).
+  void values(const Vec3* dirs, size_t n, double* out) const;
   /// Clusters summed.
-  size_t size() const { return sums_.size(); }
+  size_t size() const { return clusters_; }
 
  private:
-  /// One cluster's sums: S (3x3), the linear forms beta[a][j] with
-  /// B(v)_aj = beta[a][j].v, and the quadratic forms of H(v)_ij = v^T Hq[ij] v
-  /// (ij over the 6 pairs i <= j).
-  struct Sums {
-    Mat3 S;
-    Vec3 beta[3][3];
-    Mat3 Hq[6];
-  };
-  std::vector<Sums> sums_;
-  /// H(v) with its ridge, and B(v), of one cluster.
-  static void forms(const Sums& s, const Vec3& v, Mat3& H, Mat3& B);
+  /// Each cluster's sums, packed as profile_kernel.hpp lays them out: S
+  /// (3x3), the linear forms beta[a][j] with B(v)_aj = beta[a][j].v, and
+  /// the quadratic forms of H(v)_ij = v^T Hq[ij] v (ij over the 6 pairs
+  /// i <= j).
+  std::vector<double> sums_;
+  size_t clusters_ = 0;
 };
 
 /// The screen's result: local minima of J, lowest first.
