@@ -115,11 +115,11 @@ CELC_PASS_INLINE void newtonSmallest(const double* c0_in, const double* c1_in, c
     const Lanes p = ((l - c2) * l + c1) * l - c0;
     const Lanes dp = (3.0 * l - 2.0 * c2) * l + c1;
     const Lanes quotient = -p / dp;
-    const Lanes step = (dp > zero) & (p < zero) ? quotient : zero;
+    const Lanes step = ((dp > zero) & (p < zero)) ? quotient : zero;
     const Mask moves = step > zero;
     const Mask stalled = active & ~moves;  // at the root to rounding, or stuck
     const Mask close = last_step <= 1e-6 * l;
-    result = stalled & close ? l : result;
+    result = (stalled & close) ? l : result;
     failed |= stalled & ~close;
     const Mask advance = active & moves;
     const Lanes next = l + step;
@@ -132,7 +132,7 @@ CELC_PASS_INLINE void newtonSmallest(const double* c0_in, const double* c1_in, c
     for (size_t k = 0; k < kLanes; ++k) any = any || active[k] != 0;
     if (!any) break;
   }
-  const Lanes value = failed | active ? zero + std::numeric_limits<double>::quiet_NaN() : result;
+  const Lanes value = (failed | active) ? zero + std::numeric_limits<double>::quiet_NaN() : result;
   std::memcpy(out, &value, sizeof value);
 }
 
