@@ -70,10 +70,7 @@ int main(int argc, char** argv) {
       if (!tr.ok) continue;
       const CrlbResult b = velocityDirectionCrlb(tr.truth, tr.true_motion, tr.true_direction, o.event_noise_px);
       const SampleSeeds seeds{rng(), solver.refine.seed};
-      const auto all = solveMethods(tr.observations, tr.given_motion, {Method::Celc, Method::Npt, Method::CelcMl}, solver, seeds);
-      const SolverResult ml = all[2];
-      const SolverResult& lin = all[0];
-      const SolverResult& npt = all[1];
+      const SolverResult ml = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, solver, seeds)[0];
       if (!b.ok || !std::isfinite(b.rms_rad) || !ml.ok()) continue;
       bound_sq += b.rms_rad * b.rms_rad;
       const detail::WindowFrames frames(tr.observations, tr.given_motion);
@@ -97,17 +94,6 @@ int main(int argc, char** argv) {
                          angleBetweenSignAgnostic(from_ml.state.v, from_truth.state.v) * kDeg > 1.0;
       const bool truth_is_lower = from_truth.ok && (!from_ml.ok || from_truth.cost < from_ml.cost);
       truth_lower += apart && truth_is_lower;
-      if (apart) {
-        const double units = from_ml.events * std::abs(from_truth.cost - from_ml.cost) / std::min(from_truth.cost, from_ml.cost);
-        auto closer = [&](const SolverResult& w) {
-          if (!w.ok()) return -1;
-          return angleBetweenSignAgnostic(w.v, from_truth.state.v) < angleBetweenSignAgnostic(w.v, from_ml.state.v) ? 1 : 0;
-        };
-        std::fprintf(stderr, "APART cell %g,%g units %.2f truthlower %d lin_right %d npt_right %d ml_err %.2f truth_err %.2f\n",
-                     cell.speed, cell.sigma_px, units, truth_is_lower ? 1 : 0, closer(lin), closer(npt),
-                     angleBetweenSignAgnostic(ml.v, tr.true_direction) * kDeg,
-                     angleBetweenSignAgnostic(from_truth.state.v, tr.true_direction) * kDeg);
-      }
       wrong_lower += apart && !truth_is_lower;
       ml_err.push_back(ml_rad);
       truth_err.push_back(truth_rad);
