@@ -349,8 +349,8 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
   EXPECT_EQ(RunConfig{}.solver.ml.finalists, 3);
 }
 
-// ml.cheiral_tie: end points within 4 units of the lowest robust cost,
-// N (C - C_min) / C_min, are tied, and the one whose clusters agree best on
+// ml.cheiral_tie: end points within 6 units (the default) of the lowest
+// robust cost, N (C - C_min) / C_min, are tied, and the one whose clusters agree best on
 // the cheirality sign wins. The joint cost is blind to the side of the camera
 // a line lies on; a wrong basin that costs a little less on a draw of noise
 // puts some clusters' lines behind it. At the study's lowest parallax (V = 1
@@ -360,7 +360,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
 TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
   SolverOptions tie;
   tie.check_parallax = false;
-  ASSERT_EQ(tie.ml.cheiral_tie, 4.0);  // the default
+  ASSERT_EQ(tie.ml.cheiral_tie, 6.0);  // the default
   SolverOptions lowest = tie;
   lowest.ml.cheiral_tie = 0.0;
   const double speed = 1.0;

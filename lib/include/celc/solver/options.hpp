@@ -182,8 +182,10 @@ struct MlOptions {
   /// scale under Gaussian noise), are tied: among them the one whose
   /// clusters agree best on the side of the camera their lines lie
   /// (|sign margin| of resolveSign, sign.hpp) wins, in the screen and among
-  /// the finalists (0 = the lowest cost always).
-  double cheiral_tie = 4.0;  ///< [-]
+  /// the finalists (0 = the lowest cost always). 6: about the 95% point of
+  /// the chi-square law with 2 degrees of freedom (5.99), the direction's
+  /// two in which two basins differ.
+  double cheiral_tie = 6.0;  ///< [-]
   /// The Huber threshold of the joint cost becomes huber_scale times the
   /// robust scale (1.4826 MAD) of the residuals at the first start's end
   /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
