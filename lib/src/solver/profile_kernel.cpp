@@ -23,7 +23,8 @@ constexpr size_t kLanes = 8;
 constexpr int kNewtonIterations = 10;
 
 /// Q = S - X^T X of one cluster at v (its 6 entries q00 q01 q02 q11 q12 q22),
-/// with X = L^-1 B^T and H = L L^T (H's ridge as ml_screen.cpp states it).
+/// with X = L^-1 B^T and H = L L^T: S - B H^-1 B^T, the line's direction
+/// eliminated (ml_screen.hpp).
 struct SymQ {
   double q00, q01, q02, q11, q12, q22;
 };
@@ -48,7 +49,11 @@ CELC_PASS_INLINE SymQ clusterQ(const double* s, double v0, double v1, double v2)
       const double* b = beta + 9 * a + 3 * j;
       B[a][j] = b[0] * v0 + b[1] * v1 + b[2] * v2;
     }
-  // The ridge: H's diagonal += 1e-9 trace(H) + 1e-300.
+  // H is singular along the direction that moves the line along the
+  // camera's path (exactly v when P = tau I), and B(v) vanishes there too:
+  // a relative ridge of 1e-9 (H's diagonal += 1e-9 trace(H) + 1e-300) keeps
+  // H positive definite and leaves the minimum over d unchanged but for
+  // rounding. (i00, i11, i22: the reciprocals of L's diagonal.)
   const double ridge = 1e-9 * (h[0] + (h[3] + h[5])) + 1e-300;
   const double H00 = h[0] + ridge, H10 = h[1], H20 = h[2], H11 = h[3] + ridge, H21 = h[4], H22 = h[5] + ridge;
   const double i00 = 1.0 / std::sqrt(H00), l10 = H10 * i00, l20 = H20 * i00;
@@ -111,6 +116,13 @@ CELC_PASS_INLINE void newtonSmallest(const double* c0_in, const double* c1_in, c
   Mask active = (c0 > zero) & (c1 > zero) & (c2 > zero);
   Mask failed = {};
   Lanes l = zero, last_step = zero + HUGE_VAL, result = zero;
+  // In Newton's quadratic convergence a step s leaves an error of about
+  // s^2 / (r2 - r1) <= s^2 / l: a step below 1e-8 l that is also below 1e-3
+  // of the one before (not the halving of a double root) leaves less than
+  // 1e-16 l. Where rounding stops the climb first, the step before must have
+  // been below 1e-6 l. Otherwise (a near-multiple root, linear convergence,
+  // good to eps^(1/2) or eps^(1/3) only) the lane fails over to the closed
+  // form.
   for (int it = 0; it < kNewtonIterations; ++it) {
     const Lanes p = ((l - c2) * l + c1) * l - c0;
     const Lanes dp = (3.0 * l - 2.0 * c2) * l + c1;
@@ -182,6 +194,8 @@ void profileValues(const double* sums, size_t clusters, const double* x, const d
   profileLanes(sums, clusters, x, y, z, n, out);
 }
 
+// (One matrix in all 8 lanes: the profile's very iteration, for the tests
+// and any single use; no hot path calls it.)
 double smallestEigenvalueClamped(const Mat3& Q) {
   const SymQ q{Q(0, 0), Q(0, 1), Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2)};
   const Cubic c = characteristic(q);
