@@ -206,6 +206,15 @@ CELC_ISA_CLONES void huberCost(const double* c, size_t s, size_t begin, size_t c
   out[0] = total, out[1] = bad;
 }
 
+CELC_ISA_CLONES void distances(const double* c, size_t s, size_t begin, size_t count, const double* v,
+                               const double* m1, const double* m3, double focal, double* out) {
+#pragma omp simd
+  for (size_t k = 0; k < count; ++k) {
+    const Distance e = distance<false>(c, s, begin + k, v, m1, m3, focal);
+    out[k] = e.ok ? e.d : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
 }  // namespace
 
 JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, const Vec3& v,
@@ -236,6 +245,13 @@ double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, con
   double out[2];
   huberCost(columns.data(), columns.stride(), begin, end > begin ? end - begin : 0, vv, a1, a3, focal, delta, out);
   return out[1] > 0.0 ? std::numeric_limits<double>::infinity() : out[0];
+}
+
+void jointDistances(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
+                    const Vec3& m3, double focal, double* out) {
+  const double vv[3] = {v.x(), v.y(), v.z()}, a1[3] = {m1.x(), m1.y(), m1.z()},
+               a3[3] = {m3.x(), m3.y(), m3.z()};
+  distances(columns.data(), columns.stride(), begin, end > begin ? end - begin : 0, vv, a1, a3, focal, out);
 }
 
 }  // namespace celc::detail

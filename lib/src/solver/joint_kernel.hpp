@@ -64,4 +64,9 @@ JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t 
 double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
                       const Vec3& m3, double focal, double delta);
 
+/// The event distances d [px] of the same events into out[0 .. end - begin),
+/// NaN where the transferred line has no image direction.
+void jointDistances(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
+                    const Vec3& m3, double focal, double* out);
+
 }  // namespace celc::detail

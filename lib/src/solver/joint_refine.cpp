@@ -8,6 +8,7 @@
 
 #include "refine_costs.hpp"
 #include "sampling.hpp"
+#include "solve_spd4.hpp"
 #include "sphere_tangent.hpp"
 #include "thread_buffer.hpp"
 
@@ -124,12 +125,15 @@ double JointProblem::cost(const State& s, int stride) const {
       total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_, scale_);
     return 0.5 * total;  // +inf when a distance is not finite
   }
-  for (size_t c = 0; c + 1 < begin_.size(); ++c)
-    for (size_t k = begin_[c]; k < begin_[c + 1]; k += static_cast<size_t>(stride)) {
-      const double d = eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr);
-      if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
-      total += rho(d);
-    }
+  const JointColumns& cols = columns(stride);
+  distances_.resize(cols.size());
+  for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
+    jointDistances(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
+                   distances_.data() + column_begin_[c]);
+  for (double d : distances_) {
+    if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
+    total += rho(d);
+  }
   return 0.5 * total;
 }
 
@@ -143,11 +147,16 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
     out.events += static_cast<int>((begin_[c + 1] - begin_[c] + stride - 1) / stride);
   double f = cost(s, stride);
   if (!std::isfinite(f) || out.events < 3) return out;
-  std::vector<Mat4> U(nc);
-  std::vector<Mat24> W(nc);
-  std::vector<Vec4> bc(nc);
-  std::vector<Mat32> B1(nc), B3(nc);
-  std::vector<Eigen::LDLT<Mat4>> Uinv(nc);
+  // Per cluster: the Gauss-Newton blocks at s, the tangent bases of its
+  // lines, and (per try) U_d^-1 [W^T | bc] with U_d the damped U.
+  struct ClusterBlocks {
+    Mat4 U;
+    Mat24 W;
+    Vec4 bc;
+    Mat32 B1, B3;
+    Eigen::Matrix<double, 4, 3> X;
+  };
+  std::vector<ClusterBlocks> blocks(nc);
   double lambda = 1e-4;
   State trial = s;
   for (int it = 0; it < max_iterations; ++it) {
@@ -159,21 +168,22 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
     Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
     Eigen::Vector2d bv = Eigen::Vector2d::Zero();
     for (size_t c = 0; c < nc; ++c) {
-      B1[c] = tangentBasis(s.m1[c]);
-      B3[c] = tangentBasis(s.m3[c]);
+      ClusterBlocks& k = blocks[c];
+      k.B1 = tangentBasis(s.m1[c]);
+      k.B3 = tangentBasis(s.m3[c]);
       // An event whose distance is not finite adds nothing (not at s: its
       // cost is finite).
       const JointBlockSums b =
           jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
-                         B1[c].data(), B3[c].data(), focal_,
+                         k.B1.data(), k.B3.data(), focal_,
                          loss_ == Loss::Huber ? JointLossKind::Huber : JointLossKind::Cauchy, scale_);
       V(0, 0) += b.V[0], V(0, 1) += b.V[1], V(1, 0) += b.V[1], V(1, 1) += b.V[2];
       bv += Eigen::Vector2d(b.bv[0], b.bv[1]);
-      for (int i = 0, k = 0; i < 4; ++i)
-        for (int j = i; j < 4; ++j, ++k) U[c](i, j) = U[c](j, i) = b.U[k];
+      for (int i = 0, n = 0; i < 4; ++i)
+        for (int j = i; j < 4; ++j, ++n) k.U(i, j) = k.U(j, i) = b.U[n];
       for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 4; ++j) W[c](i, j) = b.W[4 * i + j];
-      bc[c] = Vec4(b.bc[0], b.bc[1], b.bc[2], b.bc[3]);
+        for (int j = 0; j < 4; ++j) k.W(i, j) = b.W[4 * i + j];
+      k.bc = Vec4(b.bc[0], b.bc[1], b.bc[2], b.bc[3]);
     }
     // Damped steps until one lowers the cost (lambda grows on failure).
     bool accepted = false;
@@ -182,12 +192,14 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
       S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
       Eigen::Vector2d rhs = -bv;
       for (size_t c = 0; c < nc; ++c) {
-        Mat4 Ud = U[c];
-        Ud.diagonal() += lambda * U[c].diagonal().cwiseMax(1e-12);
-        Uinv[c].compute(Ud);
-        const Mat24 WUi = Uinv[c].solve(W[c].transpose()).transpose();
-        S.noalias() -= WUi * W[c].transpose();
-        rhs.noalias() += WUi * bc[c];
+        ClusterBlocks& k = blocks[c];
+        Mat4 Ud = k.U;
+        Ud.diagonal() += lambda * k.U.diagonal().cwiseMax(1e-12);
+        k.X.leftCols<2>() = k.W.transpose();
+        k.X.col(2) = k.bc;
+        solveSpd4(Ud, k.X);
+        S.noalias() -= k.X.leftCols<2>().transpose() * k.W.transpose();
+        rhs.noalias() += k.X.leftCols<2>().transpose() * k.bc;
       }
       const Eigen::Vector2d dv = S.ldlt().solve(rhs);
       if (!dv.allFinite()) {
@@ -196,14 +208,16 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
       }
       trial.v = retract(s.v, Bv, dv);
       for (size_t c = 0; c < nc; ++c) {
-        const Vec4 dc = -Uinv[c].solve(bc[c] + W[c].transpose() * dv);
+        // dc = -U_d^-1 (bc + W^T dv), from the columns solved above.
+        const ClusterBlocks& k = blocks[c];
+        const Vec4 dc = -(k.X.col(2) + k.X.leftCols<2>() * dv);
         if (!dc.allFinite()) {
           trial.m1[c] = s.m1[c];
           trial.m3[c] = s.m3[c];
           continue;
         }
-        trial.m1[c] = retract(s.m1[c], B1[c], dc.head<2>());
-        trial.m3[c] = retract(s.m3[c], B3[c], dc.tail<2>());
+        trial.m1[c] = retract(s.m1[c], k.B1, dc.head<2>());
+        trial.m3[c] = retract(s.m3[c], k.B3, dc.tail<2>());
       }
       const double ft = cost(trial, stride);
       if (ft < f) {

@@ -88,6 +88,7 @@ class JointProblem {
   mutable std::vector<size_t> column_begin_;
   mutable int column_stride_ = 0;
   const JointColumns& columns(int stride) const;
+  mutable std::vector<double> distances_;  // cost()'s under a Cauchy loss, per event
   std::vector<Vec3> m1_, m3_;                  // fitted lines (frames), unit
   /// rho(d) (twice the event's cost) and the IRLS residual r with dr/dd.
   double rho(double d) const;

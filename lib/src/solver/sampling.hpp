@@ -16,7 +16,7 @@ std::vector<size_t> rowQuota(const std::vector<size_t>& sizes, size_t budget, bo
 
 /// The k-th smallest of x (0-based, k < x.size(); x is reordered), the value
 /// std::nth_element puts at k. [lo, hi] is a guess of where it lies: when it
-/// holds (and x holds a few hundred values), only the values inside it are
+/// holds (and x holds a few dozen values), only the values inside it are
 /// selected among (after one pass without branches that moves them into
 /// `band`), else all of x are.
 double kthSmallest(std::vector<double>& x, size_t k, double lo, double hi, std::vector<double>& band);
