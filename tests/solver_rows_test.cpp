@@ -77,11 +77,16 @@ TEST(GeneralizedEigen3, RejectsIndefiniteB) {
 namespace {
 // The sign test counting every vote (kSignVotesPerCluster per cluster), as resolveSign did
 // before it stopped counting once a cluster's majority is decided (votes weighted by the
-// line's motion as there).
+// line's motion and the share of the window its lines span, as there).
 SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionModel& motion,
                                  const Vec3& v) {
   double votes = 0.0, weights = 0.0;
   long event_balance = 0;
+  double t_first = INFINITY, t_last = -INFINITY;
+  for (int c : detail::usableClusters(obs, 2)) {
+    t_first = std::min(t_first, obs.clusters[c].l1.t);
+    t_last = std::max(t_last, obs.clusters[c].l3.t);
+  }
   for (int c : detail::usableClusters(obs, 2)) {
     const auto& cl = obs.clusters[c];
     const auto fr = makeClusterFrame(cl, motion);
@@ -100,8 +105,10 @@ SignDecision resolveSignAllVotes(const WindowObservations& obs, const MotionMode
       else if (lambda < 0) ++neg;
     }
     if (pos == neg) continue;
+    const double share =
+        std::clamp((cl.l3.t - cl.l1.t) / (detail::kSignFullSpanShare * (t_last - t_first)), 0.0, 1.0);
     const double w = std::min(lineMotionPx(cl, motion, obs.focal_px, detail::kSignCentroidEvents),
-                              detail::kSignFullWeightPx);
+                              detail::kSignFullWeightPx) * share;
     votes += pos > neg ? w : -w;
     weights += w;
     event_balance += pos - neg;

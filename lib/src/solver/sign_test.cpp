@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <vector>
 
 namespace celc {
@@ -63,13 +64,25 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
     s.count(v, false);
   }
   // A line that hardly moved (rotation removed) carries almost no depth:
-  // each cluster's vote counts by its line's motion, up to kSignFullWeightPx.
+  // each cluster's vote counts by its line's motion, up to kSignFullWeightPx,
+  // and, where its own l1 .. l3 span less than kSignFullSpanShare of the
+  // window's (first l1 to last l3), in proportion to its span: a line seen
+  // over a short time moved mostly by its fits' and the rotation's errors
+  // (docs/solver.md).
+  double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
+  for (const SignVotes& s : clusters) {
+    t_first = std::min(t_first, s.cl->l1.t);
+    t_last = std::max(t_last, s.cl->l3.t);
+  }
+  const double window = t_last - t_first;
   double votes = 0.0, weights = 0.0;
   for (std::size_t i = 0; i < clusters.size(); ++i) {
     const SignVotes& s = clusters[i];
     if (s.pos == s.neg) continue;
     const double moved = frames.lineMotionPx(frames.clusters()[i]);
-    const double w = std::isfinite(moved) ? std::min(moved, kSignFullWeightPx) : 0.0;
+    const double share =
+        window > 0.0 ? std::clamp((s.cl->l3.t - s.cl->l1.t) / (kSignFullSpanShare * window), 0.0, 1.0) : 1.0;
+    const double w = std::isfinite(moved) && std::isfinite(share) ? std::min(moved, kSignFullWeightPx) * share : 0.0;
     votes += s.pos > s.neg ? w : -w;
     weights += w;
   }
