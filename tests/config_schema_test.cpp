@@ -252,7 +252,7 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, max_events, screen_events, profile_lattice, "
             "profile_starts, profile_events, start_iterations, finalists, cheiral_tie, huber_scale, cauchy_scale, "
-            "cauchy_min_tail, rate_offset)");
+            "cauchy_min_tail, tukey_scale, rate_offset)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
             "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");
@@ -267,6 +267,16 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(c.solver.refine.cauchy_min_tail, RefineOptions{}.cauchy_min_tail);  // unchanged
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.tukey_scale=-1", c); }),
             "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
+  // celc_ml's last refinement: Tukey's biweight at 3 robust scales in `celc run`.
+  EXPECT_EQ(RunConfig{}.solver.ml.tukey_scale, 3.0);
+  EXPECT_EQ(MlOptions{}.tukey_scale, 0.0);  // the library's default: Cauchy
+  applyRunSetting("solver.ml.tukey_scale=4.5", c);
+  EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=-1", c); }),
+            "--set solver.ml.tukey_scale=-1: tukey_scale must be finite and >= 0");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=nan", c); }),
+            "--set solver.ml.tukey_scale=nan: key 'solver.ml.tukey_scale': expected a number, got 'nan'");
+  EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);  // unchanged by a refused value
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.starts=0", c); }),
             "--set solver.refine.starts=0: starts must be in [1, 64]");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.screen_events=-1", c); }),

@@ -54,8 +54,11 @@ JointBlockSums directSums(const std::vector<EventTerm>& terms, size_t begin, siz
     double slope, r;
     if (loss == JointLossKind::Huber) {
       r = detail::sqrtHuber(d, scale, &slope);
-    } else {
+    } else if (loss == JointLossKind::Cauchy) {
       slope = 1.0 / std::sqrt(1.0 + (d / scale) * (d / scale));
+      r = slope * d;
+    } else {  // Tukey: sqrt(w) = 1 - (d / c)^2 within c, 0 beyond
+      slope = std::abs(d) < scale ? 1.0 - (d / scale) * (d / scale) : 0.0;
       r = slope * d;
     }
     const Eigen::Vector2d jv = slope * (Bv.transpose() * gv);
@@ -94,7 +97,7 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
   const std::vector<EventTerm> terms = randomTerms(201, rng);
   const std::vector<size_t> begin = {0, 61, 61, 201};
   const double focal = 320.0;
-  int checked = 0;
+  int checked = 0, tukey_inside = 0, tukey_beyond = 0;
   for (size_t step : {size_t{1}, size_t{3}}) {
     JointColumns columns;
     std::vector<size_t> column_begin;
@@ -106,7 +109,7 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
       const detail::Mat32 Bv = detail::tangentBasis(v), B1 = detail::tangentBasis(m1),
                           B3 = detail::tangentBasis(m3);
       for (size_t c = 0; c + 1 < begin.size(); ++c) {
-        for (JointLossKind loss : {JointLossKind::Huber, JointLossKind::Cauchy}) {
+        for (JointLossKind loss : {JointLossKind::Huber, JointLossKind::Cauchy, JointLossKind::Tukey}) {
           for (double scale : {0.5, 50.0}) {
             const JointBlockSums got =
                 detail::jointBlockSums(columns, column_begin[c], column_begin[c + 1], v, m1, m3, Bv.data(),
@@ -114,6 +117,11 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
             expectSumsNear(got, directSums(terms, begin[c], begin[c + 1], step, v, m1, m3, Bv, B1, B3, focal,
                                            loss, scale));
             ++checked;
+            if (loss == JointLossKind::Tukey)  // both sides of Tukey's cut are exercised
+              for (size_t k = begin[c]; k < begin[c + 1]; k += step) {
+                const double d = eventDistance(terms[k], v, m1, m3, focal, nullptr, nullptr, nullptr);
+                if (std::isfinite(d)) ++(std::abs(d) < scale ? tukey_inside : tukey_beyond);
+              }
           }
         }
         // The Huber cost: +inf with an event that has no image direction
@@ -138,5 +146,7 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
       }
     }
   }
-  EXPECT_EQ(checked, 2 * 3 * 3 * 2 * 2);
+  EXPECT_EQ(checked, 2 * 3 * 3 * 3 * 2);
+  EXPECT_GT(tukey_inside, 50);
+  EXPECT_GT(tukey_beyond, 50);
 }

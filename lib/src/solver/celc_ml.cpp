@@ -245,17 +245,21 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   const WindowFrames& used_frames = shifted_frames ? *shifted_frames : frames;
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));
-  // A last refinement under a redescending loss (ml.cauchy_scale), from the
-  // winner (the basin is chosen under Huber, whose cost has fewer minima),
-  // where the residuals have a heavier tail than Gaussian noise gives.
-  const double cauchy_px = options.ml.cauchy_scale > 0.0
-                               ? active->spread(best.state).cauchyScale(options.ml.cauchy_scale,
-                                                                        options.ml.cauchy_min_tail)
-                               : 0.0;
-  if (cauchy_px > 0.0) {
-    active->setLoss(JointProblem::Loss::Cauchy, cauchy_px);
-    JointProblem::Result r = active->refine(best.state, iterations, tolerance, 1);
-    if (r.ok) best = std::move(r);
+  // A last refinement under a redescending loss, from the winner (the basin
+  // is chosen under Huber, whose cost has fewer minima), where the residuals
+  // have a heavier tail than Gaussian noise gives: Cauchy's at
+  // ml.cauchy_scale robust scales, or with ml.tukey_scale > 0 Tukey's
+  // biweight at that many (an event beyond has no pull at all).
+  if (options.ml.cauchy_scale > 0.0) {
+    const ResidualSpread spread = active->spread(best.state);
+    const bool tukey = options.ml.tukey_scale > 0.0;
+    const double scale_px = spread.cauchyScale(tukey ? options.ml.tukey_scale : options.ml.cauchy_scale,
+                                               options.ml.cauchy_min_tail);
+    if (scale_px > 0.0) {
+      active->setLoss(tukey ? JointProblem::Loss::Tukey : JointProblem::Loss::Cauchy, scale_px);
+      JointProblem::Result r = active->refine(best.state, iterations, tolerance, 1);
+      if (r.ok) best = std::move(r);
+    }
   }
   SolverResult out;
   out.status = SolveStatus::Ok;

@@ -138,9 +138,15 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
         const double root = std::sqrt(inside ? 1.0 : 2.0 * scale * a - scale * scale);
         slope = inside ? 1.0 : scale / root;
         r = inside ? d : (d < 0.0 ? -root : root);
-      } else {
+      } else if (kLoss == JointLossKind::Cauchy) {
         const double q = d / scale;
         slope = 1.0 / std::sqrt(1.0 + q * q);
+        r = slope * d;
+      } else {
+        // Tukey's biweight by reweighting: sqrt(w) = 1 - q^2 inside, 0 beyond.
+        const double q = d / scale;
+        const double t = 1.0 - q * q;
+        slope = t > 0.0 ? t : 0.0;
         r = slope * d;
       }
       const bool use = in & ok & std::isfinite(d);
@@ -173,6 +179,12 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
   for (int k = 0; k < kSums; ++k)
     for (size_t l = 0; l < kLanes; ++l) sums[k] += acc[k][l];
   std::copy(sums, sums + kSums, out);
+}
+
+CELC_ISA_CLONES void blockSumsTukey(const double* c, size_t s, size_t begin, size_t count, const double* v,
+                                    const double* m1, const double* m3, const double* Bv, const double* B1,
+                                    const double* B3, double focal, double scale, double* out) {
+  blockSums<JointLossKind::Tukey>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 
 CELC_ISA_CLONES void blockSumsHuber(const double* c, size_t s, size_t begin, size_t count, const double* v,
@@ -227,8 +239,10 @@ JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t 
   const size_t count = end > begin ? end - begin : 0;
   if (loss == JointLossKind::Huber)
     blockSumsHuber(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
-  else
+  else if (loss == JointLossKind::Cauchy)
     blockSumsCauchy(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
+  else
+    blockSumsTukey(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
   JointBlockSums out;
   std::copy(total, total + 3, out.V);
   std::copy(total + 3, total + 5, out.bv);

@@ -39,9 +39,10 @@ class JointColumns {
 };
 
 /// The loss of a pass: Huber with threshold `scale` [px], or the Cauchy loss
-/// with scale c [px] by iteratively reweighted steps (weights frozen at the
-/// point of linearisation: r = d / sqrt(1 + d^2 / c^2)).
-enum class JointLossKind { Huber, Cauchy };
+/// or Tukey's biweight with scale c [px] by iteratively reweighted steps
+/// (weights frozen at the point of linearisation: r = d / sqrt(1 + d^2 / c^2),
+/// r = (1 - d^2 / c^2) d within c and 0 beyond).
+enum class JointLossKind { Huber, Cauchy, Tukey };
 
 /// One cluster's Gauss-Newton sums at (v, m1, m3) over the events
 /// begin .. end - 1 of the columns: with d the event distance [px]

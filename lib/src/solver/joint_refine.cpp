@@ -86,6 +86,10 @@ JointProblem::~JointProblem() {
 size_t JointProblem::events() const { return terms_.size(); }
 
 double JointProblem::rho(double d) const {
+  if (loss_ == Loss::Tukey) {
+    const double q = d / scale_, t = std::max(0.0, 1.0 - q * q);
+    return scale_ * scale_ / 3.0 * (1.0 - t * t * t);
+  }
   if (loss_ == Loss::Cauchy) {
     const double q = d / scale_;
     return scale_ * scale_ * std::log1p(q * q);
@@ -96,6 +100,11 @@ double JointProblem::rho(double d) const {
 }
 
 double JointProblem::weighted(double d, double* slope) const {
+  if (loss_ == Loss::Tukey) {
+    const double q = d / scale_;
+    *slope = std::max(0.0, 1.0 - q * q);
+    return *slope * d;
+  }
   if (loss_ == Loss::Cauchy) {
     const double q = d / scale_;
     *slope = 1.0 / std::sqrt(1.0 + q * q);
@@ -176,7 +185,10 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
       const JointBlockSums b =
           jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
                          k.B1.data(), k.B3.data(), focal_,
-                         loss_ == Loss::Huber ? JointLossKind::Huber : JointLossKind::Cauchy, scale_);
+                         loss_ == Loss::Huber    ? JointLossKind::Huber
+                         : loss_ == Loss::Cauchy ? JointLossKind::Cauchy
+                                                 : JointLossKind::Tukey,
+                         scale_);
       V(0, 0) += b.V[0], V(0, 1) += b.V[1], V(1, 0) += b.V[1], V(1, 1) += b.V[2];
       bv += Eigen::Vector2d(b.bv[0], b.bv[1]);
       for (int i = 0, n = 0; i < 4; ++i)

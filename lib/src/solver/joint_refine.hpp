@@ -7,7 +7,7 @@
 // a 4x4 block per cluster (the tangents of m1 and m3) and their coupling,
 // so one step costs O(events) and a 2x2 solve. The same cost as the Ceres
 // refinement (refine.hpp), without its per-problem set-up; or, after
-// setLoss(Cauchy), the Cauchy cost by iteratively reweighted steps.
+// setLoss(Cauchy / Tukey), that cost by iteratively reweighted steps.
 #include <cstdint>
 #include <vector>
 
@@ -65,8 +65,12 @@ class JointProblem {
   /// The loss of the cost: Huber with threshold scale [px] (sum of Huber
   /// rho(d^2)), or Cauchy with scale c [px], rho = c^2 log(1 + d^2 / c^2),
   /// a redescending loss: an event far from its cluster's line (another
-  /// edge's) pulls ~c^2 / d instead of Huber's constant c.
-  enum class Loss { Huber, Cauchy };
+  /// edge's) pulls ~c^2 / d instead of Huber's constant c; or Tukey's
+  /// biweight with scale c [px], rho = c^2 / 3 (1 - (1 - d^2 / c^2)^3)
+  /// within c and c^2 / 3 beyond: an event beyond c does not pull at all.
+  /// Cauchy and Tukey are minimised by reweighted steps (weights frozen at
+  /// the point of linearisation).
+  enum class Loss { Huber, Cauchy, Tukey };
   void setLoss(Loss loss, double scale_px) {
     loss_ = loss;
     scale_ = scale_px;

@@ -56,6 +56,7 @@ std::string MlOptions::validate() const {
   if (!(huber_scale >= 0.0) || !std::isfinite(huber_scale)) e += "huber_scale must be finite and >= 0; ";
   if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e += "cauchy_scale must be finite and >= 0; ";
   if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e += "cauchy_min_tail must be in [0, 1]; ";
+  if (!(tukey_scale >= 0.0) || !std::isfinite(tukey_scale)) e += "tukey_scale must be finite and >= 0; ";
   return e;
 }
 

@@ -115,6 +115,10 @@ void describe(FieldVisitor& v, MlOptions& o) {
                       "then a last refinement under a Cauchy loss at this times the residuals' robust scale: "
                       "other edges' events in a cluster stop pulling (0 = off)",
                       o.cauchy_scale, o.cauchy_min_tail);
+  v.field({"tukey_scale", "-",
+           "> 0: that last refinement uses Tukey's biweight at this times the robust scale instead of the "
+           "Cauchy loss (cauchy_scale 0 still turns it off)"},
+          o.tukey_scale);
   v.field({"rate_offset", "", "also estimate a constant gyro-rate offset with v, kept where a likelihood-ratio test "
                               "(p = 0.001) finds one (30-60 joint refinements more)"},
           o.rate_offset);

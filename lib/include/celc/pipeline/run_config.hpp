@@ -70,11 +70,12 @@ struct RunConfig {
   /// both have local minima that a single start falls into; and a larger
   /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
   /// with its three lowest screened basins refined to convergence; and
-  /// Tukey's biweight in the linear stage and in celc_opt's last refinement,
-  /// for clusters that hold a few per cent of another edge's events; and
-  /// celc_opt started from celc on 4 random row subsets, its lowest cost kept
-  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
-  /// linear stage's Tukey stage", "celc_opt's starts").
+  /// Tukey's biweight in the linear stage and in celc_opt's and celc_ml's
+  /// last refinements, for clusters that hold a few per cent of another
+  /// edge's events; and celc_opt started from celc on 4 random row subsets,
+  /// its lowest cost kept (docs/solver.md, "celc_ml's event budget",
+  /// "celc_ml's finalists", "The linear stage's Tukey stage", "celc_opt's
+  /// starts", "celc_ml's last refinement under Tukey's biweight").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
@@ -86,6 +87,7 @@ struct RunConfig {
     s.ml.max_events = 40000;
     s.ml.screen_events = 4000;
     s.ml.finalists = 3;
+    s.ml.tukey_scale = 3.0;
     return s;
   }();
   std::vector<Method> methods = allMethods();

@@ -204,6 +204,13 @@ struct MlOptions {
   /// Huber's estimate is kept, since Cauchy's cost is flatter where a window
   /// is weakly observed.
   double cauchy_min_tail = 0.01;  ///< [-]
+  /// > 0: that last refinement uses Tukey's biweight at tukey_scale robust
+  /// scales instead of the Cauchy loss, rho(d) = c^2 / 3 (1 - (1 - d^2 /
+  /// c^2)^3) within c and c^2 / 3 beyond: an event of another edge has no
+  /// pull at all, where under Cauchy many of them together still move v
+  /// (docs/solver.md, "celc_ml's last refinement under Tukey's biweight").
+  /// cauchy_scale = 0 still turns the last refinement off.
+  double tukey_scale = 0.0;  ///< [-]
   /// Also estimate a constant offset of the given angular velocity (a
   /// gyroscope bias) with v, kept where a likelihood-ratio test (p = 0.001)
   /// finds one (solver/rate_offset.hpp; docs/solver.md): some 30-60 joint
