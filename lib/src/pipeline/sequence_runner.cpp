@@ -91,9 +91,9 @@ struct SequenceRunner::Impl {
     const std::size_t budget = config.parallax.probeBudget(t1 - t0);
     std::size_t keep_every = std::max<std::size_t>(1, (events.size() + budget - 1) / budget);
     // A k times sparser subset needs longer time neighbourhoods: the probe
-    // clusters at c = the median normal speed (factor 1), where the sparse
-    // subsets found their clusters before the default factor became 3;
-    // D is a median over clusters and needs no purity.
+    // clusters at c = the median normal speed (factor at most 1, the default
+    // since the twenty-third session; it was 3 from the second); D is a
+    // median over clusters and needs no purity.
     ClusterOptions cluster = config.cluster;
     cluster.c_speed_factor = std::min(1.0, cluster.c_speed_factor);
     for (;;) {

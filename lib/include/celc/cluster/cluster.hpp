@@ -44,11 +44,11 @@ struct ClusterOptions {
   /// Time scale c [px/s]: points are (x, y, c*t). 0 = automatic: c_speed_factor
   /// times the median normal-flow speed of a first pass (ClusterResult::c_px_per_s).
   double c_px_per_s = 0.0;
-  /// Automatic c = this factor x the median normal-flow speed [-]: an edge at the
-  /// median speed leaves a surface steeper than 45 deg in (x, y, c*t), so its
-  /// time neighbourhoods (+-time_radius_px / c) span 1/factor of the time it
-  /// takes to move time_radius_px (docs/clustering.md, "Choosing c").
-  double c_speed_factor = 3.0;
+  /// Automatic c = this factor x the median normal-flow speed [-]: at 1 an edge
+  /// at the median speed leaves a surface at 45 deg in (x, y, c*t), and its
+  /// time neighbourhoods (+-time_radius_px / c) span the time it takes to move
+  /// time_radius_px; at f > 1, 1/f of it (docs/clustering.md, "Choosing c").
+  double c_speed_factor = 1.0;
   /// Automatic c is clamped to [c_min, c_max] [px/s].
   double c_min_px_per_s = 20.0;
   double c_max_px_per_s = 20000.0;
