@@ -591,6 +591,9 @@ TEST(Ce3lc, AnswersAnAmbiguousNullspaceWhenTheEventsFixTheDirection) {
 
 namespace {
 
+bool refitWith(std::vector<std::pair<double, Vec3>> events, double focal_px, const MotionModel& motion,
+               ClusterObservation& cl);
+
 /// A cluster that absorbed a piece of another edge (what the clustering does
 /// where edges cross: 93% purity on the rendered hand-held scenes,
 /// docs/solver.md): every cluster of the trial takes a contiguous tenth of its
@@ -606,16 +609,60 @@ bool withForeignEvents(const PeerSceneTrial& tr, WindowObservations& obs) {
     ClusterObservation& cl = obs.clusters[c];
     for (size_t k = 0; k < cl.size(); ++k) events.emplace_back(cl.times[k], cl.bearings[k]);
     for (size_t k = first; k < first + take; ++k) events.emplace_back(other.times[k], other.bearings[k]);
-    std::sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    cl.times.clear();
-    cl.bearings.clear();
-    for (const auto& [time, f] : events) {
-      cl.times.push_back(time);
-      cl.bearings.push_back(f);
-    }
-    if (!attachFittedLines(cl, obs.focal_px, LineFitOptions{}, &tr.given_motion)) return false;
+    if (!refitWith(std::move(events), obs.focal_px, tr.given_motion, cl)) return false;
   }
   return true;
+}
+
+/// The cluster's events replaced by `events` (time, bearing) in time order,
+/// its lines fitted again; false when a line fit fails.
+bool refitWith(std::vector<std::pair<double, Vec3>> events, double focal_px, const MotionModel& motion,
+               ClusterObservation& cl) {
+  std::sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  cl.times.clear();
+  cl.bearings.clear();
+  for (const auto& [time, f] : events) {
+    cl.times.push_back(time);
+    cl.bearings.push_back(f);
+  }
+  return attachFittedLines(cl, focal_px, LineFitOptions{}, &motion);
+}
+
+/// Angles [deg] to the truth of the joint minima from the true direction:
+/// on the trial's clean clusters, on `obs` under Huber, then on `obs` from
+/// that Huber minimum under each of `losses` (its scale in robust scales of
+/// the Huber minimum's residuals). ok false when a refinement fails.
+struct LossAngles {
+  bool ok = false;
+  double clean = NAN, huber = NAN;
+  std::vector<double> by_loss;
+};
+LossAngles lossAnglesFromTruth(const PeerSceneTrial& tr, const WindowObservations& obs,
+                               const std::vector<std::pair<detail::JointProblem::Loss, double>>& losses) {
+  const RefineOptions ro;
+  LossAngles out;
+  auto angle = [&](const Vec3& v) { return angleBetweenSignAgnostic(v, tr.true_direction) * kDeg; };
+  const detail::WindowFrames clean_frames(tr.observations, tr.given_motion);
+  const detail::JointProblem clean(tr.observations, tr.given_motion, clean_frames, ro.max_events,
+                                   ro.balance_clusters, ro.seed, ro.huber_px);
+  const auto m = clean.refine(clean.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
+  if (!m.ok) return out;
+  out.clean = angle(m.state.v);
+  const detail::WindowFrames frames(obs, tr.given_motion);
+  detail::JointProblem problem(obs, tr.given_motion, frames, ro.max_events, ro.balance_clusters, ro.seed,
+                               ro.huber_px);
+  const auto h = problem.refine(problem.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
+  if (!h.ok) return out;
+  out.huber = angle(h.state.v);
+  const double scale = problem.robustScale(h.state);
+  for (const auto& [loss, factor] : losses) {
+    problem.setLoss(loss, factor * scale);
+    const auto r = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
+    if (!r.ok) return out;
+    out.by_loss.push_back(angle(r.state.v));
+  }
+  out.ok = true;
+  return out;
 }
 
 double medianOf(std::vector<double> x) {
@@ -632,7 +679,6 @@ double medianOf(std::vector<double> x) {
 // then under Cauchy from it, against the minimum on the clean events. 30
 // fixed trials, V = 2 m/s, 0.5 px.
 TEST(JointProblem, CauchyLossLetsForeignEventsGo) {
-  const RefineOptions ro;
   const MlOptions ml;
   ASSERT_GT(ml.cauchy_scale, 0.0);  // on by default
   std::vector<double> phi_huber, phi_cauchy, phi_clean;
@@ -641,22 +687,11 @@ TEST(JointProblem, CauchyLossLetsForeignEventsGo) {
     ASSERT_TRUE(tr.ok);
     WindowObservations obs;
     ASSERT_TRUE(withForeignEvents(tr, obs));
-    const detail::WindowFrames clean_frames(tr.observations, tr.given_motion);
-    const detail::JointProblem clean(tr.observations, tr.given_motion, clean_frames, ro.max_events,
-                                     ro.balance_clusters, ro.seed, ro.huber_px);
-    const auto m = clean.refine(clean.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(m.ok);
-    phi_clean.push_back(angleBetweenSignAgnostic(m.state.v, tr.true_direction) * kDeg);
-    const detail::WindowFrames frames(obs, tr.given_motion);
-    detail::JointProblem problem(obs, tr.given_motion, frames, ro.max_events, ro.balance_clusters, ro.seed,
-                                 ro.huber_px);
-    const auto h = problem.refine(problem.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(h.ok);
-    problem.setLoss(detail::JointProblem::Loss::Cauchy, ml.cauchy_scale * problem.robustScale(h.state));
-    const auto c = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(c.ok);
-    phi_huber.push_back(angleBetweenSignAgnostic(h.state.v, tr.true_direction) * kDeg);
-    phi_cauchy.push_back(angleBetweenSignAgnostic(c.state.v, tr.true_direction) * kDeg);
+    const LossAngles a = lossAnglesFromTruth(tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}});
+    ASSERT_TRUE(a.ok);
+    phi_clean.push_back(a.clean);
+    phi_huber.push_back(a.huber);
+    phi_cauchy.push_back(a.by_loss[0]);
   }
   // Measured: 2.95 (Huber), 1.00 (Cauchy), 0.93 (the clean events).
   EXPECT_GT(medianOf(phi_huber), 2.0 * medianOf(phi_clean));  // the foreign events matter
@@ -683,14 +718,7 @@ bool withParallelEdge(const PeerSceneTrial& tr, double offset_px, WindowObservat
         events.emplace_back(cl.times[k], f);
       }
     }
-    std::sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    cl.times.clear();
-    cl.bearings.clear();
-    for (const auto& [time, f] : events) {
-      cl.times.push_back(time);
-      cl.bearings.push_back(f);
-    }
-    if (!attachFittedLines(cl, obs.focal_px, LineFitOptions{}, &tr.given_motion)) return false;
+    if (!refitWith(std::move(events), obs.focal_px, tr.given_motion, cl)) return false;
   }
   return true;
 }
@@ -707,7 +735,6 @@ bool withParallelEdge(const PeerSceneTrial& tr, double offset_px, WindowObservat
 // events 1.32 (offsets of 2 / 4 / 6 px: Cauchy 2.62 / 2.39 / 1.65, Tukey
 // 1.41 / 1.19 / 1.41).
 TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
-  const RefineOptions ro;
   const MlOptions ml;
   std::vector<double> phi_huber, phi_cauchy, phi_tukey, phi_clean;
   for (std::uint64_t t = 0; t < 30; ++t) {
@@ -715,26 +742,13 @@ TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
     ASSERT_TRUE(tr.ok);
     WindowObservations obs;
     ASSERT_TRUE(withParallelEdge(tr, 3.0, obs));
-    const detail::WindowFrames clean_frames(tr.observations, tr.given_motion);
-    const detail::JointProblem clean(tr.observations, tr.given_motion, clean_frames, ro.max_events,
-                                     ro.balance_clusters, ro.seed, ro.huber_px);
-    const auto m = clean.refine(clean.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(m.ok);
-    phi_clean.push_back(angleBetweenSignAgnostic(m.state.v, tr.true_direction) * kDeg);
-    const detail::WindowFrames frames(obs, tr.given_motion);
-    detail::JointProblem problem(obs, tr.given_motion, frames, ro.max_events, ro.balance_clusters, ro.seed,
-                                 ro.huber_px);
-    const auto h = problem.refine(problem.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(h.ok);
-    const double scale = problem.robustScale(h.state);
-    problem.setLoss(detail::JointProblem::Loss::Cauchy, ml.cauchy_scale * scale);
-    const auto c = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
-    problem.setLoss(detail::JointProblem::Loss::Tukey, 3.0 * scale);
-    const auto k = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
-    ASSERT_TRUE(c.ok && k.ok);
-    phi_huber.push_back(angleBetweenSignAgnostic(h.state.v, tr.true_direction) * kDeg);
-    phi_cauchy.push_back(angleBetweenSignAgnostic(c.state.v, tr.true_direction) * kDeg);
-    phi_tukey.push_back(angleBetweenSignAgnostic(k.state.v, tr.true_direction) * kDeg);
+    const LossAngles a = lossAnglesFromTruth(
+        tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}, {detail::JointProblem::Loss::Tukey, 3.0}});
+    ASSERT_TRUE(a.ok);
+    phi_clean.push_back(a.clean);
+    phi_huber.push_back(a.huber);
+    phi_cauchy.push_back(a.by_loss[0]);
+    phi_tukey.push_back(a.by_loss[1]);
   }
   EXPECT_GT(medianOf(phi_huber), 2.0 * medianOf(phi_clean));  // the piece matters
   EXPECT_LT(medianOf(phi_tukey), 0.7 * medianOf(phi_cauchy));
