@@ -251,8 +251,8 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.grid_start=3", c); }),
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, max_events, screen_events, profile_lattice, "
-            "profile_starts, profile_events, start_iterations, finalists, cheiral_tie, huber_scale, cauchy_scale, "
-            "cauchy_min_tail, tukey_scale, rate_offset)");
+            "profile_starts, profile_events, start_iterations, finalists, cheiral_tie, cheiral_min, cheiral_clusters, "
+            "huber_scale, cauchy_scale, cauchy_min_tail, tukey_scale, rate_offset)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
             "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");
@@ -277,6 +277,17 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=nan", c); }),
             "--set solver.ml.tukey_scale=nan: key 'solver.ml.tukey_scale': expected a number, got 'nan'");
   EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);  // unchanged by a refused value
+  // celc_ml's answer in front of the camera: on in `celc run`, off in the library.
+  EXPECT_EQ(RunConfig{}.solver.ml.cheiral_min, 0.9);
+  EXPECT_EQ(MlOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(MlOptions{}.cheiral_clusters, 10.0);
+  applyRunSetting("solver.ml.cheiral_min=0.8", c);
+  EXPECT_EQ(c.solver.ml.cheiral_min, 0.8);
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.cheiral_min=1.5", c); }),
+            "--set solver.ml.cheiral_min=1.5: cheiral_min must be in [0, 1]");
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.cheiral_clusters=-1", c); }),
+            "--set solver.ml.cheiral_clusters=-1: cheiral_clusters must be finite and >= 0");
+  EXPECT_EQ(c.solver.ml.cheiral_min, 0.8);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.starts=0", c); }),
             "--set solver.refine.starts=0: starts must be in [1, 64]");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.screen_events=-1", c); }),

@@ -215,6 +215,40 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       }
     }
   }
+  // ml.cheiral_min: the answer must put the clusters' lines in front of the
+  // camera; if it does not, the lowest screened end point that does, within
+  // ml.cheiral_clusters clusters' share of the lowest screened cost, is
+  // refined to convergence and replaces it (MlOptions::cheiral_min).
+  std::string cheiral_note;
+  if (options.ml.cheiral_min > 0.0) {
+    auto marginAt = [&](const Vec3& v) { return std::abs(resolveSign(obs, motion, v, frames).margin); };
+    const double answer_margin = marginAt(best.state.v);
+    if (answer_margin < options.ml.cheiral_min) {
+      std::vector<const End*> by_cost;
+      for (const End& e : screened) by_cost.push_back(&e);
+      std::stable_sort(by_cost.begin(), by_cost.end(),
+                       [](const End* a, const End* b) { return a->result.cost < b->result.cost; });
+      const double low = std::max(by_cost.front()->result.cost, 1e-300);
+      const double clusters = static_cast<double>(problem.clusters());
+      for (const End* e : by_cost) {
+        if (clusters * (e->result.cost - low) / low > options.ml.cheiral_clusters) break;
+        if (marginAt(e->result.state.v) < options.ml.cheiral_min) continue;
+        JointProblem::Result r = problem.refine(e->result.state, iterations, tolerance, 1);
+        if (!r.ok) continue;
+        const double m = marginAt(r.state.v);
+        if (m < options.ml.cheiral_min) continue;
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "answer in front of the camera: sign margin %.2f against %.2f at the lowest cost "
+                      "(%.1f deg away)",
+                      m, answer_margin, angleBetweenSignAgnostic(r.state.v, best.state.v) * 180.0 / M_PI);
+        cheiral_note = text;
+        best = std::move(r);
+        best_start = e->start;
+        break;
+      }
+    }
+  }
   // ml.rate_offset: where the events ask for an offset of the given rate
   // (rate_offset.hpp), the rest runs with the gyro shifted by it.
   std::optional<MotionModel> shifted_motion;
@@ -263,7 +297,8 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   }
   SolverResult out;
   out.status = SolveStatus::Ok;
-  out.message = tie_note.empty() ? note : note.empty() ? tie_note : tie_note + "; " + note;
+  for (const std::string* part : {&tie_note, &cheiral_note, &note})
+    if (!part->empty()) out.message += (out.message.empty() ? "" : "; ") + *part;
   out.v = best.state.v.dot(best_start->v) < 0 ? Vec3(-best.state.v) : best.state.v;  // keep the start's sign
   out.residual_px = residual_px;
   out.iterations = best.iterations;
@@ -283,6 +318,9 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       out.sign_margin = sd.margin * sd.sign;
     }
   }
+  // With cheiral_min, the margin reported is the answer's own (solveMethods
+  // floors sigma_deg by it).
+  if (options.ml.cheiral_min > 0.0) out.sign_margin = resolveSign(obs, used_motion, out.v, used_frames).margin;
   out.time_us =
       time_us + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   return out;

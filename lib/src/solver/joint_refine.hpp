@@ -59,6 +59,8 @@ class JointProblem {
 
   /// Events in the problem.
   size_t events() const;
+  /// Clusters in the problem.
+  size_t clusters() const { return begin_.size() - 1; }
   /// The spread of the residuals at s (sampling.hpp).
   ResidualSpread spread(const State& s) const;
   double robustScale(const State& s) const;  ///< spread(s).scale

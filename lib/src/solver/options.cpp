@@ -53,6 +53,9 @@ std::string MlOptions::validate() const {
   if (start_iterations < 0) e += "start_iterations must be >= 0; ";
   if (finalists < 1 || finalists > 100) e += "finalists must be in [1, 100]; ";
   if (!(cheiral_tie >= 0.0) || !std::isfinite(cheiral_tie)) e += "cheiral_tie must be finite and >= 0; ";
+  if (!(cheiral_min >= 0.0 && cheiral_min <= 1.0)) e += "cheiral_min must be in [0, 1]; ";
+  if (!(cheiral_clusters >= 0.0) || !std::isfinite(cheiral_clusters))
+    e += "cheiral_clusters must be finite and >= 0; ";
   if (!(huber_scale >= 0.0) || !std::isfinite(huber_scale)) e += "huber_scale must be finite and >= 0; ";
   if (!(cauchy_scale >= 0.0) || !std::isfinite(cauchy_scale)) e += "cauchy_scale must be finite and >= 0; ";
   if (!(cauchy_min_tail >= 0.0 && cauchy_min_tail <= 1.0)) e += "cauchy_min_tail must be in [0, 1]; ";

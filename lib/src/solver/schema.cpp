@@ -108,6 +108,14 @@ void describe(FieldVisitor& v, MlOptions& o) {
            "end points within this of the lowest robust cost, N (C - C_min) / C_min, are tied: the one whose "
            "clusters agree best on the cheirality sign wins (0 = lowest cost)"},
           o.cheiral_tie);
+  v.field({"cheiral_min", "-",
+           "an answer whose clusters' cheirality votes agree less than this (|sign margin|, 1 = unanimous) is "
+           "replaced by the lowest-cost screened end point that reaches it, if within cheiral_clusters; "
+           "still below it: sigma_deg >= 61.2 deg (0 = off)"},
+          o.cheiral_min);
+  v.field({"cheiral_clusters", "-",
+           "... that end point's cost within this many clusters' share of the lowest, K (C - C_min) / C_min"},
+          o.cheiral_clusters);
   v.field({"huber_scale", "-", "Huber threshold at this times the residuals' robust scale, at least "
                                 "refine.huber_px (0 = off)"},
           o.huber_scale);

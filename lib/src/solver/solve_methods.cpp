@@ -68,6 +68,11 @@ double answerIfObservable(const WindowObservations& obs, const MotionModel& moti
   return std::isfinite(rows_deg) ? rows_deg : 180.0;
 }
 
+/// sigma_deg of a celc_ml answer whose clusters' cheirality votes disagree
+/// (MlOptions::cheiral_min) at least this [deg]: the RMS angle of a random
+/// direction to a fixed one, sign-agnostic, sqrt(pi - 2) rad.
+constexpr double kRandomDirectionRmsDeg = 61.2;
+
 /// Seeds celc_opt's further starts (RefineOptions::starts): subset k's seed is
 /// the window's row seed XOR k times this.
 constexpr std::uint64_t kRestartSeed = 0xd1b54a32d192ed03ULL;
@@ -217,6 +222,9 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc) &&
         out[i].degeneracy == Degeneracy::NullspaceNotUnique)
       sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, terms(), frames, out[i]);
+    else if (methods[i] == Method::CelcMl && options.ml.cheiral_min > 0.0 && out[i].ok() &&
+             std::abs(out[i].sign_margin) < options.ml.cheiral_min)
+      sigma_floor_deg[i] = kRandomDirectionRmsDeg;
   // What every method shares (the window's verdict), and each estimate's
   // uncertainty at its own direction.
   for (size_t i = 0; i < out.size(); ++i) {

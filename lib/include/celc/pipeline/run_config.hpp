@@ -73,9 +73,11 @@ struct RunConfig {
   /// Tukey's biweight in the linear stage and in celc_opt's and celc_ml's
   /// last refinements, for clusters that hold a few per cent of another
   /// edge's events; and celc_opt started from celc on 4 random row subsets,
-  /// its lowest cost kept (docs/solver.md, "celc_ml's event budget",
-  /// "celc_ml's finalists", "The linear stage's Tukey stage", "celc_opt's
-  /// starts", "celc_ml's last refinement under Tukey's biweight").
+  /// its lowest cost kept; and celc_ml's answer kept in front of the camera
+  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
+  /// linear stage's Tukey stage", "celc_opt's starts", "celc_ml's last
+  /// refinement under Tukey's biweight", "celc_ml's answer in front of the
+  /// camera").
   SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
@@ -88,6 +90,7 @@ struct RunConfig {
     s.ml.screen_events = 4000;
     s.ml.finalists = 3;
     s.ml.tukey_scale = 3.0;
+    s.ml.cheiral_min = 0.9;
     return s;
   }();
   std::vector<Method> methods = allMethods();

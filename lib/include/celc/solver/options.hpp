@@ -186,6 +186,17 @@ struct MlOptions {
   /// the chi-square law with 2 degrees of freedom (5.99), the direction's
   /// two in which two basins differ.
   double cheiral_tie = 6.0;  ///< [-]
+  /// The scene lies in front of the camera: an answer whose clusters'
+  /// cheirality votes disagree, |sign margin| below cheiral_min (resolveSign,
+  /// sign.hpp; 1 = unanimous), is replaced by the lowest-cost screened end
+  /// point whose margin reaches it, refined to convergence, if that end
+  /// point's cost lies within cheiral_clusters clusters' share of the lowest,
+  /// K (C - C_min) / C_min over the K clusters: a lead that the errors of a
+  /// few impure clusters can make (docs/solver.md, "celc_ml's answer in
+  /// front of the camera"). An answer still below cheiral_min gets a
+  /// sigma_deg of at least 61.2 deg, a random direction's (0 = off).
+  double cheiral_min = 0.0;       ///< [-] in [0, 1]
+  double cheiral_clusters = 10.0;  ///< [-] clusters' share of the cost
   /// The Huber threshold of the joint cost becomes huber_scale times the
   /// robust scale (1.4826 MAD) of the residuals at the first start's end
   /// point when that exceeds refine.huber_px (0 = refine.huber_px always).
