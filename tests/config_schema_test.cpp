@@ -301,6 +301,11 @@ TEST(ConfigSchema, SetAssignments) {
   applyRunSetting("solver.uncertainty.agreement=false", c);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=1000", c); }),
             "--set solver.uncertainty.witness_rows=1000: uncertainty.witness_rows needs uncertainty.agreement: true");
+  // The sigma_deg floor of answers behind the camera: on in `celc run`, off in the library.
+  EXPECT_EQ(RunConfig{}.solver.uncertainty.cheiral_min, 0.9);
+  EXPECT_EQ(UncertaintyOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.cheiral_min=-0.1", c); }),
+            "--set solver.uncertainty.cheiral_min=-0.1: uncertainty.cheiral_min must be in [0, 1]");
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
   EXPECT_EQ(s.scene.camera.fx, 100.0);

@@ -394,16 +394,18 @@ TEST(EndToEnd, ClustersSeenBrieflyDoNotDecideTheSign) {
   fs::remove_all(d);
 }
 
-// celc_ml's answer in front of the camera (MlOptions::cheiral_min), on the
-// shipped hand-held scene (config/scenes/handheld_fast_rotation.yaml, three
-// windows). Measured with the option off: the third window's lowest joint
-// cost lies 0.173 rad from the truth where only 95% of the clusters' weighted
-// votes put the lines in front of the camera (|sign margin| 0.89); a basin
-// 0.026 rad off, unanimous (1.00), costs 1.2 clusters' share more. The first
-// window (the constant-velocity bias, rho ~ 0.84) is 0.670 rad off at
-// sigma_deg 0.96 with a margin of 0.51 and no cheiral basin near: with the
-// option it stays there but is no longer confident.
-TEST(EndToEnd, CelcMlAnswerLiesInFrontOfTheCamera) {
+// Answers in front of the camera (MlOptions::cheiral_min and
+// UncertaintyOptions::cheiral_min), on the shipped hand-held scene
+// (config/scenes/handheld_fast_rotation.yaml, three windows). Measured with
+// both off: the third window's lowest joint cost lies 0.173 rad from the
+// truth where only 95% of the clusters' weighted votes put the lines in
+// front of the camera (|sign margin| 0.89); a basin 0.026 rad off,
+// unanimous (1.00), costs 1.2 clusters' share more. The first window (the
+// constant-velocity bias, rho ~ 0.84) is 0.66-0.72 rad off for celc,
+// celc_opt and celc_ml at sigma_deg 0.96-2.7, with margins of 0.51-0.6 and
+// no cheiral basin near: with the options they stay there but are no
+// longer confident.
+TEST(EndToEnd, AnswersLieInFrontOfTheCamera) {
   const fs::path d = test::freshTempDir("e2e_cheiral");
   const auto synth = test::runCelc(
       "synth '" CELC_SOURCE_DIR "/config/scenes/handheld_fast_rotation.yaml' -o '" + (d / "seq").string() + "' -q",
@@ -411,25 +413,33 @@ TEST(EndToEnd, CelcMlAnswerLiesInFrontOfTheCamera) {
   ASSERT_EQ(synth.status, 0) << synth.err;
   auto celcMl = [&](const std::string& extra) {
     const fs::path out = d / ("run" + std::to_string(extra.size()));
-    const auto run = test::runCelc("run '" + (d / "seq").string() + "' --methods celc_ml --threads 2 -q " + extra +
-                                       " -o '" + out.string() + "'",
+    const auto run = test::runCelc("run '" + (d / "seq").string() + "' --methods celc,celc_opt,celc_ml --threads 2 -q " +
+                                       extra + " -o '" + out.string() + "'",
                                    d);
     EXPECT_EQ(run.status, 0) << run.err;
-    auto rows = readWindowsCsv((out / "windows.csv").string(), false);
-    EXPECT_EQ(rows.size(), 3u);
-    for (const auto& row : rows) EXPECT_EQ(row.status, "ok") << "window " << row.window;
+    std::map<std::pair<std::int64_t, std::string>, WindowsCsvRow> rows;
+    for (const auto& row : readWindowsCsv((out / "windows.csv").string(), false)) {
+      EXPECT_EQ(row.status, "ok") << "window " << row.window << ", " << row.method;
+      rows[{row.window, row.method}] = row;
+    }
+    EXPECT_EQ(rows.size(), 9u);
     return rows;
   };
-  const auto off = celcMl("--set solver.ml.cheiral_min=0");
-  const auto on = celcMl("");
-  ASSERT_EQ(off.size(), 3u);
-  ASSERT_EQ(on.size(), 3u);
-  EXPECT_GT(off[2].phi, 0.1);
-  EXPECT_LT(on[2].phi, 0.05);
-  EXPECT_GT(off[0].phi, 0.3);
-  EXPECT_LT(off[0].sigma_deg, 5.0);
-  EXPECT_GE(on[0].sigma_deg, 61.2);
-  // The window between holds its answer (margin 1.00 either way).
-  EXPECT_NEAR(on[1].phi, off[1].phi, 1e-9);
+  auto off = celcMl("--set solver.ml.cheiral_min=0 --set solver.uncertainty.cheiral_min=0");
+  auto on = celcMl("");
+  ASSERT_EQ(off.size(), 9u);
+  ASSERT_EQ(on.size(), 9u);
+  auto row = [](auto& rows, std::int64_t window, const std::string& method) -> const WindowsCsvRow& {
+    return rows[std::make_pair(window, method)];
+  };
+  EXPECT_GT(row(off, 2, "celc_ml").phi, 0.1);
+  EXPECT_LT(row(on, 2, "celc_ml").phi, 0.05);
+  for (const std::string method : {"celc", "celc_opt", "celc_ml"}) {
+    EXPECT_GT(row(off, 0, method).phi, 0.3) << method;
+    EXPECT_LT(row(off, 0, method).sigma_deg, 5.0) << method;
+    EXPECT_GE(row(on, 0, method).sigma_deg, 61.2) << method;
+    // The window between holds its answers (margin 1.00 either way).
+    EXPECT_NEAR(row(on, 1, method).phi, row(off, 1, method).phi, 1e-9) << method;
+  }
   fs::remove_all(d);
 }

@@ -318,9 +318,6 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       out.sign_margin = sd.margin * sd.sign;
     }
   }
-  // With cheiral_min, the margin reported is the answer's own (solveMethods
-  // floors sigma_deg by it).
-  if (options.ml.cheiral_min > 0.0) out.sign_margin = resolveSign(obs, used_motion, out.v, used_frames).margin;
   out.time_us =
       time_us + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   return out;

@@ -67,6 +67,7 @@ std::string UncertaintyOptions::validate() const {
   std::string e;
   if (max_events < 0) e += "uncertainty.max_events must be >= 0; ";
   if (witness_rows < 0) e += "uncertainty.witness_rows must be >= 0; ";
+  if (!(cheiral_min >= 0.0 && cheiral_min <= 1.0)) e += "uncertainty.cheiral_min must be in [0, 1]; ";
   if (witness_rows > 0 && !agreement) e += "uncertainty.witness_rows needs uncertainty.agreement: true; ";
   for (double s : {scale_celc, scale_celc_opt, scale_celc_ml, scale_ce3lc, scale_npt})
     if (!(s >= 0.0) || !std::isfinite(s)) {

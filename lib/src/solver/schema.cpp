@@ -110,8 +110,7 @@ void describe(FieldVisitor& v, MlOptions& o) {
           o.cheiral_tie);
   v.field({"cheiral_min", "-",
            "an answer whose clusters' cheirality votes agree less than this (|sign margin|, 1 = unanimous) is "
-           "replaced by the lowest-cost screened end point that reaches it, if within cheiral_clusters; "
-           "still below it: sigma_deg >= 61.2 deg (0 = off)"},
+           "replaced by the lowest-cost screened end point that reaches it, if within cheiral_clusters (0 = off)"},
           o.cheiral_min);
   v.field({"cheiral_clusters", "-",
            "... that end point's cost within this many clusters' share of the lowest, K (C - C_min) / C_min"},
@@ -140,6 +139,10 @@ void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"witness_rows", "rows",
            "with agreement: one more witness, celc on a second random subset of this many rows (0 = none)"},
           o.witness_rows);
+  v.field({"cheiral_min", "-",
+           "a celc / celc_opt / celc_ml estimate whose clusters' cheirality votes agree less than this (|sign "
+           "margin|, 1 = unanimous) gets sigma_deg >= 61.2 deg (0 = off)"},
+          o.cheiral_min);
   v.field({"max_events", "events", "events per window used for it (0 = all)"}, o.max_events);
   v.field({"scale_celc", "-", "calibration factor of sigma_deg for celc"}, o.scale_celc);
   v.field({"scale_celc_opt", "-", "... for celc_opt"}, o.scale_celc_opt);

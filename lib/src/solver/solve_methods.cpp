@@ -68,8 +68,8 @@ double answerIfObservable(const WindowObservations& obs, const MotionModel& moti
   return std::isfinite(rows_deg) ? rows_deg : 180.0;
 }
 
-/// sigma_deg of a celc_ml answer whose clusters' cheirality votes disagree
-/// (MlOptions::cheiral_min) at least this [deg]: the RMS angle of a random
+/// sigma_deg of an estimate whose clusters' cheirality votes disagree
+/// (UncertaintyOptions::cheiral_min) at least this [deg]: the RMS angle of a random
 /// direction to a fixed one, sign-agnostic, sqrt(pi - 2) rad.
 constexpr double kRandomDirectionRmsDeg = 61.2;
 
@@ -222,9 +222,21 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc) &&
         out[i].degeneracy == Degeneracy::NullspaceNotUnique)
       sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, terms(), frames, out[i]);
-    else if (methods[i] == Method::CelcMl && options.ml.cheiral_min > 0.0 && out[i].ok() &&
-             std::abs(out[i].sign_margin) < options.ml.cheiral_min)
-      sigma_floor_deg[i] = kRandomDirectionRmsDeg;
+  // Answers that put the clusters' lines behind the camera: their floor is
+  // applied last, so that they still witness with their Fisher sigma.
+  std::vector<bool> behind(out.size(), false);
+  if (u.enabled && u.cheiral_min > 0.0)
+    for (size_t i = 0; i < out.size(); ++i) {
+      const bool celc_family = methods[i] == Method::Celc || methods[i] == Method::CelcOpt ||
+                               methods[i] == Method::CelcMl;
+      behind[i] = celc_family && out[i].ok() &&
+                  std::abs(detail::resolveSign(obs, motion, out[i].v, frames).margin) < u.cheiral_min;
+    }
+  auto floorBehind = [&]() {
+    for (size_t i = 0; i < out.size(); ++i)
+      if (behind[i]) out[i].sigma_deg = std::max(out[i].sigma_deg, kRandomDirectionRmsDeg);
+    return out;
+  };
   // What every method shares (the window's verdict), and each estimate's
   // uncertainty at its own direction.
   for (size_t i = 0; i < out.size(); ++i) {
@@ -243,7 +255,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
     r.sigma_deg = std::max(terms().sigmaDeg(r.v, scale), sigma_floor_deg[i]);
   }
-  if (!u.enabled || !u.agreement) return out;
+  if (!u.enabled || !u.agreement) return floorBehind();
   // The witnesses: the ok estimates of the celc family with their Fisher
   // sigma, and the linear celc estimate when celc itself was not asked for.
   std::vector<SolverResult> witnesses;
@@ -276,7 +288,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
   }
   for (size_t i = 0; i < out.size(); ++i)
     if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], witness_of[i], witnesses);
-  return out;
+  return floorBehind();
 }
 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,

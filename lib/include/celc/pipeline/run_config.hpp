@@ -91,6 +91,7 @@ struct RunConfig {
     s.ml.finalists = 3;
     s.ml.tukey_scale = 3.0;
     s.ml.cheiral_min = 0.9;
+    s.uncertainty.cheiral_min = 0.9;
     return s;
   }();
   std::vector<Method> methods = allMethods();

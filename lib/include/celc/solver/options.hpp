@@ -193,8 +193,7 @@ struct MlOptions {
   /// point's cost lies within cheiral_clusters clusters' share of the lowest,
   /// K (C - C_min) / C_min over the K clusters: a lead that the errors of a
   /// few impure clusters can make (docs/solver.md, "celc_ml's answer in
-  /// front of the camera"). An answer still below cheiral_min gets a
-  /// sigma_deg of at least 61.2 deg, a random direction's (0 = off).
+  /// front of the camera"); 0 = off.
   double cheiral_min = 0.0;       ///< [-] in [0, 1]
   double cheiral_clusters = 10.0;  ///< [-] clusters' share of the cost
   /// The Huber threshold of the joint cost becomes huber_scale times the
@@ -256,6 +255,13 @@ struct UncertaintyOptions {
   /// flat (model errors: impure clusters, an accelerating camera) such
   /// subsets scatter, while the window's own estimates may share one bias.
   int witness_rows = 0;
+  /// > 0: an ok estimate of celc, celc_opt or celc_ml whose clusters'
+  /// cheirality votes agree less than this (|sign margin| of resolveSign at
+  /// the estimate, sign.hpp; 1 = unanimous) gets a sigma_deg of at least
+  /// 61.2 deg, the RMS angle of a random direction to a fixed one: the
+  /// scene must lie in front of the camera, and such answers were measured
+  /// wrong (docs/uncertainty.md, "Answers behind the camera").
+  double cheiral_min = 0.0;  ///< [-] in [0, 1]
   int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
   double scale_celc = 2.5;      ///< [-] factor for method celc
   double scale_celc_opt = 2.5;  ///< [-] for celc_opt
