@@ -217,7 +217,7 @@ void bindReaders(pyb::module_& m) {
 x, y float32 [px, origin top-left, x right, y down], p bool (ON).
 
 path: an RPG / UZH-FPV directory, an events text file, AEDAT 2.0 / 3.1 / 4.0,
-a ROS bag or an HDF5 file (format from the magic bytes, docs/io.md).
+a ROS bag or an HDF5 file (format from the magic bytes, docs/formats.md).
 t0, t1: keep t0 <= t < t1 [s]; max_events: at most that many (file order).
 options: the `input:` section of a run configuration as a dict, e.g.
 {"width": 240, "height": 180, "time_scale": 1e-6, "topic_events": "/dvs/events"}.

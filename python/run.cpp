@@ -32,7 +32,8 @@ std::vector<std::string> splitCsv(const std::string& line) {
 // int64 (-1 where the cell is empty), the rest float64 (NaN where empty).
 pyb::dict columns(const std::vector<std::string>& lines) {
   static const std::set<std::string> text{"method", "status", "reason"};
-  static const std::set<std::string> counts{"window", "n_events", "n_clusters", "n_lines"};
+  static const std::set<std::string> counts{"window",          "n_events", "n_clusters",    "n_lines",
+                                            "impure_clusters", "edges",    "edges_complete"};
   const std::vector<std::string> names = splitCsv(windowsCsvHeader());
   std::vector<std::vector<std::string>> cells;
   cells.reserve(lines.size());
@@ -100,7 +101,7 @@ pyb::dict run(const pyb::object& path, const pyb::object& config, const pyb::obj
   if (threads != 1) c.cluster.threads = 1;
   if (const std::string err = c.validate(); !err.empty()) throw ConfigError("run: configuration: " + err);
 
-  RunInputs inputs{existingPath(path), optionalPath(calib), optionalPath(groundtruth), optionalPath(imu)};
+  RunInputs inputs{existingPath(path), optionalPath(calib), optionalPath(groundtruth), optionalPath(imu), ""};
   std::vector<std::string> lines;
   {
     pyb::gil_scoped_release nogil;
@@ -125,10 +126,12 @@ void bindRun(pyb::module_& m) {
 windows.csv as a dict of numpy arrays, one entry per column in the file's
 order (window, t_start, t_end, n_events, n_clusters, method, status, vx, vy,
 vz, gt_vx, gt_vy, gt_vz, eps, phi, runtime_ms, reason, sigma_deg, parallax,
-n_lines, wx, wy, wz; units in docs/runs.md), one row per window and method.
+n_lines, wx, wy, wz, translation_px, then with truth labels purity,
+impure_clusters, edges, edges_complete, coverage, noise_admitted, oracle_phi;
+units in docs/running.md), one row per window and method.
 The values are the file's text read back (same digits as windows.csv):
-method / status / reason str arrays, window / n_events / n_clusters / n_lines
-int64 (-1 where the file's cell is empty), the others float64 (NaN where empty).
+method / status / reason str arrays, window / n_events / n_clusters / n_lines /
+impure_clusters / edges / edges_complete int64 (-1 where the file's cell is empty), the others float64 (NaN where empty).
 
 path: RPG / UZH-FPV directory, events / aedat file, ROS bag or HDF5 (a bag's
 camera and a container's poses are used unless calib / groundtruth say otherwise).

@@ -103,7 +103,7 @@ gyro_integrated), "true_omega", "camera" (dict for solve(calib=...)),
   m.def("synth", &synth, pyb::arg("scene"), pyb::arg("out_dir"), pyb::kw_only(), pyb::arg("seed") = pyb::none(),
         pyb::arg("duration") = pyb::none(), pyb::arg("threads") = pyb::none(), pyb::arg("force") = false,
         R"(`celc synth`: renders the scene (a SCENE.yaml path, or YAML text holding
-a newline; docs/synth.md) into the sequence directory out_dir (events.txt,
+a newline; docs/simulation.md) into the sequence directory out_dir (events.txt,
 imu.txt, groundtruth.txt, calib.yaml, ...), which celc.run reads as it is.
 seed, duration [s], threads override the scene's. Returns a summary dict
 (events, events_on, imu_samples, poses, duration [s], wall_seconds).)");

@@ -139,7 +139,7 @@ those fields); labels: cluster id per event (int, -1 = unassigned).
 omega: constant angular velocity wx, wy, wz [rad/s], camera frame (default
 0); or gyro: (N, 4) array t [s], wx, wy, wz [rad/s], camera frame (the
 gyro-integrated model). The reference time is the first labelled event.
-calib: calibration file (docs/calibration.md, calib.txt) or a dict of the
+calib: calibration file (docs/formats.md, calib.txt) or a dict of the
 camera schema (width, height, fx, fy, cx, cy, distortion_model, distortion); or
 normalized=True for normalised coordinates (focal [px] scales thresholds).
 config: run configuration (YAML path or dict: its lines, observations,

@@ -16,7 +16,7 @@
 #   CELC_FUZZ_SEED (default 0: libFuzzer picks one; CI sets 1, so that its run
 #   repeats the same mutations).
 # The corpus grows in BUILD/fuzz-corpus/<target> across runs (the long campaign:
-# run it again with a larger SECONDS; docs/fuzzing.md); findings go to
+# run it again with a larger SECONDS; docs/robustness.md); findings go to
 # BUILD/fuzz-artifacts/<target>/ (reproduce: BUILD/tests/fuzz/fuzz_<target> FILE).
 # The build also makes celc_sanitize_tests (scripts/test_sanitize.sh --subset).
 set -euo pipefail
@@ -108,7 +108,7 @@ max_len_of() {
 }
 
 # CI's executions per target: about 20 s each at the rates of a fresh corpus on
-# this machine (docs/fuzzing.md).
+# this machine (docs/robustness.md).
 ci_runs_of() {
   case "$1" in
     events_text) echo 20000 ;;

@@ -53,7 +53,7 @@ def plot(outdir, sweep):
             ax.plot(x, m, marker="o", ms=3, color=color, label=label)
             ax.fill_between(x, [a - b for a, b in zip(m, s)], [a + b for a, b in zip(m, s)],
                             color=color, alpha=0.15, lw=0)
-    for ax, name in zip(axes, ("eps = |v_gt - v|", "phi [rad]")):
+    for ax, name in zip(axes, ("eps (unit-vector distance)", "phi [rad]")):
         ax.set_xlabel(LABELS.get(sweep, sweep))
         ax.set_ylabel(name)
         ax.set_ylim(bottom=0)

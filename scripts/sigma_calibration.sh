@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The calibration of sigma_deg (docs/uncertainty.md): the share of ok windows
+# The calibration of sigma_deg (docs/accuracy.md): the share of ok windows
 # with phi <= 2 sigma_deg per method and setting, on simulated windows
 # (`celc simulate --study sigma`) and on rendered scenes: the shipped scenes
 # (config/scenes/*.yaml) and 16 held-out variants (scripts/heldout_scenes.py),

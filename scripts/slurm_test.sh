@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One-node Slurm test of scripts/slurm_batch.sh (issue 17).
+# One-node Slurm test of scripts/slurm_batch.sh.
 #   scripts/slurm_test.sh            (needs build/celc: scripts/setup.sh first)
 # Installs slurm-wlm and munge when missing (apt-get, through sudo when not
 # root), then, all inside a temporary folder and on free local ports:

@@ -4,7 +4,7 @@
 #   scripts/test_sanitize.sh [extra ctest args...]
 #       every test: a second GCC build directory (CELC_ASAN_BUILD_DIR, default
 #       build-asan), RelWithDebInfo, then ctest there (about an hour cold on
-#       2 cores: docs/fuzzing.md)
+#       2 cores: docs/robustness.md)
 #   scripts/test_sanitize.sh --subset [extra gtest args...]
 #       what CI runs: the tests of the readers, calibration and config files
 #       and the window source (celc_sanitize_tests, tests/fuzz/CMakeLists.txt

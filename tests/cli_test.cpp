@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 #include <random>
+#include <regex>
 #include <sstream>
 
 #include "celc/sim/line_scene.hpp"
@@ -170,9 +171,9 @@ TEST(Cli, SolveBadInputNamesFileAndLine) {
 // command gives the run's answers (the bundled sample, window 0: the same
 // events, clusters, gyro samples, configuration, seed and reference time;
 // bearings differ by the undistortion table's rounding, ~1e-8 measured).
-// Window 1 (0.175 s since the twentieth session) does not serve: its
+// Window 1 (0.175 s) does not serve: its
 // celc_opt is decided by that rounding (0.009 rad between run and solve),
-// as docs/runs.md describes for a window at a tie between basins.
+// as docs/running.md describes for a window at a tie between basins.
 TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
   const fs::path d = tempDir("dump");
   const std::string out = (d / "run").string(), dump = (d / "windows").string();
@@ -208,4 +209,16 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
     ASSERT_TRUE(alone.count(method)) << method;
     EXPECT_LT(angleBetween(v, alone.at(method)), 1e-6) << method;
   }
+}
+
+// `celc --version` names the release and the git revision it was built from
+// (a hexadecimal hash, "-dirty" for a modified tree, or "unknown" outside a
+// git checkout).
+TEST(Cli, VersionNamesReleaseAndRevision) {
+  const fs::path d = tempDir("version");
+  const auto r = runCelc("--version", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::regex form(R"(celc \d+\.\d+\.\d+ \(git ([0-9a-f]{7,40}(-dirty)?|unknown)\)\s*)");
+  EXPECT_TRUE(std::regex_match(r.out, form)) << r.out;
+  fs::remove_all(d);
 }

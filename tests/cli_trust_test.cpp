@@ -1,6 +1,6 @@
 // `celc run` / `celc table` refuse what would give silent mis-runs, resume
 // only the same configuration, name their rows, and never take a failed or
-// interrupted run for a result (issues 13 items 4-6, 15 item 8). Each case:
+// interrupted run for a result. Each case:
 // the exit status and the one-line message.
 #include <gtest/gtest.h>
 
@@ -49,7 +49,7 @@ fs::path sequenceWithBadLine(const fs::path& dir, int bad_line) {
 }
 }  // namespace
 
-// ---- issue 13, item 4: no silent mis-runs ----
+// ---- no silent mis-runs ----
 
 TEST(CliTrust, WindowSizesMustBePositiveAndFinite) {
   const fs::path d = test::freshTempDir("trust_win");
@@ -121,7 +121,7 @@ TEST(CliTrust, CalibrationOfAnotherSensorSizeIsRefused) {
 }
 
 // Clusters whose lines cannot be fitted are counted in the summary and their
-// reasons logged with --verbose (issue 12's bad-input rule).
+// reasons logged with --verbose.
 TEST(CliTrust, ClustersWithoutLinesAreCountedAndExplained) {
   const fs::path d = test::freshTempDir("trust_lines");
   const auto r = runCelc("run '" + kSample + "' -o " + q(d / "o") +
@@ -170,7 +170,7 @@ TEST(CliTrust, LastPartialWindowProcessedFromHalfAWindowElseReported) {
   fs::remove_all(d);
 }
 
-// ---- issue 13, item 5: resume that checks ----
+// ---- resume that checks ----
 
 TEST(CliTrust, ResumeRefusesAnotherConfigurationAndKeepsRows) {
   const fs::path d = test::freshTempDir("trust_resume");
@@ -198,7 +198,7 @@ TEST(CliTrust, ResumeRefusesAnotherConfigurationAndKeepsRows) {
   fs::remove_all(d);
 }
 
-// ---- issue 13, item 6: tables that name runs ----
+// ---- tables that name runs ----
 
 TEST(CliTrust, TableKeepsRunsOfTheSameNameApart) {
   const fs::path d = test::freshTempDir("trust_table");
@@ -236,7 +236,7 @@ TEST(CliTrust, BatchLabelsNameTheRows) {
   fs::remove_all(d);
 }
 
-// ---- issue 15, item 8: failed and interrupted runs are never results ----
+// ---- failed and interrupted runs are never results ----
 
 TEST(CliTrust, RunFailingBeforeItsFirstWindowLeavesNothing) {
   const fs::path d = test::freshTempDir("trust_early");

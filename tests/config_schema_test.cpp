@@ -163,6 +163,15 @@ TEST(ConfigSchema, ShippedFilesAreWhatTheSchemaWrites) {
         << "config/" << f.file << " differs from the schema: run `celc config --write-defaults config/`";
 }
 
+TEST(ConfigSchema, KeyReferencePagesAreWhatTheSchemaWrites) {
+  const auto pages = shippedReferences();
+  ASSERT_EQ(pages.size(), 2u);
+  for (const ShippedConfig& p : pages)
+    EXPECT_EQ(readText(std::string(CELC_SOURCE_DIR "/docs/configuration/") + p.file), p.text)
+        << "docs/configuration/" << p.file
+        << " differs from the schema: run `celc config --write-reference docs/configuration/`";
+}
+
 TEST(ConfigSchema, ShippedFilesReadToTheDefaults) {
   RunConfig run = loadRunConfig(CELC_SOURCE_DIR "/config/run.yaml"), run_default;
   EXPECT_EQ(values(run), values(run_default));

@@ -108,7 +108,7 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
 // celc_ml from extra hemisphere starts (MlOptions::grid_starts): on the
 // peer scene at parallax 0.125 (V = 1 m/s), 0.5 px, the single-start joint
 // refinement ends in a wrong basin in about a quarter of the trials
-// (docs/peers.md). With 16 more starts, keeping the lowest robust cost, the
+// (docs/accuracy.md). With 16 more starts, keeping the lowest robust cost, the
 // cost never gets worse and the error spread shrinks. Measured on these 24
 // trials: RMS 19.0 -> 10.7 deg with the paper's still 10% lines; with the
 // moving-line fit (lines/line_fit.hpp) the single start lands better,

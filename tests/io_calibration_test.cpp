@@ -1,4 +1,4 @@
-// Calibration YAML (docs/calibration.md) and RPG calib.txt.
+// Calibration YAML (docs/formats.md) and RPG calib.txt.
 #include <gtest/gtest.h>
 
 #include "celc/io/calibration.hpp"

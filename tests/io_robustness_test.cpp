@@ -1,5 +1,5 @@
-// Regression tests for the malformed inputs of issue 15 (and the reader checks
-// of issue 13): every reproducer is generated here, through the project's
+// Regression tests for malformed inputs and the readers' consistency checks:
+// every reproducer is generated here, through the project's
 // writers and byte edits. docs/robustness.md lists them with the behaviour each
 // one checks.
 #include <gtest/gtest.h>
@@ -332,7 +332,7 @@ TEST(IoRobustness, TruncatedBinaryFilesYieldTheirCompletePackets) {
   }
 }
 
-// ---- time sanity (issue 13 / 15) ------------------------------------------------
+// ---- time sanity ---------------------------------------------------------------
 
 TEST(IoRobustness, BackwardsBeyondToleranceIsAnErrorOrDroppedOrSorted) {
   TempDir d;

@@ -1,4 +1,4 @@
-// Boundary lines under motion (issue 12): labelled events from 3D segments
+// Boundary lines under motion: labelled events from 3D segments
 // (the peer scene: segments in view at both ends of the window, true
 // clusters) through the tool's own line fit with its defaults (the moving
 // model, given the rotation) and the solvers with theirs.
@@ -68,7 +68,7 @@ const std::vector<Method> kLineMethods{Method::Celc, Method::CelcOpt, Method::Ce
 // Noise-free float pixels: the fitted lines are exact (the moving model is
 // exact at constant velocity with the rotation known), so every method that
 // uses them is exact up to rounding, still and at 3 rad/s. Measured: at most
-// 0.02 deg; the paper's still 5 ms lines were 7 deg off (issue 12).
+// 0.02 deg, where the paper's still 5 ms lines are 7 deg off.
 TEST(LinesMotion, NoiseFreeEventsGiveExactVelocityStillAndRotating) {
   for (double omega : {0.0, 3.0}) {
     const Outcome r = runScenes(davis240Scene(4.0, 0.2, omega), kLineMethods, 5, 100);
@@ -145,7 +145,7 @@ TEST(LinesMotion, ClusterWithoutLinesServesNptOnly) {
   EXPECT_GT(angleBetweenSignAgnostic(without[2].v, all[2].v), 1e-6);  // the cluster counts for npt
 }
 
-// The table of docs/lines.md (opt-in, prints medians; not a check):
+// The table of docs/method.md (opt-in, prints medians; not a check):
 //   CELC_LINES_STUDY=1 build/celc_tests --gtest_filter=LinesMotion.Study
 TEST(LinesMotion, Study) {
   if (!std::getenv("CELC_LINES_STUDY")) GTEST_SKIP() << "set CELC_LINES_STUDY=1 to print the table";

@@ -1,5 +1,5 @@
 // The peer scene with an accelerating camera (PeerSceneOptions::acceleration)
-// and what a constant-velocity solver makes of it (docs/results.md, "A
+// and what a constant-velocity solver makes of it (docs/accuracy.md, "A
 // camera that accelerates").
 #include <gtest/gtest.h>
 

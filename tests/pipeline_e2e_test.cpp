@@ -1,6 +1,6 @@
 // End to end against rendered ground truth: `celc synth` renders a sequence,
 // `celc run` estimates the velocity per window, and the estimates are compared
-// with the simulator's twist (docs/synth.md, "End-to-end accuracy").
+// with the simulator's twist (docs/simulation.md, "End-to-end accuracy").
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,15 +141,11 @@ TEST(EndToEnd, DenseRecordingGetsWindowsShorterThanTheMaximum) {
 //   last step of 0.025 s is cut by the data at 0.29 s).
 // - Where the longest window has no room for it (max_seconds 0.15 s) it is
 //   a window of its own, and the parallax policy's verdict reaches it: its D,
-//   measured on the whole window, is 8.7 px (3.5 px while the clusters were
-//   grown at 3x the median speed, cluster.c_speed_factor 3), below
-//   windows.no_parallax_px set to 10 here, so every method is
-//   `degenerate / no_parallax` there, as at max_seconds. (At the default 7
-//   it is solved: celc_ml 0.12 rad off at sigma_deg 61, celc 1.46 at 1.0.)
-//   Before the eighth session such last windows were solved: over the
-//   development set and three held-out draws, 13 of them were ok, 8 of those
-//   more than 0.1 rad off (three with sigma_deg <= 3.4 deg at 0.27-1.57 rad;
-//   docs/results.md).
+//   measured on the whole window, is 8.7 px, below windows.no_parallax_px
+//   set to 10 here, so every method is `degenerate / no_parallax` there, as
+//   at max_seconds. (At the default 7 it is solved: celc_ml 0.12 rad off at
+//   sigma_deg 61, celc 1.46 at 1.0.) Solving such short last windows gives
+//   confident wrong answers (docs/decisions.md).
 TEST(EndToEnd, ShortLastWindowIsJoinedOrWithoutParallaxNotSolved) {
   const fs::path d = test::freshTempDir("e2e_last_window");
   ASSERT_EQ(renderEditedScene(d, "sample_davis346_room.yaml", {{"duration:", "duration: 0.29"}}), "");
@@ -227,20 +223,18 @@ TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
 // A held-out room (`heldout_scenes.py --seed 7000`, its first scene: 1.5
 // m/s, 0.98 rad/s, 1 Hz/px of noise) cut to 0.45 s, two windows of 0.225 s:
 // in the second, clusters at the chessboard's corners hold 5-20% of another
-// edge's events a few pixels from their line (docs/results.md, tenth
-// session). Huber's weights keep a bounded pull from each of those rows and
+// edge's events a few pixels from their line. Huber's weights keep a bounded pull from each of those rows and
 // celc is 0.09-0.20 rad off over seeds 1-4; with Tukey's biweight from the
 // Huber end point, 0.010-0.034 (measured). celc_opt's last refinement under
 // Tukey's biweight (solver.refine.tukey_scale 3) instead of the Cauchy loss:
 // 0.055-0.083 against 0.111-0.158 rad (seed 1, the test's: 0.057 / 0.154).
 // celc's part pins the linear stage's 1000 rows (`celc run`'s default): on
 // 4000 this window is 0.07-0.14 rad off with the Tukey stage and 0.28-0.33
-// without (celc_opt does not move; docs/results.md, twelfth session).
+// without (celc_opt does not move).
 // The clusters are grown at a fixed 20 deg (cluster.smoothness_noise_factor
-// 0, the default before the fourteenth session) and at 3x the median speed
-// (cluster.c_speed_factor 3, the default from the second to the
-// twenty-second session): the defaults give this window purer clusters,
-// where the stage matters less (with the noise angle: celc 0.079, celc_opt
+// 0) and at 3x the median speed (cluster.c_speed_factor 3), which leaves
+// these impure clusters; the defaults give this window purer clusters, where
+// the stage matters less (with the noise angle: celc 0.079, celc_opt
 // 0.036 rad).
 TEST(EndToEnd, TukeyStageKeepsCelcOnTrackWithImpureClusters) {
   const fs::path d = test::freshTempDir("e2e_tukey");
@@ -270,7 +264,7 @@ TEST(EndToEnd, TukeyStageKeepsCelcOnTrackWithImpureClusters) {
   fs::remove_all(d);
 }
 
-// Rendered pure rotation (issue 13): the sample's room seen by a camera that
+// Rendered pure rotation: the sample's room seen by a camera that
 // only turns, at 1.6 rad/s, for 0.6 s. With the default windows and with
 // fixed windows of 0.2 s and of 80,000 events, no row is `ok` with a
 // sigma_deg below 10 deg (measured: every window degenerate, no_parallax).
@@ -304,10 +298,9 @@ TEST(EndToEnd, RenderedPureRotationIsNeverConfident) {
 // fixed 20 deg, clusters ran through the corners from one grid line into the
 // next: 61% of the clustered events were in the majority line of their
 // cluster (renderer's labels), and celc_ml on those clusters was 1.13 rad
-// off. From the second to the twenty-second session c was 3x the median
-// speed against that (98%); the smoothness angle from the normals' noise
-// (cluster.smoothness_noise_factor) keeps the lines apart by itself, and the
-// factor is 1 again (docs/clustering.md, "Choosing c").
+// off; at 3x the median speed 98%. The smoothness angle from the normals'
+// noise (cluster.smoothness_noise_factor) keeps the lines apart by itself at
+// the default factor 1 (docs/clustering.md).
 TEST(EndToEnd, RenderedChessboardClustersArePure) {
   const fs::path d = test::freshTempDir("e2e_chessboard");
   ASSERT_EQ(renderEditedScene(d, "davis346_chessboard.yaml", {{"duration:", "duration: 0.25"}}), "");

@@ -284,8 +284,7 @@ TEST(WindowPolicy, ProbeBudgetGrowsPastMaxSeconds) {
 
 // The rest of the data after a window that showed the target is joined to
 // it when the rest is too short to show the target itself (D linear in the
-// length) and the joined window stays within the longest one. Until the
-// twentieth session only a rest too short for no_parallax_px was joined.
+// length) and the joined window stays within the longest one.
 TEST(WindowPolicy, JoinerJoinsARestTooShortToShowTheTarget) {
   ParallaxWindowOptions o;  // 25 px, 0.05 .. 0.3 s, steps of 0.025 s
   auto windows = [&](std::size_t n, double rate_px_s) {

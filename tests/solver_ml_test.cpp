@@ -304,7 +304,7 @@ TEST(JointProblem, StopsWhereAnEarlierEndIs) {
 
 // The default celc_ml beside the bound on fixed trials of the peers' scene
 // (5 lines x 200 events). The issue's targets are on the RMS over the peer
-// study's 500 trials per cell (docs/peers.md); over 40 trials one trial in a
+// study's 500 trials per cell (docs/accuracy.md); over 40 trials one trial in a
 // wrong basin moves the RMS by 2x, so this test checks the median (within
 // 1.3x of the bound's median; the study: 0.67-0.82x) and the tail: at most 3
 // of 40 trials beyond 4x their own bound (measured: 2, 0, 0; at V = 1 both
@@ -358,7 +358,7 @@ TEST(CelcMl, DrawsItsOwnEventBudget) {
   ASSERT_TRUE(all.ok());
   EXPECT_EQ(all.rows_used, 3000);
   // The defaults of `celc run` draw more than the library's: its windows
-  // hold 10^4-10^6 events (docs/solver.md).
+  // hold 10^4-10^6 events (docs/method.md).
   EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions{}.ml.max_events);
   options.ml.max_events = -1;
   EXPECT_NE(options.validate().find("max_events must be >= 0"), std::string::npos);
@@ -393,7 +393,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
   EXPECT_GE(lower, 4);
   three.ml.finalists = 0;
   EXPECT_NE(three.validate().find("finalists must be in [1, 100]"), std::string::npos);
-  // `celc run` refines three (docs/solver.md, "celc_ml's finalists").
+  // `celc run` refines three (docs/method.md, "celc_ml's finalists").
   EXPECT_EQ(RunConfig{}.solver.ml.finalists, 3);
 }
 
@@ -404,7 +404,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
 // puts some clusters' lines behind it. At the study's lowest parallax (V = 1
 // m/s, 5 x 200 events), 100 trials at 0.5 and at 1 px: measured RMS 8.03 ->
 // 6.64 deg (4 trials changed) and 18.5 -> 16.0 deg (12 changed);
-// docs/peers.md has the study's 500 trials per cell.
+// docs/accuracy.md has the study's 500 trials per cell.
 TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
   SolverOptions tie;
   tie.check_parallax = false;
@@ -473,16 +473,14 @@ TEST(CelcMl, ProfileStartsEscapeWrongBasins) {
 }
 
 
-// Issue 14 part 3: `celc solve`'s path on the peer scene at V = 1 m/s, 1 px:
-// in a few of 100 trials the linear stage finds its nullspace ambiguous (two
+// `celc solve`'s path on the peer scene at V = 1 m/s, 1 px: in a few of 100
+// trials the Huber-only linear stage finds its nullspace ambiguous (two
 // singular values within 0.2%), so celc is degenerate there; celc_ml answers
 // every trial from the line profile's minima (and the ambiguous direction),
-// mostly within 30 deg. Measured: 4 ambiguous trials; in one of them (91)
-// celc_ml is 84 deg off, as it was when the linear stage still answered it
-// (88 deg off) before its IRLS stopped cycling (robust_nullspace.cpp).
-// With `celc run`'s Tukey stage (solver.linear.tukey_k = 3) no trial of this
-// cell is ambiguous since the twelfth session: the test runs the Huber-only
-// stage, the library's default, to keep the path.
+// mostly within 30 deg (4 ambiguous trials at this seed; in one, trial 91,
+// celc_ml is 84 deg off). With the Tukey stage (solver.linear.tukey_k = 3)
+// no trial of this cell is ambiguous, so the test runs the Huber-only stage
+// to exercise the path.
 TEST(CelcMl, AnswersWhenTheLinearStageIsAmbiguous) {
   RunConfig defaults;
   defaults.solver.linear.tukey_k = 0.0;
@@ -551,7 +549,7 @@ TEST(CelcOpt, AnswersWhenTheLinearStageIsAmbiguous) {
   EXPECT_EQ(beyond_sigma, 0) << "of " << ambiguous << " ambiguous trials";
 }
 
-// Issue 14 part 3: a linear method whose rows leave the direction ambiguous
+// A linear method whose rows leave the direction ambiguous
 // answers when the events fix it (LinearOptions::answer_when_observable).
 // `celc solve`'s path at V = 1 m/s, 1 px: ce3lc's 15 rows (three per
 // cluster) imply a direction std above 30 deg in 6 of 100 trials, while the
@@ -596,7 +594,7 @@ bool refitWith(std::vector<std::pair<double, Vec3>> events, double focal_px, con
 
 /// A cluster that absorbed a piece of another edge (what the clustering does
 /// where edges cross: 93% purity on the rendered hand-held scenes,
-/// docs/solver.md): every cluster of the trial takes a contiguous tenth of its
+/// docs/method.md): every cluster of the trial takes a contiguous tenth of its
 /// neighbour's events, and its lines are fitted again from the mixture.
 /// False when a line fit fails.
 bool withForeignEvents(const PeerSceneTrial& tr, WindowObservations& obs) {

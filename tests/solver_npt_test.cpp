@@ -100,7 +100,7 @@ TEST(Npt, ConstantTwistApproximationError) {
 }
 
 // Noise: the faithful solver lands near an independent implementation's
-// medians on the peers' scene (5 lines x 200 events; issue 7: 0.31, 0.98, 3.2
+// medians on the peers' scene (5 lines x 200 events; published: 0.31, 0.98, 3.2
 // deg at V = 5 for sigma 0.5, 1, 2 px; 3.0, 8.5, 22 at V = 2). 60 trials per
 // cell; a factor of 1.8 either way covers the sampling spread of a median of
 // 60 (about +-20%) and the unknown details of that implementation (over 300
@@ -305,7 +305,7 @@ TEST(PeerScene, ConstraintsAndFittedLines) {
         // Fitted l1 and l3 (from the events, 1 px noise) within a few pixels
         // of the true line at their times: distance of the true endpoints. Only
         // at V = 1: at V = 16 the line moves ~60 px within each 10% interval
-        // and the fit of the smeared band is off by up to ~30 px (docs/peers.md).
+        // and the fit of the smeared band is off by up to ~30 px (docs/accuracy.md).
         const auto& cl = tr.observations.clusters[c];
         EXPECT_EQ(cl.size(), 200u);
         EXPECT_GT(cl.l3.t, cl.l1.t);

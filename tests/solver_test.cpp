@@ -184,7 +184,7 @@ TEST(Solvers, LinearIrlsSettlesWhereTheDirectionIsWeak) {
   }
   EXPECT_LE(at_limit, 1);
   // Still the estimator it was: the mean sign-agnostic error stays near the
-  // study's figures for celc in this cell (median 5 deg, docs/peers.md).
+  // study's figures for celc in this cell (median 5 deg, docs/accuracy.md).
   EXPECT_LT(phi_sum / trials * 180.0 / M_PI, 15.0);
 }
 

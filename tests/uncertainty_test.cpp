@@ -1,4 +1,4 @@
-// Issue 13 items 1, 2, 3, 7: sigma_deg per estimate and its calibration, the
+// sigma_deg per estimate and its calibration, the
 // quality columns of windows.csv, pure rotation never confident, gyro bias.
 #include <gtest/gtest.h>
 
@@ -247,6 +247,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   EXPECT_TRUE(rows[0].has_omega);
   EXPECT_NEAR(rows[0].omega.y(), -0.2, 1e-9);
   EXPECT_DOUBLE_EQ(rows[0].translation_px, 12.5);
+  EXPECT_FALSE(rows[0].has_truth);  // a record without truth labels: empty truth columns
   EXPECT_EQ(rows[1].status, "degenerate");
   EXPECT_EQ(rows[1].reason, "no_parallax");
   EXPECT_TRUE(std::isnan(rows[1].sigma_deg));
@@ -260,7 +261,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(old_rows.size(), 1u);
   EXPECT_TRUE(std::isnan(old_rows[0].sigma_deg));
   EXPECT_EQ(old_rows[0].n_lines, -1);
-  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,,");
+  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,," + ",,,,,,,");
   // The second format (23 columns, before translation_px): read, padded by one.
   const std::string v2 = old + ",,2.5,3.25,4,0.1,-0.2,0.3";
   {
@@ -271,7 +272,18 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(v2_rows.size(), 1u);
   EXPECT_DOUBLE_EQ(v2_rows[0].sigma_deg, 2.5);
   EXPECT_TRUE(std::isnan(v2_rows[0].translation_px));
-  EXPECT_EQ(padWindowsCsvLine(v2), v2 + ",");
+  EXPECT_EQ(padWindowsCsvLine(v2), v2 + "," + ",,,,,,,");
+  // The third format (24 columns, before the truth columns): read, padded by seven.
+  const std::string v3 = v2 + ",12.5";
+  {
+    std::ofstream f(path);
+    f << windowsCsvHeaderV3() << "\n" << v3 << "\n";
+  }
+  const auto v3_rows = readWindowsCsv(path, false);
+  ASSERT_EQ(v3_rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(v3_rows[0].translation_px, 12.5);
+  EXPECT_FALSE(v3_rows[0].has_truth);
+  EXPECT_EQ(padWindowsCsvLine(v3), v3 + ",,,,,,,");
   // Summaries: NaN sigma is never kept.
   const auto s = summarize(old_rows, 5.0);
   EXPECT_EQ(s[0].ok, 1);

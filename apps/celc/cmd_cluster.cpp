@@ -107,7 +107,7 @@ void registerCluster(CLI::App& app) {
       "cluster",
       "Space-time clustering of an event file's windows into line clusters; prints one CSV row "
       "per window (window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms,smoothness_deg)");
-  cmd->add_option("EVENTS", args->events, "events.txt: 't x y p' per line (s, px, px, 0/1), '#' comments")
+  cmd->add_option("EVENTS", args->events, "an event file or recording in any format celc run reads (text 't x y p', AEDAT, bag, HDF5)")
       ->required();
   cmd->add_option("--window-events", args->window_events, "events per window [events]")
       ->capture_default_str()

@@ -17,16 +17,22 @@ struct ConfigArgs {
   std::string show = "run";
   bool keys = false;
   std::string write_defaults;
+  std::string write_reference;
 };
 
+void writeFiles(const std::vector<ShippedConfig>& files, const std::string& dir) {
+  for (const ShippedConfig& f : files) {
+    const std::string path = (std::filesystem::path(dir) / f.file).string();
+    std::ofstream out(path, std::ios::binary);
+    if (!(out << f.text)) throw std::runtime_error(path + ": cannot write");
+    std::cerr << "wrote " << path << "\n";
+  }
+}
+
 void run(const ConfigArgs& a) {
-  if (!a.write_defaults.empty()) {
-    for (const ShippedConfig& f : shippedConfigs()) {
-      const std::string path = (std::filesystem::path(a.write_defaults) / f.file).string();
-      std::ofstream out(path, std::ios::binary);
-      if (!(out << f.text)) throw std::runtime_error(path + ": cannot write");
-      std::cerr << "wrote " << path << "\n";
-    }
+  if (!a.write_defaults.empty() || !a.write_reference.empty()) {
+    if (!a.write_defaults.empty()) writeFiles(shippedConfigs(), a.write_defaults);
+    if (!a.write_reference.empty()) writeFiles(shippedReferences(), a.write_reference);
     return;
   }
   RunConfig run_config;
@@ -56,6 +62,10 @@ void registerConfig(CLI::App& app) {
   cmd->add_flag("--keys", a->keys, "one line per key: dotted key = default [unit] doc");
   cmd->add_option("--write-defaults", a->write_defaults,
                   "rewrite run.yaml, simulate.yaml and cluster.yaml in this folder (config/)")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--write-reference", a->write_reference,
+                  "write the key reference pages run.md and simulate.md (Markdown) in this folder "
+                  "(docs/configuration/)")
       ->check(CLI::ExistingDirectory);
   cmd->callback([a]() { run(*a); });
 }

@@ -18,14 +18,14 @@ namespace {
 
 struct RunArgs {
   RunOverrides o;
-  std::string input, outdir, calib, groundtruth, imu, dump_windows;
+  std::string input, outdir, calib, groundtruth, imu, dump_windows, truth_labels;
 };
 
 void runRun(const RunArgs& a) {
   configureLogging(a.o.quiet, a.o.verbose);
   useOneMallocArena();  // windows of megabytes: the heap in huge pages for every thread
   SequenceJob job;
-  job.inputs = {a.input, a.calib, a.groundtruth, a.imu};
+  job.inputs = {a.input, a.calib, a.groundtruth, a.imu, a.truth_labels};
   job.config = buildRunConfig(a.o);
   defaultContainerInputs(job.inputs, job.config.reader);
   job.mode = outputMode(a.o);
@@ -69,12 +69,18 @@ void registerRun(CLI::App& app) {
           "(phi per window; with ground truth only) unless --no-plots.");
   cmd->add_option("input", a->input, "sequence directory or event file")->required();
   cmd->add_option("-o,--outdir", a->outdir, "output folder (default celc_run_<name>)");
-  cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/calibration.md) or ") + sequence_file::kCalibText)
+  cmd->add_option("--calib", a->calib, std::string("calibration YAML (docs/formats.md) or ") + sequence_file::kCalibText)
       ->check(CLI::ExistingFile);
   cmd->add_option("--groundtruth", a->groundtruth, "poses `t px py pz qx qy qz qw` [s, m]")
       ->check(CLI::ExistingFile);
   cmd->add_option("--imu", a->imu, "IMU text file (when not in the sequence directory)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--truth-labels", a->truth_labels,
+                  "FILE|none: the true edge of every event, one integer per line in the events' order, -1 = "
+                  "noise (`celc synth`'s labels.txt, used by default when the sequence directory holds one): "
+                  "windows.csv then gives each window's cluster purity, completeness, coverage and celc_ml's phi "
+                  "on the true clusters (oracle_phi); `none` turns it off")
+      ->check(CLI::ExistingFile | CLI::IsMember({"none"}));
   cmd->add_option("--dump-windows", a->dump_windows,
                   "also write each clustered window into this folder: window_NNNNN.csv (t,x,y,cluster: `celc "
                   "solve`'s input), window_NNNNN_gyro.csv and window_NNNNN.sh, the `celc solve` command that gives "

@@ -39,7 +39,7 @@ std::string fmtCell(double x) { return std::isfinite(x) ? fmt::format("{:.4f}", 
 // The default-setting table (mean +- std of eps and phi per method).
 void printDefaultTable(const std::vector<SweepCell>& cells) {
   std::cout << "\nDefault setting (paper Sec. 5.1): mean +- std over the trials with status ok\n\n"
-            << "| method | ok / trials | eps [m/s-dir] | phi [rad] | median phi [rad] | sign right | median time [us] |\n"
+            << "| method | ok / trials | eps (unit-vector distance) | phi [rad] | median phi [rad] | sign right | median time [us] |\n"
             << "|---|---|---|---|---|---|---|\n";
   for (const auto& c : cells)
     std::cout << fmt::format("| {} | {} / {} | {} +- {} | {} +- {} | {} | {} | {:.0f} |\n",

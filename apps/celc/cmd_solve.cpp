@@ -150,7 +150,7 @@ void registerSolve(CLI::App& app) {
   cmd->add_option("--gyro", a->gyro,
                   "gyroscope CSV t,wx,wy,wz [s, rad/s, camera frame]: gyro-integrated motion model")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--calib", a->calib, "calibration YAML (docs/calibration.md) or calib.txt")
+  cmd->add_option("--calib", a->calib, "calibration YAML (docs/formats.md) or calib.txt")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--normalized", a->normalized, "x, y are normalised (undistorted) coordinates");
   cmd->add_option("--focal", a->focal, "focal length [px] for pixel thresholds with --normalized")

@@ -81,7 +81,7 @@ void registerSynth(CLI::App& app) {
       "synth",
       "Rendering event simulator: textured planes seen by a moving DAVIS-like camera; writes an\n"
       "RPG-style sequence directory (" +
-          synthFileList() + ").\nSchema: docs/synth.md, config/scenes/.");
+          synthFileList() + ").\nSchema: docs/simulation.md, config/scenes/.");
   cmd->add_option("scene", args->scene, "SCENE.yaml describing camera, planes, motion, events, IMU")
       ->required()
       ->check(CLI::ExistingFile);

@@ -1,6 +1,7 @@
 // `celc table`: the paper-layout tables from existing windows.csv files.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "celc/io/labelled_events.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/run_output.hpp"
+#include "celc/solver/methods.hpp"
 #include "commands.hpp"
 #include "plots.hpp"
 
@@ -27,6 +29,7 @@ struct TableArgs {
   std::string output;
   std::string plot;  ///< --plot FILE.png (empty: none)
   double max_sigma_deg = -1.0;  ///< < 0: every ok row
+  std::string methods;  ///< --methods LIST (empty: every method in the results)
   bool quiet = false, allow_incomplete = false;
 };
 
@@ -141,6 +144,20 @@ void runTable(const TableArgs& a) {
     }
   }
 
+  // --methods: the columns, in the order given (e.g. the paper's three).
+  std::vector<std::string> wanted;
+  if (!a.methods.empty()) {
+    try {
+      for (Method m : parseMethodList(a.methods)) wanted.push_back(toString(m));
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error("--methods '" + a.methods + "': " + e.what());
+    }
+  }
+  const auto column = [&](const std::string& method) {
+    return static_cast<std::size_t>(std::find(wanted.begin(), wanted.end(), method) - wanted.begin());
+  };
+  std::set<std::string> methods_found;
+
   std::vector<SequenceSummary> table;
   std::vector<std::string> kept_notes;
   for (const auto& g : groups) {
@@ -190,8 +207,20 @@ void runTable(const TableArgs& a) {
       kept_notes.push_back("- " + g.label + ": " + std::to_string(ok - dropped) + " of " + std::to_string(ok) +
                            " ok rows kept");
     }
-    table.push_back({g.label, summarize(rows)});
+    if (!wanted.empty()) {
+      for (const auto& r : rows) methods_found.insert(r.method);
+      rows.erase(std::remove_if(rows.begin(), rows.end(),
+                                [&](const WindowsCsvRow& r) { return column(r.method) == wanted.size(); }),
+                 rows.end());
+    }
+    SequenceSummary summary{g.label, summarize(rows)};
+    std::stable_sort(summary.methods.begin(), summary.methods.end(),
+                     [&](const MethodSummary& x, const MethodSummary& y) { return column(x.method) < column(y.method); });
+    table.push_back(std::move(summary));
   }
+  for (const auto& m : wanted)
+    if (!methods_found.count(m))
+      throw std::runtime_error("--methods: no rows of method '" + m + "' in the results");
   if (!a.output.empty()) {
     writeFileAtomically(a.output + ".md", tableMarkdown(table));
     writeFileAtomically(a.output + ".tex", tableLatex(table));
@@ -247,6 +276,9 @@ void registerTable(CLI::App& app) {
                   "DEG: only the windows a user would keep, ok rows with sigma_deg <= DEG [deg] "
                   "(rows without sigma_deg, from older files, are left out)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--methods", a->methods,
+                  "comma-separated methods, the table's columns in this order (default: every method in "
+                  "the results); --methods celc,celc_opt,ce3lc gives the paper's three columns");
   cmd->add_flag("--allow-incomplete", a->allow_incomplete,
                 "include runs that have not completed, their rows marked '(incomplete)'");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

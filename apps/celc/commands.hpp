@@ -21,6 +21,10 @@ void registerSynth(CLI::App& app);
 /// `celc config`: defaults and keys of the configuration schema (cmd_config.cpp).
 void registerConfig(CLI::App& app);
 
+/// The git revision the executable was built from (`git describe --always
+/// --dirty`; "unknown" outside a checkout), generated at build time.
+const char* gitRevision();
+
 /// Sets the spdlog level from --quiet / --verbose flags shared by all subcommands.
 void configureLogging(bool quiet, bool verbose);
 

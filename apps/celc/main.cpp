@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
       ": linear velocity of an event camera from the Continuous Event-Line Constraint\n"
       "(Peng, Xu, Yang, Kneip, BMVC 2021). Units: seconds, pixels, metres, radians."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("celc ") + CELC_VERSION);
+  app.set_version_flag("--version", std::string("celc ") + CELC_VERSION + " (git " + celc::app::gitRevision() + ")");
   // Subcommands, in the order `celc --help` lists them.
   celc::app::registerRun(app);
   celc::app::registerBatch(app);

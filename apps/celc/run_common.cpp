@@ -145,7 +145,7 @@ OutputMode outputMode(const RunOverrides& o) {
 void printSummary(const std::string& title, const SequenceOutcome& out) {
   auto f = [](double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : std::string("-"); };
   std::cout << "\n" << title << "\n\n"
-            << "| method | windows | ok | with gt | mean eps | median eps | mean phi [rad] | median phi [rad] | consistency R |\n"
+            << "| method | windows | ok | with gt | mean eps (unit-vector distance) | median eps (unit-vector distance) | mean phi [rad] | median phi [rad] | consistency R |\n"
             << "|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& m : out.summaries)
     std::cout << "| " << m.method << " | " << m.windows << " | " << m.ok << " | " << m.with_metrics

@@ -1,6 +1,6 @@
 // Reader throughput (events/s, one core) and the memory of windowed reading.
 // Inputs are generated once per process into the temp directory (removed at exit).
-// Targets (docs/io.md): events.txt >= 10 M/s, AEDAT 2.0 >= 50 M/s,
+// Targets (docs/formats.md): events.txt >= 10 M/s, AEDAT 2.0 >= 50 M/s,
 // AEDAT 4.0 LZ4 >= 30 M/s, windowed events.txt peak RSS < 300 MB.
 #include <benchmark/benchmark.h>
 #include <unistd.h>

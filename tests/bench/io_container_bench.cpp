@@ -2,7 +2,7 @@
 // memory of windowed reading from a bag. The inputs are written once per
 // process by tests/fixtures/make_fixtures.py --bench (Debian's python3-rosbag,
 // python3-h5py) into the temp directory and removed at exit.
-// Targets (docs/io.md): bag with lz4 chunks >= 10 M/s, HDF5 uncompressed >= 20 M/s.
+// Targets (docs/formats.md): bag with lz4 chunks >= 10 M/s, HDF5 uncompressed >= 20 M/s.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 

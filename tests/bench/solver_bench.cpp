@@ -93,7 +93,7 @@ static void BM_CelcLinearMethod1000Events(benchmark::State& state) {
 }
 BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
 
-// The CELC linear method as the dispatcher (solveMethods) runs it, the issue-14
+// The CELC linear method as the dispatcher (solveMethods) runs it, the timing
 // target: the clusters' frames, the rows, the IRLS and the sign test; the
 // window checks, shared by all methods, are measured apart
 // (BM_WindowChecks1000Events). arg = events per line, 5 lines.
@@ -150,7 +150,7 @@ static void BM_CelcLinearPeers16(benchmark::State& state) { timeCelcLinearPeers1
 BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 // The same with the Tukey stage that `celc run` and `celc solve` add
-// (solver.linear.tukey_k 3): the issue-14 target as a user's run meets it.
+// (solver.linear.tukey_k 3): the timing as a user's run meets it.
 static void BM_CelcLinearPeers16Tukey(benchmark::State& state) {
   LinearOptions opt;
   opt.tukey_k = 3.0;
@@ -163,7 +163,7 @@ BENCHMARK(BM_CelcLinearPeers16Tukey)->Arg(20)->Arg(200)->Unit(benchmark::kMicros
 // profile's screen, the joint refinements. Cycles over 16 trials (the time
 // depends on the trial); arg = events per line, 5 lines. The time column
 // includes the window's uncertainty (sigma_deg, the witnesses);
-// method_median_us is the method alone. Target (issue 14): median <= 1 ms at
+// method_median_us is the method alone. Target: median <= 1 ms at
 // 200 events per line, <= 0.3 ms at 20.
 static void BM_CelcMlPeers(benchmark::State& state) {
   const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
@@ -179,7 +179,7 @@ static void BM_CelcMlPeers(benchmark::State& state) {
   }
   // The method's own time (SolverResult::time_us, its starts included and
   // the window's uncertainty not), the figure the peer study's time column
-  // and issue 14's target give: median over the iterations [us].
+  // and the timing target give: median over the iterations [us].
   if (!method_us.empty()) {
     const auto mid = method_us.begin() + static_cast<std::ptrdiff_t>(method_us.size() / 2);
     std::nth_element(method_us.begin(), mid, method_us.end());

@@ -1,5 +1,5 @@
 // Speed of method npt (Gao et al., CVPR 2024) on the peers' scene, and of the
-// Cramér-Rao bound, 5 lines x 200 events (the reference: ~50 us per solve).
+// Cramér-Rao bound, 5 lines x 200 events (published reference: ~50 us per solve).
 #include <benchmark/benchmark.h>
 
 #include "celc/eval/crlb.hpp"

@@ -1,5 +1,5 @@
 // libFuzzer target: calibration files, RPG calib.txt and the YAML schema of
-// docs/calibration.md, from the same bytes. A loaded camera must be within the
+// docs/formats.md, from the same bytes. A loaded camera must be within the
 // bound the undistortion table accepts.
 #include "celc/geometry/undistort.hpp"
 #include "celc/io/calibration.hpp"

@@ -1,7 +1,7 @@
 #pragma once
 // Shared by the libFuzzer harnesses: the input goes to a file with a fixed name
 // (the readers take paths), and every error a reader or loader throws must keep
-// the contract of docs/io.md: one printable line that names the file. Any other
+// the contract of docs/formats.md: one printable line that names the file. Any other
 // exception (std::bad_alloc, a library's own exception, ...) is a finding: the
 // harness aborts so that libFuzzer records the input.
 #include <unistd.h>

@@ -12,7 +12,7 @@
 // order, so the bias should depend on their ratio, rho, and not on T.
 // The cells vary T at one V (same a) and V at one T (same rho).
 //   build/celc_acceleration_study [--trials N] [--seed S]
-// Prints a markdown table of the median phi [deg] per method (docs/results.md).
+// Prints a markdown table of the median phi [deg] per method (docs/accuracy.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
-// Where celc_ml's RMS beyond the Cramér-Rao bound comes from (issue 14's
-// target, docs/peers.md): the search for the joint cost's global minimum, or
+// Where celc_ml's RMS beyond the Cramér-Rao bound comes from (the peers' accuracy
+// target, docs/accuracy.md): the search for the joint cost's global minimum, or
 // that minimum itself. The peer study's trials (`celc simulate --study peers
 // --trials N`, the same seeding: pipeline/peer_study.hpp) of its 5 x 200
 // grid cells at V = 1, 2, 5 m/s and 0.5-2 px, with its solver options; per

@@ -1,6 +1,6 @@
 // What celc_ml's rate-offset search (solver.ml.rate_offset,
 // solver/rate_offset.hpp) buys on the peer study's rate-error cells
-// (docs/peers.md; the study's trials and seeding, pipeline/peer_study.hpp):
+// (docs/accuracy.md; the study's trials and seeding, pipeline/peer_study.hpp):
 // per cell the median / RMS sign-agnostic error [deg] of npt, celc_ml with
 // the option off and on, and of a joint refinement given the true offset
 // (no estimator has it: the floor the search aims at); how often the offset

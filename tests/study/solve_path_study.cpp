@@ -1,4 +1,4 @@
-// How often `celc solve` answers with its defaults (issue 14 part 3): the
+// How often `celc solve` answers with its defaults: the
 // peer scene's trials (sim/peer_scene.hpp) taken through the path that
 // `celc solve` takes for labelled events - normalised pixels and cluster
 // labels -> clustersFromLabels -> toObservations -> solveMethods, every option
@@ -6,7 +6,7 @@
 // event - and the share of trials each method answers (status ok) per cell,
 // with the ambiguous nullspaces the linear methods answered.
 //   build/celc_solve_path_study [--trials N] [--seed S]
-// Prints a markdown table (docs/peers.md); about 5 s for 100 trials per cell.
+// Prints a markdown table (docs/accuracy.md); about 5 s for 100 trials per cell.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -7,6 +7,7 @@
 #include <pcl/search/kdtree.h>
 #include <pcl/segmentation/region_growing.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "cluster/internal.hpp"
@@ -40,6 +41,9 @@ Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads
   ror.setRadiusSearch(opt.pcl_normal_radius_px > 0.0 ? opt.pcl_normal_radius_px : 2.0 * opt.grid_radius_px);
   ror.setMinNeighborsInRadius(opt.min_neighbours);
   ror.filter(*kept);
+  // Too few events left to grow a cluster: PCL's region growing does not
+  // accept empty indices (it dereferences an empty kd-tree), so stop here.
+  if (kept->size() < std::max<size_t>(3, static_cast<size_t>(opt.min_cluster_size))) return out;
 
   pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
   rg.setIndices(kept);

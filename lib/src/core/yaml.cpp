@@ -447,8 +447,8 @@ class Lister final : public TextVisitor {
   }
 
  private:
-  void value(const FieldInfo& i, const std::string& value, const std::vector<std::string>& = {}) override {
-    out_.push_back({join(path_, i.key), i.unit ? i.unit : "", i.doc ? i.doc : "", value});
+  void value(const FieldInfo& i, const std::string& value, const std::vector<std::string>& allowed = {}) override {
+    out_.push_back({join(path_, i.key), i.unit ? i.unit : "", i.doc ? i.doc : "", value, allowed});
   }
   std::vector<FieldEntry>& out_;
   std::string path_;

@@ -19,14 +19,18 @@ std::string windowsCsvHeaderV1() {
 }
 
 std::string windowsCsvHeaderV2() { return windowsCsvHeaderV1() + ",reason,sigma_deg,parallax,n_lines,wx,wy,wz"; }
-std::string windowsCsvHeader() { return windowsCsvHeaderV2() + ",translation_px"; }
+std::string windowsCsvHeaderV3() { return windowsCsvHeaderV2() + ",translation_px"; }
+std::string windowsCsvHeader() {
+  return windowsCsvHeaderV3() + ",purity,impure_clusters,edges,edges_complete,coverage,noise_admitted,oracle_phi";
+}
 
 std::string padWindowsCsvLine(const std::string& line) {
   std::string l = line;
   if (!l.empty() && l.back() == '\r') l.pop_back();
   const auto commas = std::count(l.begin(), l.end(), ',');
-  if (l.empty() || (commas != 15 && commas != 22)) return line;
-  return l + (commas == 15 ? ",,,,,,,," : ",");
+  if (l.empty() || (commas != 15 && commas != 22 && commas != 23)) return line;
+  const std::string truth = ",,,,,,,";  // the seven truth columns
+  return l + (commas == 15 ? ",,,,,,,," + truth : commas == 22 ? "," + truth : truth);
 }
 
 namespace {
@@ -69,7 +73,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     if (!l.empty() && l.back() == '\r') l.pop_back();
     const std::string where = path + ":" + std::to_string(no);
     if (no == 1) {
-      if (l != windowsCsvHeader() && l != windowsCsvHeaderV2() && l != windowsCsvHeaderV1())
+      if (l != windowsCsvHeader() && l != windowsCsvHeaderV3() && l != windowsCsvHeaderV2() &&
+          l != windowsCsvHeaderV1())
         throw std::runtime_error(where + ": not a celc windows.csv header");
       continue;
     }
@@ -77,8 +82,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     const bool last = i + 1 == lines.size();
     const auto f = splitList(l, ',');
     try {
-      if (f.size() != 16 && f.size() != 23 && f.size() != 24)
-        throw std::runtime_error(where + ": expected 16, 23 or 24 columns, got " + std::to_string(f.size()));
+      if (f.size() != 16 && f.size() != 23 && f.size() != 24 && f.size() != 31)
+        throw std::runtime_error(where + ": expected 16, 23, 24 or 31 columns, got " + std::to_string(f.size()));
       WindowsCsvRow r;
       r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
       r.t_start = toDouble(f[1], where, "t_start");
@@ -108,7 +113,17 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         if (r.has_omega)
           r.omega = Vec3(toDouble(f[20], where, "wx"), toDouble(f[21], where, "wy"), toDouble(f[22], where, "wz"));
       }
-      if (f.size() == 24 && !f[23].empty()) r.translation_px = toDouble(f[23], where, "translation_px");
+      if (f.size() >= 24 && !f[23].empty()) r.translation_px = toDouble(f[23], where, "translation_px");
+      if (f.size() == 31 && !f[26].empty()) {
+        r.has_truth = true;
+        if (!f[24].empty()) r.purity = toDouble(f[24], where, "purity");
+        r.impure_clusters = static_cast<int>(toDouble(f[25], where, "impure_clusters"));
+        r.edges = static_cast<int>(toDouble(f[26], where, "edges"));
+        r.edges_complete = static_cast<int>(toDouble(f[27], where, "edges_complete"));
+        if (!f[28].empty()) r.coverage = toDouble(f[28], where, "coverage");
+        if (!f[29].empty()) r.noise_admitted = toDouble(f[29], where, "noise_admitted");
+        if (!f[30].empty()) r.oracle_phi = toDouble(f[30], where, "oracle_phi");
+      }
       rows.push_back(r);
     } catch (const std::runtime_error&) {
       if (last && !complete_last && tolerate_truncated_tail) break;  // interrupted write
@@ -117,6 +132,39 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
   }
   if (lines.empty()) throw std::runtime_error(path + ": empty file");
   return rows;
+}
+
+std::string truthSummaryMarkdown(const std::vector<WindowsCsvRow>& rows) {
+  std::vector<double> purity, coverage, ml_phi, oracle_phi;
+  int windows = 0, few_impure = 0, edges = 0, complete = 0, within = 0, compared = 0;
+  for (const WindowsCsvRow& r : rows) {
+    if (r.method != "celc_ml" || !r.has_truth) continue;
+    ++windows;
+    if (std::isfinite(r.purity)) purity.push_back(r.purity);
+    if (std::isfinite(r.coverage)) coverage.push_back(r.coverage);
+    if (r.impure_clusters <= 1) ++few_impure;
+    edges += r.edges;
+    complete += r.edges_complete;
+    if (std::isfinite(r.oracle_phi)) {
+      ++compared;
+      oracle_phi.push_back(r.oracle_phi);
+      const double phi = r.has_metrics ? r.phi : M_PI;  // no answer: as far off as can be
+      ml_phi.push_back(phi);
+      if (phi <= std::max(1.5 * r.oracle_phi, r.oracle_phi + M_PI / 180.0)) ++within;
+    }
+  }
+  if (windows == 0) return "";
+  std::ostringstream o;
+  o << "Clusters against the truth labels (" << windows << " windows; docs/clustering.md):\n\n"
+    << "- event-weighted purity, median window: " << fmt(median(purity), 3) << "\n"
+    << "- windows with at most one cluster below 95% purity: " << few_impure << " of " << windows << "\n"
+    << "- edges with 80% of their events in one cluster: " << complete << " of " << edges << "\n"
+    << "- coverage of the edges' events, median window: " << fmt(median(coverage), 3) << "\n";
+  if (compared > 0)
+    o << "- celc_ml within max(1.5x, +1 deg) of celc_ml on the true clusters (the oracle): " << within << " of "
+      << compared << " windows; median phi " << fmt(median(ml_phi), 4) << " rad against the oracle's "
+      << fmt(median(oracle_phi), 4) << " rad\n";
+  return o.str();
 }
 
 std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows, double max_sigma_deg) {
@@ -184,7 +232,7 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
   o << "# " << title << "\n\n";
   for (const auto& n : notes) o << "- " << n << "\n";
   if (!notes.empty()) o << "\n";
-  o << "| method | windows | ok | with ground truth | mean eps | median eps | mean phi [rad] | median phi [rad] | direction consistency R | median spread [rad] | median runtime [ms] |\n"
+  o << "| method | windows | ok | with ground truth | mean eps (unit-vector distance) | median eps (unit-vector distance) | mean phi [rad] | median phi [rad] | direction consistency R | median spread [rad] | median runtime [ms] |\n"
     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& m : methods)
     o << "| " << m.method << " | " << m.windows << " | " << m.ok << " | " << m.with_metrics << " | "

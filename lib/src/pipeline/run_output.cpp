@@ -61,6 +61,23 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     else o << ",,,";
     o << ",";
     if (std::isfinite(rec.translation_px)) o << std::setprecision(2) << rec.translation_px;
+    // Truth columns: purity,impure_clusters,edges,edges_complete,coverage,noise_admitted,oracle_phi.
+    o << ",";
+    if (rec.has_truth) {
+      const ClusterQuality& q = rec.quality;
+      const auto share = [&](double x) {
+        if (std::isfinite(x)) o << std::setprecision(4) << x;
+      };
+      share(q.purity);
+      o << "," << q.n_impure << "," << q.n_edges << "," << q.n_edges_complete << ",";
+      share(q.coverage);
+      o << ",";
+      share(q.noise_admitted);
+      o << ",";
+      if (std::isfinite(rec.oracle_phi)) o << std::setprecision(9) << rec.oracle_phi;
+    } else {
+      o << ",,,,,,";
+    }
     lines.push_back(o.str());
   }
   return lines;
@@ -195,9 +212,14 @@ void RunOutput::append(const WindowRecord& record) {
 
 std::vector<MethodSummary> RunOutput::writeSummary(const std::string& title,
                                                          const std::vector<std::string>& notes) const {
-  const auto summaries = summarize(readWindowsCsv(csv_path_, true));
-  writeFileAtomically((fs::path(dir_) / "summary.md").string(),
-                      summaryMarkdown(title, summaries, notes));
+  const std::vector<WindowsCsvRow> rows = readWindowsCsv(csv_path_, true);
+  const auto summaries = summarize(rows);
+  std::string text = summaryMarkdown(title, summaries, notes);
+  if (const std::string truth = truthSummaryMarkdown(rows); !truth.empty()) {
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    text += "\n\n" + truth;
+  }
+  writeFileAtomically((fs::path(dir_) / "summary.md").string(), text);
   return summaries;
 }
 
@@ -295,7 +317,7 @@ void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
     << (s.seconds_total > 0 ? s.events_processed / s.seconds_total / 1e6 : 0.0) << " M events/s)";
   out.notes.push_back(t.str());
   const double busy = s.seconds_reading + s.stage_seconds.cluster + s.stage_seconds.lines +
-                      s.stage_seconds.solve + s.stage_seconds.groundtruth;
+                      s.stage_seconds.solve + s.stage_seconds.groundtruth + s.stage_seconds.truth;
   if (busy > 0) {
     std::ostringstream sh;
     sh.precision(3);
@@ -303,6 +325,8 @@ void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
        << "%, clustering " << 100 * s.stage_seconds.cluster / busy << "%, undistortion+lines "
        << 100 * s.stage_seconds.lines / busy << "%, solvers " << 100 * s.stage_seconds.solve / busy
        << "%, ground truth " << 100 * s.stage_seconds.groundtruth / busy << "%";
+    if (s.stage_seconds.truth > 0)
+      sh << ", clusters against the truth labels and the oracle " << 100 * s.stage_seconds.truth / busy << "%";
     out.notes.push_back(sh.str());
   }
   if (s.reader_warnings > 0)

@@ -7,6 +7,7 @@
 #include <deque>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <sstream>
 
 #include "celc/core/parallel.hpp"
@@ -15,6 +16,7 @@
 #include "celc/io/calibration.hpp"
 #include "celc/io/sequence_layout.hpp"
 #include "celc/io/text_io.hpp"
+#include "celc/io/truth_labels.hpp"
 #include "celc/pipeline/imu_still.hpp"
 
 namespace fs = std::filesystem;
@@ -23,6 +25,21 @@ namespace celc {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+
+/// Cluster labels with the clusters that the observation stage joined into
+/// another (fragments of one edge, observations.merge_px) relabelled as it.
+std::vector<int> joinedLabels(std::vector<int> labels, const ObservationReport& report) {
+  if (report.merged_ids.empty()) return labels;
+  std::map<int, int> into;
+  for (std::size_t k = 0; k < report.merged_ids.size(); ++k) into[report.merged_ids[k]] = report.merged_into[k];
+  for (int& l : labels)
+    for (int hops = 0; hops < 64; ++hops) {  // a chain of joins ends at a cluster that was kept
+      const auto it = into.find(l);
+      if (it == into.end()) break;
+      l = it->second;
+    }
+  return labels;
+}
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -39,6 +56,27 @@ struct SequenceRunner::Impl {
   std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
   std::optional<WindowDumpContext> dump;  ///< dumpWindows()
+  std::optional<TruthLabels> truth;       ///< RunInputs::truth_labels, when there are any
+
+  /// The window's clusters against the true edges (`labels`: the clusters
+  /// the solvers see, fragments of one edge joined), and celc_ml on the true
+  /// clusters of the same events with the same lines code, motion and seed.
+  void measureAgainstTruth(WindowRecord& rec, const std::vector<Event>& events, const std::vector<int>& labels,
+                           const MotionModel& motion) const {
+    const auto start = Clock::now();
+    const std::vector<int> edges = truth->lookup(events);
+    rec.has_truth = true;
+    rec.quality = measureClusterQuality(labels, edges);
+    const ClusterResult true_clusters = clustersFromLabels(events, edges);
+    if (true_clusters.status != ClusterStatus::Ok) return;
+    auto to_bearing = [&](const Vec2& p) { return bearing(p); };
+    const WindowObservations obs = toObservations(events, true_clusters, to_bearing, calib.camera.focal(),
+                                                  config.observations, &motion, nullptr);
+    const SampleSeeds seeds{config.seed + rec.index, config.seed + rec.index};
+    const std::vector<SolverResult> oracle = solveMethods(obs, motion, {Method::CelcMl}, config.solver, seeds);
+    if (rec.has_gt && oracle.front().ok()) rec.oracle_phi = directionAngle(rec.gt, oracle.front().v);
+    rec.times.truth = secondsSince(start);
+  }
 
   /// Unit-plane bearing (x, y, 1) of a pixel: the undistortion table at whole
   /// pixels, the camera model elsewhere.
@@ -91,9 +129,8 @@ struct SequenceRunner::Impl {
     const std::size_t budget = config.parallax.probeBudget(t1 - t0);
     std::size_t keep_every = std::max<std::size_t>(1, (events.size() + budget - 1) / budget);
     // A k times sparser subset needs longer time neighbourhoods: the probe
-    // clusters at c = the median normal speed (factor at most 1, the default
-    // since the twenty-third session; it was 3 from the second); D is a
-    // median over clusters and needs no purity.
+    // clusters at c = the median normal speed (factor at most 1, the
+    // default); D is a median over clusters and needs no purity.
     ClusterOptions cluster = config.cluster;
     cluster.c_speed_factor = std::min(1.0, cluster.c_speed_factor);
     for (;;) {
@@ -126,6 +163,8 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     const SequenceLayout layout = resolveSequenceLayout(in.events);
     if (m.inputs.calib.empty()) m.inputs.calib = layout.calib;
     if (m.inputs.groundtruth.empty()) m.inputs.groundtruth = layout.groundtruth;
+    const std::string labels = sequenceFilePath(in.events, sequence_file::kLabels);
+    if (m.inputs.truth_labels.empty() && fs::is_regular_file(labels)) m.inputs.truth_labels = labels;
   }
   if (m.inputs.calib.empty())
     throw std::runtime_error(in.events + ": no calibration (give --calib, or put " +
@@ -172,6 +211,11 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     if (!m.gyro_bias.isZero(0.0))
       for (ImuSample& sample : imu) sample.gyro -= m.gyro_bias;
     m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
+  }
+  if (!m.inputs.truth_labels.empty() && m.inputs.truth_labels != "none") {
+    const std::string events_file =
+        fs::is_directory(in.events) ? sequenceFilePath(in.events, sequence_file::kEvents) : in.events;
+    m.truth = TruthLabels::read(events_file, m.inputs.truth_labels, m.config.reader);
   }
   if (!m.inputs.groundtruth.empty()) {
     auto poses = readPosesText(m.inputs.groundtruth, m.config.reader);
@@ -267,6 +311,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     dumpWindow(*m.dump, index, t0, events, clusters.labels, &gw, rec.omega);
   }
   if (clusters.status != ClusterStatus::Ok) {
+    if (m.truth) m.measureAgainstTruth(rec, events, clusters.labels, motion);
     rec.window_status = toString(clusters.status);
     return rec;
   }
@@ -292,6 +337,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                   index, report.n_merged);
   rec.times.lines = secondsSince(start);
   rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
+  if (m.truth) m.measureAgainstTruth(rec, events, joinedLabels(clusters.labels, report), motion);
 
   // The parallax policy grew the window as far as it could (to
   // windows.max_seconds, or to the end of the data) and its lines still show
@@ -417,6 +463,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         stats.stage_seconds.cluster += rec.times.cluster;
         stats.stage_seconds.lines += rec.times.lines;
         stats.stage_seconds.solve += rec.times.solve;
+        stats.stage_seconds.truth += rec.times.truth;
         stats.stage_seconds.groundtruth += rec.times.groundtruth;
         stats.clusters_line_fit_failed += static_cast<std::uint64_t>(rec.n_line_fit_failed);
         sink(rec);

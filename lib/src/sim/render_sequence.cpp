@@ -188,7 +188,7 @@ std::string mat(const Mat3& R) {
 std::string calibYaml(const SynthConfig& c) {
   std::ostringstream y;
   const CameraModel& k = c.camera;
-  y << "# Calibration of a sequence simulated by `celc synth` (schema: docs/calibration.md).\n"
+  y << "# Calibration of a sequence simulated by `celc synth` (schema: docs/formats.md).\n"
     << "camera:\n"
     << "  width: " << k.width << "            # [px]\n"
     << "  height: " << k.height << "           # [px]\n"

@@ -1,5 +1,5 @@
 // SCENE.yaml of `celc synth`: its schema (core/fields.hpp) and loader
-// (docs/synth.md, config/scenes/).
+// (docs/simulation.md, config/scenes/).
 #include <cmath>
 #include <string>
 #include <vector>

@@ -43,7 +43,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
                          const SolverResult& linear, const SolverResult* npt,
                          const SolverOptions& options, const WindowFrames& frames,
                          std::uint64_t event_seed) {
-  // The joint problem has several minima (docs/peers.md): every start is refined.
+  // The joint problem has several minima (docs/accuracy.md): every start is refined.
   struct Start {
     Vec3 v;
     const SolverResult* from;  // null: a direction of the profile or the lattice
@@ -102,7 +102,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     // Every start begins at the fitted lines (measured: the profile's own
     // lines for its minima did worse at parallax 0.125, RMS 6.2 -> 10.1 deg).
     // A start that comes within kMergeDeg of an earlier end point, in v and
-    // in every line, would follow its descent and stops there (docs/peers.md).
+    // in every line, would follow its descent and stops there (docs/accuracy.md).
     JointProblem::Result r = problem.refine(problem.start(s.v), start_iterations, tolerance, stride,
                                             ends, kMergeDeg * M_PI / 180.0);
     if (!r.ok || r.merged) continue;
@@ -175,7 +175,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
     // The screen ranks its end points after a few iterations on a subset,
     // and near-tied basins can swap places on convergence: the
     // ml.finalists lowest are refined on every event of the problem and the
-    // lowest converged cost wins (docs/solver.md, "celc_ml's finalists").
+    // lowest converged cost wins (docs/method.md, "celc_ml's finalists").
     // The first runs to convergence; a later one runs start_iterations and
     // continues only while it is below the best so far, and one heading
     // into a basin an earlier finalist ended in stops there.

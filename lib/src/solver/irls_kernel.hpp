@@ -68,7 +68,7 @@ class PackedRows {
   PackedRows strided(size_t step) const;
   /// The rows the robust scale is taken from: every floor(n / kScaleSample)-th,
   /// so 256 to 511 of them once n >= 256: enough for the Huber threshold
-  /// (docs/solver.md).
+  /// (docs/method.md).
   const PackedRows& scaleSample() const { return sample_ ? *sample_ : *this; }
   static constexpr size_t kScaleSample = 256;
 

@@ -90,7 +90,7 @@ namespace {
 /// steps at most max_step [rad], halved until J falls, until a step is
 /// below tol [rad]. Where the model is not convex the step follows the
 /// negative gradient. (A pattern search of 8 tangent directions needed
-/// several times as many evaluations of J; docs/peers.md.)
+/// several times as many evaluations of J; docs/accuracy.md.)
 void descend(const LineProfile& profile, ScreenMinimum& s, double max_step, double tol) {
   const double h = std::max(tol, 1e-4);
   for (int it = 0; it < 20; ++it) {

@@ -9,7 +9,7 @@
 // each value one joint refinement to convergence from the fitted lines and
 // the v of the lowest value so far. C is minimised by Nelder-Mead from
 // delta = 0 (C is not convex in delta: a Newton step on a quadratic model
-// was measured to fail in half of the trials, docs/peers.md). The offset is
+// was measured to fail in half of the trials, docs/accuracy.md). The offset is
 // kept when the likelihood ratio
 //   LR = 2 (C(0) - C(delta)) / sigma^2,  sigma^2 = 2 C(0) / N
 // (N events) exceeds kRateOffsetGate: without an offset LR follows a

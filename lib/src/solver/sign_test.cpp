@@ -68,7 +68,7 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   // and, where its own l1 .. l3 span less than kSignFullSpanShare of the
   // window's (first l1 to last l3), in proportion to its span: a line seen
   // over a short time moved mostly by its fits' and the rotation's errors
-  // (docs/solver.md).
+  // (docs/method.md).
   double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
   for (const SignVotes& s : clusters) {
     t_first = std::min(t_first, s.cl->l1.t);

@@ -45,6 +45,7 @@ struct FieldEntry {
   std::string unit;
   std::string doc;
   std::string value;  ///< YAML text, exactly as writeYaml writes it
+  std::vector<std::string> choices;  ///< the allowed names of an enumeration (empty otherwise)
 };
 /// Every field `describe` visits, in order, with its value: to compare two
 /// configurations field by field or to list the schema.

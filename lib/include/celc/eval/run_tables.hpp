@@ -14,15 +14,18 @@
 namespace celc {
 
 /// The header of windows.csv: the 16 columns of the first format, then the
-/// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px
-/// (README, docs/runs.md).
+/// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px,
+/// then the truth columns purity,impure_clusters,edges,edges_complete,
+/// coverage,noise_admitted,oracle_phi (docs/running.md).
 std::string windowsCsvHeader();
+/// The header of files written without the truth columns (still read).
+std::string windowsCsvHeaderV3();
 /// The header of files written before translation_px (still read).
 std::string windowsCsvHeaderV2();
 /// The header of files written before the quality columns (still read).
 std::string windowsCsvHeaderV1();
-/// A row of an earlier format (16 or 23 columns) padded with empty quality
-/// columns; other lines are returned as they are.
+/// A row of an earlier format (16, 23 or 24 columns) padded with empty
+/// quality and truth columns; other lines are returned as they are.
 std::string padWindowsCsvLine(const std::string& line);
 
 struct WindowsCsvRow {
@@ -43,12 +46,26 @@ struct WindowsCsvRow {
   Vec3 omega = Vec3::Zero();    ///< angular velocity used [rad/s], camera frame
   /// The lines' translation D over the window [px] (pipeline/window_policy.hpp); NaN: none.
   double translation_px = NAN;
+  /// Truth columns (runs with truth labels; eval/cluster_quality.hpp): the
+  /// window's clusters against the true edges, and celc_ml's phi [rad] on
+  /// its true clusters (the oracle). has_truth false: no truth.
+  bool has_truth = false;
+  double purity = NAN, coverage = NAN, noise_admitted = NAN, oracle_phi = NAN;
+  int impure_clusters = 0, edges = 0, edges_complete = 0;
 };
 
 /// Reads a windows.csv; throws std::runtime_error("FILE:LINE: ...") on a wrong
 /// header, column count or number. An incomplete last line (an interrupted
 /// write) is ignored when `tolerate_truncated_tail`.
 std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate_truncated_tail = true);
+
+/// The clusters against the truth over a run's windows with truth columns
+/// (one line each, Markdown): the median event-weighted purity, the windows
+/// with at most one cluster below 95% purity, the edges with 80% of their
+/// events in one cluster, the median coverage, and the windows where
+/// celc_ml's phi on the pipeline's clusters is within max(1.5x, +1 deg) of
+/// its phi on the true clusters (oracle_phi). Empty without truth columns.
+std::string truthSummaryMarkdown(const std::vector<WindowsCsvRow>& rows);
 
 /// The summary's default threshold on sigma_deg for the windows a user would keep [deg].
 inline constexpr double kDefaultKeepSigmaDeg = 5.0;

@@ -16,7 +16,7 @@
 ///        integral of R(s) ds over [t_ref, t]; v is the body-frame velocity, and
 ///        with a constant rate this is the constant twist;
 ///      - or in the reference frame (VelocityFrame::Reference, the newer
-///        papers' protocol, docs/peers.md): P(t) = tau I; v is the velocity in
+///        papers' protocol, docs/accuracy.md): P(t) = tau I; v is the velocity in
 ///        the reference camera frame.
 /// Both keep every CELC constraint linear in v.
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 /// \file calibration.hpp
-/// Camera / IMU / body calibration (schema: docs/calibration.md).
+/// Camera / IMU / body calibration (schema: docs/formats.md).
 ///  - camera intrinsics and distortion -> celc::CameraModel;
 ///  - R_cam_imu (or the rotation of T_cam_imu): maps IMU-frame vectors to the
 ///    camera frame, w_cam = R_cam_imu * w_imu;
@@ -23,7 +23,7 @@ struct Calibration {
   bool has_body = false;  ///< the file had a `body` section
 };
 
-/// Loads a calibration YAML (docs/calibration.md). Unknown keys, wrong types,
+/// Loads a calibration YAML (docs/formats.md). Unknown keys, wrong types,
 /// wrong list lengths, non-orthonormal rotations and invalid intrinsics are
 /// ConfigErrors naming the file, the line and the key.
 Calibration loadCalibrationYaml(const std::string& path);

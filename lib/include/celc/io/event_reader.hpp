@@ -13,7 +13,7 @@
 /// layouts). openEventSource() detects the format from the magic bytes
 /// (`#!AER-DAT2.0`, `#!AER-DAT3.1`, `#!AER-DAT4.0`, `#ROSBAG V`, the HDF5 signature).
 ///
-/// Bad-input policy (docs/io.md):
+/// Bad-input policy (docs/formats.md):
 ///  - errors (an IoError naming the file and the line or byte offset): bad magic,
 ///    truncated binary records, sizes or offsets out of range, corrupt
 ///    compression or flatbuffers, non-numeric text fields, wrong column counts;

@@ -8,7 +8,7 @@
 ///   events.txt       t x y p
 ///   imu.txt          t ax ay az gx gy gz (or gyro first, UZH-FPV)
 ///   groundtruth.txt  t px py pz qx qy qz qw
-///   calib.yaml       docs/calibration.md (preferred), or calib.yml, or
+///   calib.yaml       docs/formats.md (preferred), or calib.yml, or
 ///   calib.txt        fx fy cx cy k1 k2 p1 p2 k3
 /// written by `celc synth` besides: labels.txt, twist.txt, twist.yaml, edges.txt.
 #include <string>

@@ -4,7 +4,7 @@
 /// CVPR 2024 N-point linear solver `npt`, on the peers' scene (sim/peer_scene.hpp),
 /// beside the Cramér-Rao bound (eval/crlb.hpp).
 ///
-/// Cells: the full factorial of the grid is 4*4*4*3*3*2 = 1152 cells;
+/// Cells: the full factorial of the peers' grid is 4*4*4*3*3*2 = 1152 cells;
 /// the study runs one-factor-at-a-time sweeps around a base cell (5 lines x
 /// 200 events, V = 2 m/s, sigma = 1 px, no angular-velocity error, no
 /// outliers) plus the full V x sigma grid at the base's other factors:

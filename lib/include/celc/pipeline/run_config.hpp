@@ -47,7 +47,7 @@ struct RunConfig {
   ParallaxWindowOptions parallax;
   /// The rotation within a window: the gyro's samples integrated
   /// (gyro_integrated, the default: a hand-held camera's rate changes within
-  /// a window; docs/results.md) or the window's mean rate (constant_twist,
+  /// a window; docs/accuracy.md) or the window's mean rate (constant_twist,
   /// the paper's model). The velocity is constant in the body frame either way.
   MotionModelKind motion = MotionModelKind::GyroIntegrated;
   OmegaSource omega_source = OmegaSource::Gyro;
@@ -74,11 +74,11 @@ struct RunConfig {
   /// last refinements, for clusters that hold a few per cent of another
   /// edge's events; and celc_opt started from celc on 4 random row subsets,
   /// its lowest cost kept; and celc_ml's answer kept in front of the camera
-  /// (docs/solver.md, "celc_ml's event budget", "celc_ml's finalists", "The
+  /// (docs/method.md, "celc_ml's event budget", "celc_ml's finalists", "The
   /// linear stage's Tukey stage", "celc_opt's starts", "celc_ml's last
   /// refinement under Tukey's biweight", "celc_ml's answer in front of the
   /// camera").
-  SolverOptions solver = [] {  // the pipeline's solver defaults (docs/synth.md)
+  SolverOptions solver = [] {  // the pipeline's solver defaults (docs/simulation.md)
     SolverOptions s;
     s.linear.grid_directions = 256;
     s.linear.grid_starts = 4;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/eval/cluster_quality.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/window_dump.hpp"
 
@@ -26,6 +27,11 @@ struct RunInputs {
   std::string calib;        ///< calibration YAML or calib.txt
   std::string groundtruth;  ///< pose file `t px py pz qx qy qz qw` (optional)
   std::string imu;          ///< IMU text file (optional; aedat files carry their own)
+  /// The true edge of every event (`celc synth`'s labels.txt, io/truth_labels.hpp):
+  /// each window's clusters are then measured against it and solved on its
+  /// true clusters too (the oracle). Empty: a sequence directory's labels.txt
+  /// when it has one; "none": no truth.
+  std::string truth_labels;
 };
 
 /// A ROS bag or HDF5 file as the events input: the calibration (a bag's
@@ -45,6 +51,7 @@ struct MethodRow {
 /// Seconds spent per stage in one window (wall time of that window's worker).
 struct StageTimes {
   double undistort = 0, cluster = 0, lines = 0, solve = 0, groundtruth = 0;
+  double truth = 0;  ///< the clusters against the truth labels and the oracle's solve
 };
 
 struct WindowRecord {
@@ -68,6 +75,13 @@ struct WindowRecord {
   bool has_omega = false;
   Vec3 omega = Vec3::Zero();
   StageTimes times;
+  /// With truth labels (RunInputs::truth_labels): the clusters against the
+  /// true edges, and the oracle: celc_ml's phi [rad] on the window's true
+  /// clusters (same lines code, motion and seed; NaN where it has no answer
+  /// or there is no ground truth).
+  bool has_truth = false;
+  ClusterQuality quality;
+  double oracle_phi = NAN;
 };
 
 /// Which windows to process (the others are read and skipped).

@@ -18,4 +18,10 @@ struct ShippedConfig {
 /// defaults) and config/cluster.yaml (the clustering sections alone).
 std::vector<ShippedConfig> shippedConfigs();
 
+/// docs/configuration/run.md and simulate.md: the key reference as Markdown
+/// tables (key, default, unit, meaning), one table per top-level section,
+/// from the same schema. `celc config --write-reference docs/configuration/`
+/// regenerates them; a test fails when the committed pages differ.
+std::vector<ShippedConfig> shippedReferences();
+
 }  // namespace celc

@@ -14,7 +14,7 @@
 ///   D = median over clusters of f |d(m1) - d(m3)| (t_end - t_start) / (t3 - t1)   [px],
 /// over the clusters with lines whose t3 - t1 covers at least a quarter of
 /// the window (a short one, scaled up to the window, would mostly add noise).
-/// The accuracy of the line methods follows D (docs/runs.md): a window is
+/// The accuracy of the line methods follows D (docs/running.md): a window is
 /// grown until D >= parallax_px.
 #include <cmath>
 #include <cstddef>

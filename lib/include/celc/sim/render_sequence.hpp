@@ -17,7 +17,7 @@
 ///   groundtruth.txt  t px py pz qx qy qz qw  T_world_body [s] [m]
 ///   twist.txt        t vx vy vz wx wy wz  true camera-frame twist at the GT times
 ///   calib.txt        fx fy cx cy k1 k2 p1 p2 k3
-///   calib.yaml       docs/calibration.md schema
+///   calib.yaml       docs/formats.md schema
 ///   twist.yaml       the trajectory definition and the run's parameters
 ///   edges.txt        id x0 y0 z0 x1 y1 z1  world end points of each scene edge [m]
 /// Every file is written under a temporary name (.NAME.partial) and renamed

@@ -2,7 +2,7 @@
 /// \file options.hpp
 /// Options of the solvers, one struct per stage, each with a validate() that
 /// returns what is wrong (empty when valid). Defaults are the pipeline's;
-/// docs/solver.md gives the measurements behind them.
+/// docs/method.md gives the measurements behind them.
 #include <cstdint>
 #include <string>
 
@@ -23,7 +23,7 @@ struct LinearOptions {
   /// robust scales (0 = off), from the Huber end point: rows beyond it get no
   /// weight. Huber keeps a bounded pull of every far row; on rendered
   /// clusters that hold a few per cent of another edge's events (at corners)
-  /// those rows together move the direction far off (docs/solver.md).
+  /// those rows together move the direction far off (docs/method.md).
   double tukey_k = 0.0;
   /// Stop when the direction moves less than this [rad]; well below the
   /// direction error at realistic noise.
@@ -63,7 +63,7 @@ struct LinearOptions {
   /// The window's parallax (the median over its clusters of the static /
   /// moving ratio above) below this -> degenerate / no_parallax, however many
   /// single clusters pass: a window the rotation explains (pure rotation)
-  /// has a median near 1 even when a few noisy clusters pass (docs/uncertainty.md).
+  /// has a median near 1 even when a few noisy clusters pass (docs/accuracy.md).
   double min_window_parallax = 1.1;
   /// ... applied to windows with at least this many measured clusters (with
   /// fewer, the per-cluster test alone decides, as it always did).
@@ -89,7 +89,7 @@ struct RefineOptions {
   /// > 0: that last refinement uses Tukey's biweight at tukey_scale robust
   /// scales instead of the Cauchy loss: an event beyond has no pull at all,
   /// where under Cauchy many far events of other edges together still move v
-  /// (docs/solver.md). cauchy_scale = 0 still turns the last refinement off.
+  /// (docs/method.md). cauchy_scale = 0 still turns the last refinement off.
   double tukey_scale = 0.0;       ///< [-]
   /// celc_opt: starts of the refinement, the linear estimate on this many
   /// random row subsets (the first is celc's own; one within 1 deg of an
@@ -138,7 +138,7 @@ struct MlOptions {
   /// Also start from npt's estimate (sign resolved) when the celc start ends
   /// more than second_start_deg away from it, and keep the lower robust cost;
   /// also run from npt alone when celc fails. A remedy for the local minima of
-  /// the joint problem (docs/peers.md). Only where npt's motion model holds:
+  /// the joint problem (docs/accuracy.md). Only where npt's motion model holds:
   /// GyroIntegrated in the reference frame (P = tau I, exact), or a body-frame
   /// model (constant twist, gyro-integrated) turning little,
   /// |w| max|tau| / 2 <= second_start_max_twist (npt's relative error on the
@@ -152,7 +152,7 @@ struct MlOptions {
   int grid_starts = 0;
   /// Events of the joint problem: a seeded subset of about this many (0 =
   /// all), drawn as refine.max_events draws celc_opt's. `celc run` draws
-  /// more (pipeline/run_config.hpp; docs/solver.md, "celc_ml's event
+  /// more (pipeline/run_config.hpp; docs/method.md, "celc_ml's event
   /// budget").
   int max_events = 5000;
   /// With several starts, each is refined on every k-th event of the
@@ -162,7 +162,7 @@ struct MlOptions {
   int screen_events = 1000;
   /// Also start from the lowest local minima of the line profile J(v), the
   /// algebraic event-line cost with every cluster's line eliminated in closed
-  /// form (no fitted lines; docs/peers.md): J on a hemisphere lattice of
+  /// form (no fitted lines; docs/accuracy.md): J on a hemisphere lattice of
   /// profile_lattice directions (0 = off), a pattern search from the
   /// profile_starts lowest separated points, profile_events events per
   /// cluster summed into J (0 = all).
@@ -192,7 +192,7 @@ struct MlOptions {
   /// point whose margin reaches it, refined to convergence, if that end
   /// point's cost lies within cheiral_clusters clusters' share of the lowest,
   /// K (C - C_min) / C_min over the K clusters: a lead that the errors of a
-  /// few impure clusters can make (docs/solver.md, "celc_ml's answer in
+  /// few impure clusters can make (docs/method.md, "celc_ml's answer in
   /// front of the camera"); 0 = off.
   double cheiral_min = 0.0;       ///< [-] in [0, 1]
   double cheiral_clusters = 10.0;  ///< [-] clusters' share of the cost
@@ -218,12 +218,12 @@ struct MlOptions {
   /// scales instead of the Cauchy loss, rho(d) = c^2 / 3 (1 - (1 - d^2 /
   /// c^2)^3) within c and c^2 / 3 beyond: an event of another edge has no
   /// pull at all, where under Cauchy many of them together still move v
-  /// (docs/solver.md, "celc_ml's last refinement under Tukey's biweight").
+  /// (docs/method.md, "celc_ml's last refinement under Tukey's biweight").
   /// cauchy_scale = 0 still turns the last refinement off.
   double tukey_scale = 0.0;  ///< [-]
   /// Also estimate a constant offset of the given angular velocity (a
   /// gyroscope bias) with v, kept where a likelihood-ratio test (p = 0.001)
-  /// finds one (solver/rate_offset.hpp; docs/solver.md): some 30-60 joint
+  /// finds one (solver/rate_offset.hpp; docs/method.md): some 30-60 joint
   /// refinements more per window.
   bool rate_offset = false;
   std::string validate() const;  ///< empty when valid
@@ -235,7 +235,7 @@ struct MlOptions {
 /// lines, C = s^2 S^-1 with s the robust scale of the residuals there
 /// (direction_information.hpp), times a per-method factor. The factors
 /// calibrate the Fisher value (the ML bound) to each method's actual spread,
-/// so that about 9 in 10 windows have phi <= 2 sigma (docs/uncertainty.md).
+/// so that about 9 in 10 windows have phi <= 2 sigma (docs/accuracy.md).
 ///
 /// The Fisher value sees the noise, not a model that fails (a rotation that
 /// is not constant, clusters that mix edges, a wrong basin): with
@@ -260,7 +260,7 @@ struct UncertaintyOptions {
   /// the estimate, sign.hpp; 1 = unanimous) gets a sigma_deg of at least
   /// 61.2 deg, the RMS angle of a random direction to a fixed one: the
   /// scene must lie in front of the camera, and such answers were measured
-  /// wrong (docs/uncertainty.md, "Answers behind the camera").
+  /// wrong (docs/accuracy.md, "Answers behind the camera").
   double cheiral_min = 0.0;  ///< [-] in [0, 1]
   int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
   double scale_celc = 2.5;      ///< [-] factor for method celc

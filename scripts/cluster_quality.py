@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""The clusters against the truth over runs of `celc synth` sequences.
+
+usage: cluster_quality.py RUNDIR [--method celc_ml]
+
+RUNDIR holds one `celc run` output folder per sequence (RUNDIR/<name>/
+windows.csv), run on sequences with labels.txt, so that windows.csv carries
+the truth columns (purity, impure_clusters, edges, edges_complete, coverage,
+noise_admitted, oracle_phi; docs/running.md). Prints one row per window,
+then the targets: median event-weighted purity, the share of windows with
+at most one cluster below 95% purity, the share of edges with 80% of their
+events in one cluster, the median coverage, and the gap between the
+method's phi on the pipeline's clusters and celc_ml's phi on the true
+clusters of the same window (within max(1.5x, +1 deg)).
+"""
+import argparse
+import csv
+import glob
+import math
+import os
+import statistics
+
+
+def num(text):
+    return float(text) if text not in ("", None) else math.nan
+
+
+def within_gap(phi, oracle):
+    """phi within max(1.5 x oracle, oracle + 1 deg) [rad]."""
+    return phi <= max(1.5 * oracle, oracle + math.radians(1.0))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("rundir")
+    ap.add_argument("--method", default="celc_ml", help="the pipeline's method compared with the oracle")
+    a = ap.parse_args()
+    rows = []
+    for path in sorted(glob.glob(os.path.join(a.rundir, "*", "windows.csv"))):
+        name = os.path.basename(os.path.dirname(path))
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                if r["method"] != a.method:
+                    continue
+                if "purity" not in r:
+                    raise SystemExit(f"{path}: no truth columns (a windows.csv of an older celc?)")
+                if r["edges"] == "":
+                    continue  # no truth for this window
+                rows.append((name, r))
+    if not rows:
+        raise SystemExit(f"{a.rundir}: no windows with truth columns")
+    print("| sequence | window | status | purity | impure clusters | edges complete | coverage | noise admitted "
+          "| %s phi [deg] | oracle phi [deg] | within gap |" % a.method)
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    purity, coverage, impure_ok, gaps = [], [], [], []
+    edges = edges_complete = 0
+    for name, r in rows:
+        p, cov, noise = num(r["purity"]), num(r["coverage"]), num(r["noise_admitted"])
+        phi, oracle = num(r["phi"]), num(r["oracle_phi"])
+        n_imp = int(num(r["impure_clusters"])) if r["impure_clusters"] else 0
+        e, ec = int(num(r["edges"])), int(num(r["edges_complete"]))
+        edges += e
+        edges_complete += ec
+        if not math.isnan(p):
+            purity.append(p)
+        if not math.isnan(cov):
+            coverage.append(cov)
+        impure_ok.append(n_imp <= 1)
+        gap = ""
+        if not math.isnan(oracle):
+            ok = not math.isnan(phi) and within_gap(phi, oracle)
+            gaps.append(ok)
+            gap = "yes" if ok else "no"
+        deg = lambda x: "-" if math.isnan(x) else "%.1f" % math.degrees(x)
+        f3 = lambda x: "-" if math.isnan(x) else "%.3f" % x
+        print(f"| {name} | {r['window']} | {r['status']} | {f3(p)} | {n_imp} | {ec} / {e} | {f3(cov)} | {f3(noise)} "
+              f"| {deg(phi)} | {deg(oracle)} | {gap} |")
+    med = lambda x: statistics.median(x) if x else math.nan
+    share = lambda x: sum(x) / len(x) if x else math.nan
+    print()
+    print("| target | measured | goal |")
+    print("|---|---|---|")
+    print(f"| event-weighted purity, median window | {med(purity):.3f} | >= 0.99 |")
+    print(f"| windows with at most one cluster below 95% purity | {share(impure_ok):.2f} | >= 0.90 |")
+    print(f"| edges with >= 80% of their events in one cluster | "
+          f"{(edges_complete / edges if edges else math.nan):.2f} ({edges_complete} / {edges}) | >= 0.80 |")
+    print(f"| coverage of edge events, median window | {med(coverage):.3f} | >= 0.95 |")
+    print(f"| windows where {a.method} is within max(1.5x, +1 deg) of the oracle | {share(gaps):.2f} "
+          f"({sum(gaps)} / {len(gaps)}) | >= 0.80 |")
+
+
+if __name__ == "__main__":
+    main()

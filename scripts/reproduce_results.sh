@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# Regenerates the result tables of docs/results/ (and the README's results
+# table and tour pictures) from the studies, with fixed seeds.
+#   scripts/reproduce_results.sh [NAME...]
+# NAMEs (default: all, in this order; about an hour on 2 cores):
+#   simulation  celc simulate --sweep all (500 trials, seed 1): simulation_*.md (1 min)
+#   peers       celc simulate --study peers (500 trials, seed 1): peers.md, peers_*.png
+#   scenes      scripts/scene_table.sh: scenes.md, shipped_scenes.md (8 min)
+#   sample      celc run data/sample_seq: sample.md, docs/images/sample_*.png
+#   sigma       scripts/sigma_calibration.sh: sigma_calibration.md, sigma_calibration_sim.md (5 min)
+#   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
+#   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
+#   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
+#   summary     the README's results table from simulation, peers and scenes: summary.md
+# Each file's first line names the command that wrote it; the text after a
+# file's tables (its legend) is kept. Work files go to ${CELC_RESULTS_WORK:-out/results}.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+cd "$root"
+build="${CELC_BUILD_DIR:-$root/build}"
+[ -x "$build/celc" ] || scripts/setup.sh
+celc="$build/celc"
+work="${CELC_RESULTS_WORK:-$root/out/results}"
+res="$root/docs/results"
+py=/usr/bin/python3
+tables="$py $root/scripts/results_tables.py"
+mkdir -p "$work" "$res" "$root/docs/images"
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax clusters studies summary)
+
+put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
+  $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
+  echo "wrote docs/results/$1" >&2
+}
+
+for name in "${names[@]}"; do
+  case "$name" in
+    simulation)
+      cmd="celc simulate --sweep all --trials 500 --seed 1 --threads 2 -c config/simulate.yaml"
+      "$celc" simulate --sweep all --trials 500 --seed 1 --threads 2 -c config/simulate.yaml \
+        -o "$work/simulation" --force -q --no-plots > "$work/simulation.txt"
+      $tables block "Default setting" < "$work/simulation.txt" | put simulation_default.md simulation "$cmd"
+      for s in event_noise line_noise omega_noise speed interval lines; do
+        $tables block "Sweep $s:" < "$work/simulation.txt" | put "simulation_$s.md" simulation "$cmd"
+      done
+      ;;
+    peers)
+      cmd="celc simulate --study peers -c config/peers.yaml --trials 500 --seed 1 --threads 2"
+      "$celc" simulate --study peers -c config/peers.yaml --trials 500 --seed 1 --threads 2 \
+        -o "$work/peers" --force -q --no-plots > /dev/null
+      $py scripts/plot_peers.py "$work/peers"
+      for p in grid ratio factors; do cp "$work/peers/peers_$p.png" "$res/peers_$p.png"; done
+      cp "$work/peers/peers.csv" "$res/peers.csv"
+      $tables table 0 < "$work/peers/peers_table.md" | put peers.md peers "$cmd; scripts/plot_peers.py"
+      ;;
+    scenes)
+      scripts/scene_table.sh "$work/scenes" > "$work/scenes.txt"
+      $tables table 1 < "$work/scenes.txt" | put scenes.md scenes "scripts/scene_table.sh"
+      $tables table 0 < "$work/scenes.txt" | put shipped_scenes.md scenes "scripts/scene_table.sh"
+      ;;
+    sample)
+      "$celc" run data/sample_seq -o "$work/sample" --force -q > /dev/null
+      $tables windows "$work/sample/windows.csv" | put sample.md sample "celc run data/sample_seq"
+      cp "$work/sample/velocity.png" docs/images/sample_velocity.png
+      cp "$work/sample/error.png" docs/images/sample_error.png
+      ;;
+    sigma)
+      scripts/sigma_calibration.sh "$work/sigma" > "$work/sigma.txt"
+      n=$($py -c "import sys; sys.path.insert(0, 'scripts'); import results_tables as r; \
+print(len(r.tables(open('$work/sigma.txt').read().splitlines())))")
+      $tables table $((n - 1)) < "$work/sigma.txt" | put sigma_calibration.md sigma "scripts/sigma_calibration.sh"
+      $py - "$work/sigma.txt" "$n" <<'PY' | put sigma_calibration_sim.md sigma "scripts/sigma_calibration.sh"
+import sys
+sys.path.insert(0, "scripts")
+import results_tables as r
+lines = open(sys.argv[1]).read().splitlines()
+spans = r.tables(lines)[: int(sys.argv[2]) - 1]
+print("\n\n".join("\n".join(lines[s:e]) for s, e in spans))
+PY
+      ;;
+    parallax)
+      scripts/parallax_study.sh "$work/scenes" > "$work/parallax.txt"
+      $tables table 1 < "$work/parallax.txt" | put parallax.md parallax "scripts/parallax_study.sh"
+      ;;
+    clusters)
+      scripts/cluster_table.sh "$work/clusters" > "$work/clusters.txt"
+      { $tables table 1 < "$work/clusters.txt"; echo; $tables table 0 < "$work/clusters.txt"; } |
+        put clusters.md clusters "scripts/cluster_table.sh"
+      ;;
+    studies)
+      for s in acceleration rate_offset solve_path; do
+        [ -x "$build/celc_${s}_study" ] || { echo "no $build/celc_${s}_study (CELC_BUILD_BENCHMARKS=ON)" >&2; exit 1; }
+        "$build/celc_${s}_study" > "$work/$s.txt"
+        $tables table 0 < "$work/$s.txt" | put "$s.md" studies "build/celc_${s}_study"
+      done
+      ;;
+    summary)
+      $tables summary "$res" | put summary.md summary "scripts/results_tables.py summary docs/results"
+      $tables readme README.md "$res/summary.md"
+      echo "rewrote the README's results table" >&2
+      ;;
+    *)
+      echo "reproduce_results.sh: unknown name '$name' (see the header of this script)" >&2
+      exit 2
+      ;;
+  esac
+done
