@@ -88,6 +88,10 @@ pyb::dict solveImpl(const pyb::object& events, const pyb::object& labels, const 
     throw pyb::value_error("solve: labels must be a 1-D integer array, one per event (" + std::to_string(ev.size()) +
                            ")");
   std::vector<int> lb(lab.data(), lab.data() + lab.shape(0));
+  if (omega.is_none() && gyro.is_none())
+    throw pyb::value_error("solve: give omega=[wx, wy, wz] [rad/s, camera frame] ([0, 0, 0] for a camera that "
+                           "does not turn) or gyro=(N, 4) array");
+  if (!omega.is_none() && !gyro.is_none()) throw pyb::value_error("solve: give omega or gyro, not both");
   Vec3 w = Vec3::Zero();
   if (!omega.is_none()) {
     auto o = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>::ensure(omega);
@@ -136,9 +140,9 @@ void bindSolve(pyb::module_& m) {
 
 events: structured array with t [s], x, y [px] (EVENT_DTYPE, or any with
 those fields); labels: cluster id per event (int, -1 = unassigned).
-omega: constant angular velocity wx, wy, wz [rad/s], camera frame (default
-0); or gyro: (N, 4) array t [s], wx, wy, wz [rad/s], camera frame (the
-gyro-integrated model). The reference time is the first labelled event.
+omega: constant angular velocity wx, wy, wz [rad/s], camera frame ([0, 0, 0]
+for a camera that does not turn); or gyro: (N, 4) array t [s], wx, wy, wz
+[rad/s], camera frame (the gyro-integrated model). One of the two is required. The reference time is the first labelled event.
 calib: calibration file (docs/formats.md, calib.txt) or a dict of the
 camera schema (width, height, fx, fy, cx, cy, distortion_model, distortion); or
 normalized=True for normalised coordinates (focal [px] scales thresholds).

@@ -8,7 +8,8 @@
 #    the noise sweeps, OUTDIR/fig4_<sweep>.png for speed, time interval and
 #    number of lines), and OUTDIR/paper_table.md: per sweep and level the mean
 #    eps (unit-vector distance) and phi [rad] of the paper's three methods
-#    (CELC, CELC+opt, CE3LC) beside celc_ml.
+#    (CELC, CELC+opt, CE3LC) beside celc_ml; the tables `celc simulate` prints
+#    go to OUTDIR/simulation_tables.md.
 # 2. The real-data tables (Sec. 5.2), when DATA_ROOT holds UZH-FPV
 #    indoor_45_9 (DATA_ROOT/indoor_45_9_davis with calib.yaml filled in from
 #    the dataset's calibration, see config/uzh_fpv_davis_calib.yaml): a batch
@@ -49,7 +50,7 @@ celc="$build/celc"
 mkdir -p "$out"
 
 "$celc" simulate --sweep all --trials "$trials" --seed "$seed" --threads "$threads" \
-  -c "$root/config/simulate.yaml" -o "$out/simulation" --force -q
+  -c "$root/config/simulate.yaml" -o "$out/simulation" --force -q > "$out/simulation_tables.md"
 for s in event_noise line_noise omega_noise; do
   [ -f "$out/simulation/$s.png" ] && cp "$out/simulation/$s.png" "$out/fig3_$s.png"
 done

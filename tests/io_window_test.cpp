@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "celc/geometry/so3.hpp"
 #include "celc/io/imu_window.hpp"
@@ -207,4 +209,38 @@ TEST(IoGyroConformance, Davis240WindowAtRest) {
     EXPECT_LT(gw.mean_omega.norm(), 5.0);  // hand-held: well below 5 rad/s
   }
   EXPECT_EQ(ok, 8);  // every full window is covered
+}
+
+// Every event lies in exactly one window of fixed length without overlap,
+// also events exactly on a boundary: with the origin at 0.000134 s and
+// windows of 0.025 s, t0 + 0.025 rounds below the next window's start for
+// some boundaries (0.150134 s among them), so t1 must be the next t0 itself.
+TEST(IoWindow, TimeWindowsHoldEveryEventOnTheirBoundaries) {
+  TempDir d;
+  std::vector<Event> ev;
+  for (int k = 0; k < 400; ++k) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6f", 0.000134 + k * 0.025);  // as a text file states it
+    ev.push_back({std::strtod(text, nullptr), static_cast<float>(k % 200), 10.0f, true});
+    ev.push_back({std::strtod(text, nullptr) + 0.0125, static_cast<float>(k % 200), 20.0f, false});
+  }
+  writeEventsText(d.file("e.txt"), ev);
+  for (double seconds : {0.025, 0.05, 0.075}) {
+    auto r = openEventSource(d.file("e.txt"));
+    WindowOptions o;
+    o.seconds_per_window = seconds;
+    o.keep_partial = true;
+    o.read_batch = 37;
+    WindowSource ws(*r, o);
+    EventWindow w;
+    std::size_t total = 0;
+    while (ws.next(w)) {
+      for (const Event& e : w.events) {
+        EXPECT_GE(e.t, w.t0);
+        EXPECT_LT(e.t, w.t1);
+      }
+      total += w.events.size();
+    }
+    EXPECT_EQ(total, ev.size()) << seconds << " s windows";
+  }
 }

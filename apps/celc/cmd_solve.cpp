@@ -25,7 +25,7 @@ namespace celc::app {
 namespace {
 
 struct SolveArgs {
-  std::string events, calib, methods, omega = "0,0,0", gyro, config;
+  std::string events, calib, methods, omega, gyro, config;
   std::vector<std::string> sets;
   bool normalized = false, quiet = false, verbose = false;
   double focal = 320.0;
@@ -83,6 +83,12 @@ void runSolve(const SolveArgs& a) {
   const auto labelled = readLabelledEvents(a.events);
   if (a.calib.empty() && !a.normalized)
     throw std::runtime_error("solve: pixel events need --calib FILE (or pass --normalized)");
+  // No rotation is assumed silently: a turning camera solved as a still one
+  // gives confident wrong answers.
+  if (a.omega.empty() && a.gyro.empty())
+    throw std::runtime_error("solve: give the angular velocity: --omega wx,wy,wz [rad/s, camera frame] "
+                             "(0,0,0 for a camera that does not turn) or --gyro FILE");
+  if (!a.omega.empty() && !a.gyro.empty()) throw std::runtime_error("solve: give --omega or --gyro, not both");
   CameraModel cam;
   if (!a.calib.empty()) cam = loadCalibration(a.calib).camera;
   else cam.fx = cam.fy = a.focal;
@@ -145,8 +151,9 @@ void registerSolve(CLI::App& app) {
       "-c / --set) and prints method,status,vx,vy,vz,runtime_us to stdout (v: unit direction, in the camera frame at the "
       "first clustered event, the motion's reference time).");
   cmd->add_option("events", a->events, "labelled events CSV")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--omega", a->omega, "constant angular velocity wx,wy,wz [rad/s], camera frame")
-      ->capture_default_str();
+  cmd->add_option("--omega", a->omega,
+                  "constant angular velocity wx,wy,wz [rad/s], camera frame (0,0,0 for a camera that does not "
+                  "turn); this or --gyro is required");
   cmd->add_option("--gyro", a->gyro,
                   "gyroscope CSV t,wx,wy,wz [s, rad/s, camera frame]: gyro-integrated motion model")
       ->check(CLI::ExistingFile);

@@ -109,6 +109,9 @@ def test_errors(tmp_path):
         celc.solve(ev, lab, calib=w["camera"], methods=["fast"])
     with pytest.raises(ValueError, match="omega"):
         celc.solve(ev, lab, calib=w["camera"], omega=[1, 2])
+    # No rotation is assumed silently.
+    with pytest.raises(ValueError, match=r"give omega=\[wx, wy, wz\]"):
+        celc.solve(ev, lab, calib=w["camera"])
     with pytest.raises(ValueError, match="solver.linear.no_such"):
         celc.solve(ev, lab, calib=w["camera"], set={"solver.linear.no_such": 1})
     missing = tmp_path / "missing_calib.yaml"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "merge_fragments.hpp"
@@ -24,8 +25,9 @@ void attachLines(ClusterObservation& obs, const ClusterLines& lines) {
 /// Joins the fragments of one edge (merge_fragments.hpp) into the group's
 /// first cluster, whose lines are fitted again on the joined events; a group
 /// whose joined lines cannot be fitted stays apart.
-void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterLines>& fits, double focal_px,
-                    const ObservationOptions& options, const MotionModel* motion, ObservationReport& rep) {
+void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterLines>& fits,
+                    std::vector<std::vector<int>>& members, double focal_px, const ObservationOptions& options,
+                    const MotionModel* motion, ObservationReport& rep) {
   const auto groups = detail::fragmentGroups(built, focal_px, motion, options.merge_px);
   std::vector<bool> gone(built.size(), false);
   for (const auto& group : groups) {
@@ -33,16 +35,20 @@ void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterL
     ClusterObservation joined;
     const int joined_id = built[group.front()].id;
     joined.id = joined_id;
-    std::vector<std::pair<double, Vec3>> all;
+    std::vector<std::tuple<double, Vec3, int>> all;
     for (std::size_t c : group)
-      for (std::size_t j = 0; j < built[c].size(); ++j) all.emplace_back(built[c].times[j], built[c].bearings[j]);
-    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [t, b] : all) joined.times.push_back(t), joined.bearings.push_back(b);
+      for (std::size_t j = 0; j < built[c].size(); ++j)
+        all.emplace_back(built[c].times[j], built[c].bearings[j], members[c][j]);
+    std::stable_sort(all.begin(), all.end(),
+                     [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
+    std::vector<int> joined_members;
+    for (const auto& [t, b, i] : all) joined.times.push_back(t), joined.bearings.push_back(b), joined_members.push_back(i);
     const ClusterLines lines = fitClusterLines(joined.times, joined.bearings, focal_px, options.lines, motion);
     if (!lines.ok()) continue;
     attachLines(joined, lines);
     built[group.front()] = std::move(joined);
     fits[group.front()] = lines;
+    members[group.front()] = std::move(joined_members);
     for (std::size_t i = 1; i < group.size(); ++i) {
       gone[group[i]] = true;
       rep.merged_ids.push_back(built[group[i]].id);
@@ -53,11 +59,12 @@ void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterL
   std::size_t w = 0;
   for (std::size_t c = 0; c < built.size(); ++c) {
     if (gone[c]) continue;
-    if (w != c) built[w] = std::move(built[c]), fits[w] = std::move(fits[c]);
+    if (w != c) built[w] = std::move(built[c]), fits[w] = std::move(fits[c]), members[w] = std::move(members[c]);
     ++w;
   }
   built.resize(w);
   fits.resize(w);
+  members.resize(w);
 }
 
 }  // namespace
@@ -93,6 +100,7 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
   // Each cluster's events (sorted by time) and lines.
   std::vector<ClusterObservation> built;
   std::vector<ClusterLines> fits;
+  std::vector<std::vector<int>> built_members;  // input event indices of each built cluster's events
   for (size_t c = 0; c < k; ++c) {
     auto& idx = members[c];
     std::stable_sort(idx.begin(), idx.end(),
@@ -101,11 +109,14 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     obs.id = clusters.clusters[c].id;
     obs.times.reserve(idx.size());
     obs.bearings.reserve(idx.size());
+    std::vector<int> used;
+    used.reserve(idx.size());
     for (int i : idx) {
       const Vec3 b = bearing(Vec2(events[i].x, events[i].y));
       if (!b.allFinite() || !std::isfinite(events[i].t)) continue;
       obs.times.push_back(events[i].t);
       obs.bearings.push_back(b);
+      used.push_back(i);
     }
     if (static_cast<int>(obs.size()) < options.min_events) {
       ++rep.n_too_few_events;
@@ -114,8 +125,14 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     fits.push_back(fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion));
     attachLines(obs, fits.back());
     built.push_back(std::move(obs));
+    built_members.push_back(std::move(used));
   }
-  if (options.merge_px > 0.0) mergeFragments(built, fits, focal_px, options, motion, rep);
+  if (options.merge_px > 0.0) mergeFragments(built, fits, built_members, focal_px, options, motion, rep);
+  if (report) {
+    rep.event_clusters.assign(events.size(), -1);
+    for (size_t c = 0; c < built.size(); ++c)
+      for (int i : built_members[c]) rep.event_clusters[static_cast<size_t>(i)] = built[c].id;
+  }
   for (size_t c = 0; c < built.size(); ++c) {
     if (!built[c].has_lines) {
       // Kept for the methods that need no lines (npt).

@@ -130,8 +130,11 @@ bool WindowSource::next(EventWindow& w) {
   if (index_ == 0) next_t0_ = std::isfinite(o_.t_start) ? o_.t_start : buf_.front().t;
   if (buf_.empty()) pull();
   if (!buf_.empty()) skipGap(buf_.front().t, S, step);
-  // t0 from the origin and the step count (no accumulated rounding)
-  const double t0 = next_t0_ + double(step_index_) * step, t1 = t0 + S;
+  // t0 from the origin and the step count (no accumulated rounding). Without
+  // overlap t1 is the next window's t0 computed the same way: t0 + S may
+  // round below it, and an event between the two would be in neither window.
+  const double t0 = next_t0_ + double(step_index_) * step;
+  const double t1 = o_.overlap == 0.0 ? next_t0_ + double(step_index_ + 1) * step : t0 + S;
   if (!(t1 > t0) || !(next_t0_ + double(step_index_ + 1) * step > t0))
     throw IoError(reader_.path() + ": time " + std::to_string(t0) + " s is too large for windows of " +
                   std::to_string(S) + " s (t0 + S == t0 in double precision)");

@@ -7,7 +7,6 @@
 #include <deque>
 #include <cmath>
 #include <filesystem>
-#include <map>
 #include <sstream>
 
 #include "celc/core/parallel.hpp"
@@ -26,20 +25,6 @@ namespace celc {
 namespace {
 using Clock = std::chrono::steady_clock;
 
-/// Cluster labels with the clusters that the observation stage joined into
-/// another (fragments of one edge, observations.merge_px) relabelled as it.
-std::vector<int> joinedLabels(std::vector<int> labels, const ObservationReport& report) {
-  if (report.merged_ids.empty()) return labels;
-  std::map<int, int> into;
-  for (std::size_t k = 0; k < report.merged_ids.size(); ++k) into[report.merged_ids[k]] = report.merged_into[k];
-  for (int& l : labels)
-    for (int hops = 0; hops < 64; ++hops) {  // a chain of joins ends at a cluster that was kept
-      const auto it = into.find(l);
-      if (it == into.end()) break;
-      l = it->second;
-    }
-  return labels;
-}
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -337,7 +322,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                   index, report.n_merged);
   rec.times.lines = secondsSince(start);
   rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
-  if (m.truth) m.measureAgainstTruth(rec, events, joinedLabels(clusters.labels, report), motion);
+  if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);
 
   // The parallax policy grew the window as far as it could (to
   // windows.max_seconds, or to the end of the data) and its lines still show

@@ -33,6 +33,10 @@ void describe(FieldVisitor& v, ObservationOptions& options);
 
 /// What happened to each cluster.
 struct ObservationReport {
+  /// Per input event: the ClusterResult id of the cluster it ends in, after
+  /// the fragments of one edge are joined; -1 when in none (unclustered, a
+  /// non-finite bearing, a cluster with too few events).
+  std::vector<int> event_clusters;
   int n_clusters = 0;         ///< clusters in the ClusterResult
   int n_used = 0;             ///< clusters turned into observations with lines
   int n_too_few_events = 0;   ///< skipped: fewer than min_events usable events
