@@ -52,7 +52,7 @@ def main():
     print("| sequence | window | status | purity | impure clusters | edges complete | coverage | noise admitted "
           "| %s phi [deg] | oracle phi [deg] | within gap |" % a.method)
     print("|---|---|---|---|---|---|---|---|---|---|---|")
-    purity, coverage, impure_ok, gaps = [], [], [], []
+    purity, coverage, impure_ok, gaps, phis, oracles = [], [], [], [], [], []
     edges = edges_complete = 0
     for name, r in rows:
         p, cov, noise = num(r["purity"]), num(r["coverage"]), num(r["noise_admitted"])
@@ -70,6 +70,8 @@ def main():
         if not math.isnan(oracle):
             ok = not math.isnan(phi) and within_gap(phi, oracle)
             gaps.append(ok)
+            phis.append(math.pi if math.isnan(phi) else phi)
+            oracles.append(oracle)
             gap = "yes" if ok else "no"
         deg = lambda x: "-" if math.isnan(x) else "%.1f" % math.degrees(x)
         f3 = lambda x: "-" if math.isnan(x) else "%.3f" % x
@@ -87,6 +89,10 @@ def main():
     print(f"| coverage of edge events, median window | {med(coverage):.3f} | >= 0.95 |")
     print(f"| windows where {a.method} is within max(1.5x, +1 deg) of the oracle | {share(gaps):.2f} "
           f"({sum(gaps)} / {len(gaps)}) | >= 0.80 |")
+    mp, mo = med(phis), med(oracles)
+    print(f"| median {a.method} phi against the median oracle phi [deg] | {math.degrees(mp):.2f} against "
+          f"{math.degrees(mo):.2f} ({'within' if oracles and within_gap(mp, mo) else 'beyond'} max(1.5x, +1 deg)) "
+          f"| within |")
 
 
 if __name__ == "__main__":

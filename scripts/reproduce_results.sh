@@ -11,7 +11,8 @@
 #   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
-#   summary     the README's results table from simulation, peers and scenes: summary.md
+#   summary     the README's results table from simulation, peers and scenes: summary.md;
+#               then the tables the pages of docs/ include (<!-- include results/NAME.md -->)
 # Each file's first line names the command that wrote it; the text after a
 # file's tables (its legend) is kept. Work files go to ${CELC_RESULTS_WORK:-out/results}.
 set -euo pipefail
@@ -98,6 +99,7 @@ PY
       $tables summary "$res" | put summary.md summary "scripts/results_tables.py summary docs/results"
       $tables readme README.md "$res/summary.md"
       echo "rewrote the README's results table" >&2
+      $tables include docs/*.md
       ;;
     *)
       echo "reproduce_results.sh: unknown name '$name' (see the header of this script)" >&2

@@ -15,6 +15,10 @@ usage:
                                         simulation_default.md, peers.md and scenes.md
   results_tables.py readme README FILE  README's table between the results markers
                                         replaced by FILE's content
+  results_tables.py include PAGE...     in each page, every block between
+                                        "<!-- include results/NAME.md -->" and
+                                        "<!-- end include -->" replaced by that file's
+                                        Regenerate line and tables (not its legend)
 """
 import re
 import sys
@@ -139,6 +143,30 @@ def cmd_readme(readme, path):
         f.write(head + BEGIN + "\n" + table + "\n" + END + tail)
 
 
+INCLUDE = re.compile(r"(<!-- include (results/[\w.-]+\.md) -->\n)(.*?)(<!-- end include -->)", re.S)
+
+
+def cmd_include(pages):
+    import os
+    for page in pages:
+        with open(page, encoding="utf-8") as f:
+            text = f.read()
+
+        def body(m):
+            path = os.path.join(os.path.dirname(page), m.group(2))
+            with open(path, encoding="utf-8") as f:
+                lines = f.read().splitlines()
+            spans = tables(lines)
+            end = spans[-1][1] if spans else len(lines)
+            return m.group(1) + "\n".join(lines[:end]).strip("\n") + "\n" + m.group(4)
+
+        new = INCLUDE.sub(body, text)
+        if new != text:
+            with open(page, "w", encoding="utf-8") as f:
+                f.write(new)
+            print("updated %s" % page, file=sys.stderr)
+
+
 def main():
     a = sys.argv[1:]
     if a[:1] == ["table"] and len(a) == 2:
@@ -151,6 +179,8 @@ def main():
         cmd_windows(a[1])
     elif a[:1] == ["summary"] and len(a) == 2:
         cmd_summary(a[1])
+    elif a[:1] == ["include"] and len(a) >= 2:
+        cmd_include(a[1:])
     elif a[:1] == ["readme"] and len(a) == 3:
         cmd_readme(a[1], a[2])
     else:

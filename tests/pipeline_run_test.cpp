@@ -129,6 +129,16 @@ TEST(Pipeline, ShardsUnionEqualsSingleRun) {
   EXPECT_EQ(t_single.out, t_merged.out);
   EXPECT_NE(t_single.out.find("| seq | eps (unit-vector distance) |"), std::string::npos) << t_single.out;
   EXPECT_NE(t_single.out.find("**"), std::string::npos);  // best in bold
+  // --methods: the paper's three columns, in the order given; a method the
+  // results do not hold, or no method at all, is an error.
+  const auto paper = test::runCelc("table '" + (d / "all").string() + "' --methods celc,celc_opt,ce3lc", d);
+  ASSERT_EQ(paper.status, 0) << paper.err;
+  EXPECT_EQ(paper.out.substr(0, paper.out.find('\n')), "| sequence | error | CELC | CELC+opt | CE3LC |");
+  const auto reordered = test::runCelc("table '" + (d / "all").string() + "' --methods ce3lc,celc", d);
+  EXPECT_EQ(reordered.out.substr(0, reordered.out.find('\n')), "| sequence | error | CE3LC | CELC |");
+  const auto unknown = test::runCelc("table '" + (d / "all").string() + "' --methods celc,fast", d);
+  EXPECT_NE(unknown.status, 0);
+  EXPECT_NE(unknown.err.find("--methods 'celc,fast'"), std::string::npos) << unknown.err;
   EXPECT_EQ(t_merged.err.find("rows missing"), std::string::npos) << t_merged.err;
   // A shard that lost a row (cut or edited) is flagged: its methods would
   // be summarised over different windows.
