@@ -5,6 +5,7 @@
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -119,6 +120,10 @@ pyb::array readEvents(const pyb::object& path, std::optional<double> t0, std::op
                       std::optional<std::size_t> max_events, const pyb::object& options) {
   const ReaderOptions o = readerOptions(options, "read_events(options)");
   const std::string p = existingPath(path);
+  // An empty or reversed range is a mistake, not a request for no events.
+  if ((t0 && std::isnan(*t0)) || (t1 && std::isnan(*t1)) || (t0 && t1 && !(*t0 < *t1)))
+    throw pyb::value_error("read_events: need t0 < t1 [s], got t0=" + (t0 ? std::to_string(*t0) : "None") +
+                           ", t1=" + (t1 ? std::to_string(*t1) : "None"));
   EventBuffer events;
   {
     pyb::gil_scoped_release nogil;

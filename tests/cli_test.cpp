@@ -222,3 +222,12 @@ TEST(Cli, VersionNamesReleaseAndRevision) {
   EXPECT_TRUE(std::regex_match(r.out, form)) << r.out;
   fs::remove_all(d);
 }
+
+// A mistyped subcommand is named, with the ones that exist.
+TEST(Cli, UnknownSubcommandIsNamed) {
+  const fs::path d = tempDir("unknown_sub");
+  const auto r = runCelc("runn x", d);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("unknown subcommand 'runn' (the subcommands: run, batch, table"), std::string::npos) << r.err;
+  fs::remove_all(d);
+}

@@ -136,6 +136,11 @@ TEST(Pipeline, ShardsUnionEqualsSingleRun) {
   EXPECT_EQ(paper.out.substr(0, paper.out.find('\n')), "| sequence | error | CELC | CELC+opt | CE3LC |");
   const auto reordered = test::runCelc("table '" + (d / "all").string() + "' --methods ce3lc,celc", d);
   EXPECT_EQ(reordered.out.substr(0, reordered.out.find('\n')), "| sequence | error | CE3LC | CELC |");
+  // -o DIR/prefix makes DIR, as `celc run -o` makes its folder.
+  ASSERT_EQ(test::runCelc("table '" + (d / "all").string() + "' -q -o '" + (d / "new" / "dir" / "t").string() + "'", d)
+                .status,
+            0);
+  EXPECT_TRUE(fs::exists(d / "new" / "dir" / "t.md"));
   const auto unknown = test::runCelc("table '" + (d / "all").string() + "' --methods celc,fast", d);
   EXPECT_NE(unknown.status, 0);
   EXPECT_NE(unknown.err.find("--methods 'celc,fast'"), std::string::npos) << unknown.err;

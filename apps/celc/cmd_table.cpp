@@ -222,6 +222,8 @@ void runTable(const TableArgs& a) {
     if (!methods_found.count(m))
       throw std::runtime_error("--methods: no rows of method '" + m + "' in the results");
   if (!a.output.empty()) {
+    // -o DIR/prefix: DIR is made as `celc run -o` makes its folder.
+    if (const fs::path dir = fs::path(a.output).parent_path(); !dir.empty()) fs::create_directories(dir);
     writeFileAtomically(a.output + ".md", tableMarkdown(table));
     writeFileAtomically(a.output + ".tex", tableLatex(table));
     writeFileAtomically(a.output + ".csv", tableCsv(table));

@@ -47,6 +47,19 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // `celc runn x`: CLI11 says only that a subcommand is required; name the word it did not know.
+    if (argc > 1 && argv[1][0] != '-') {
+      std::string known;
+      bool is_known = false;
+      for (const CLI::App* sub : app.get_subcommands({})) {
+        known += (known.empty() ? "" : ", ") + sub->get_name();
+        is_known = is_known || sub->get_name() == argv[1];
+      }
+      if (!is_known) {
+        std::cerr << "celc: error: unknown subcommand '" << argv[1] << "' (the subcommands: " << known << ")\n";
+        return 2;
+      }
+    }
     return app.exit(e);
   } catch (const std::exception& e) {
     std::cerr << "celc: error: " << e.what() << "\n";

@@ -114,6 +114,10 @@ def test_time_range_and_count(tmp_path):
     assert len(part) == 7000
     np.testing.assert_allclose(part["t"], ev["t"][5000:12000], atol=1e-9)
     assert len(celc.read_events(path, max_events=123)) == 123
+    # A reversed, empty or NaN range is an error, not an empty array.
+    for lo, hi in ((t1, t0), (t0, t0), (float("nan"), t1)):
+        with pytest.raises(ValueError, match="need t0 < t1"):
+            celc.read_events(path, t0=lo, t1=hi)
 
 
 def test_reader_options(tmp_path):
