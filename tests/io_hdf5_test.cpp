@@ -94,6 +94,11 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
   EXPECT_NE(m.find("bad_mvsec.h5: dataset /davis/left/events: has 3 columns, expected 4 (x, y, t, p)"),
             std::string::npos)
       << m;
+  // Declared with 10^12 rows and never written: refused at once instead of
+  // read for hours as fill values.
+  m = ioErrorOf([] { openEventSource(fixture("bad_unwritten.h5")); });
+  EXPECT_NE(m.find("bad_unwritten.h5: dataset /events/"), std::string::npos) << m;
+  EXPECT_NE(m.find("chunks but stores 0: rows that were never written"), std::string::npos) << m;
   celc::test::TempDir dir;
   std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
   const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -282,6 +282,17 @@ class Hdf5Reader final : public EventReader {
       hsize_t n = 0;
       if (H5Dget_num_chunks(d.id.get(), d.space.get(), &n) < 0)
         fail(name, "its chunk index cannot be read (damaged file)");
+      // Rows in chunks that were never written read as fill values: a
+      // dataset declared with 10^12 rows and no data would be read for hours
+      // as zeros. Every chunk its rows need must be stored.
+      double needed = 1.0;
+      for (int k = 0; k < rank; ++k)
+        if (chunk[std::size_t(k)] > 0)
+          needed *= std::ceil(double(d.dims[std::size_t(k)]) / double(chunk[std::size_t(k)]));
+      if (double(n) < needed)
+        fail(name, "declares " + byteCountText(double(d.dims[0])) + " rows in " + byteCountText(needed) +
+                       " chunks but stores " + std::to_string(n) + ": rows that were never written (damaged or "
+                       "truncated file)");
       std::vector<hsize_t> offset(std::size_t(rank), 0);
       for (hsize_t i = 0; i < n; ++i) {
         unsigned mask = 0;
