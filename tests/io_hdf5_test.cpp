@@ -99,6 +99,10 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
   m = ioErrorOf([] { openEventSource(fixture("bad_unwritten.h5")); });
   EXPECT_NE(m.find("bad_unwritten.h5: dataset /events/"), std::string::npos) << m;
   EXPECT_NE(m.find("chunks but stores 0: rows that were never written"), std::string::npos) << m;
+  m = ioErrorOf([] { openEventSource(fixture("bad_unwritten_mvsec.h5")); });
+  EXPECT_NE(m.find("bad_unwritten_mvsec.h5: dataset /davis/left/events: contiguous data of 0 bytes for 32000000000 bytes"),
+            std::string::npos)
+      << m;
   celc::test::TempDir dir;
   std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
   const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -252,15 +252,15 @@ class Hdf5Reader final : public EventReader {
     const int nf = plist.valid() ? H5Pget_nfilters(plist.get()) : 0;
     // Compact (in the header) and contiguous data are stored whole: a stored
     // size other than the dataset's makes the HDF5 library copy from a buffer
-    // too small or absent (found by the hdf5 fuzz target). Contiguous data not
-    // yet written (size 0) reads as fill values.
+    // too small or absent (found by the hdf5 fuzz target). Contiguous data
+    // never written (size 0) would read as fill values: refused as well.
     const H5D_layout_t layout = plist.valid() ? H5Pget_layout(plist.get()) : H5D_LAYOUT_ERROR;
     if (layout == H5D_COMPACT || layout == H5D_CONTIGUOUS) {
       H5Id type(H5Dget_type(d.id.get()), H5Tclose);
       double need = type.valid() ? double(H5Tget_size(type.get())) : 0.0;
       for (hsize_t n : d.dims) need *= double(n);
       const double stored = double(H5Dget_storage_size(d.id.get()));
-      if (stored != need && !(layout == H5D_CONTIGUOUS && stored == 0.0))
+      if (stored != need)
         fail(name, std::string(layout == H5D_COMPACT ? "compact" : "contiguous") + " data of " +
                        byteCountText(stored) + " bytes for " + byteCountText(need) +
                        " bytes of values (damaged file)");
