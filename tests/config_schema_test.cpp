@@ -353,7 +353,7 @@ TEST(ConfigSchema, BatchFile) {
   write("sequences:\n  - {path: a}\n  - {path: b, config: {windows: {evnts: 5}}}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: policy, events, seconds, overlap, "
-            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second, parallax_px, "
+            "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second, max_events, parallax_px, "
             "no_parallax_px, min_seconds, max_seconds, slow_turn_max_seconds, slow_turn_rad, step_seconds, "
             "probe_events)");
   write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");

@@ -244,3 +244,37 @@ TEST(IoWindow, TimeWindowsHoldEveryEventOnTheirBoundaries) {
     EXPECT_EQ(total, ev.size()) << seconds << " s windows";
   }
 }
+
+// A window that would hold more than windows.max_events events (a burst of
+// events at one time, as in an AEDAT 4 file of packets of 4,000,000 events
+// sharing a timestamp) is an error naming its time, read with a buffer of at
+// most max_events + read_batch events, not gigabytes.
+TEST(IoWindow, WindowOverMaxEventsIsAnErrorNamingItsTime) {
+  TempDir d;
+  std::vector<Event> ev{{0.0, 1.0f, 1.0f, true}};
+  for (int i = 0; i < 3000; ++i) ev.push_back({0.01, static_cast<float>(i % 200), 5.0f, true});
+  ev.push_back({0.1, 2.0f, 2.0f, false});
+  writeEventsText(d.file("burst.txt"), ev);
+  auto r = openEventSource(d.file("burst.txt"));
+  WindowOptions o;
+  o.seconds_per_window = 0.025;
+  o.max_events = 1000;
+  o.read_batch = 100;
+  WindowSource ws(*r, o);
+  EventWindow w;
+  try {
+    ws.next(w);
+    ADD_FAILURE() << "no error for a window of 3001 events";
+  } catch (const IoError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("burst.txt: the window [0.000000, 0.025000) s holds more than windows.max_events = 1000"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_LE(ws.peakBuffered(), 1000u + 2 * 100u);
+  // Windows by count cannot ask for more than the bound.
+  WindowOptions count;
+  count.events_per_window = 2000;
+  count.max_events = 1000;
+  EXPECT_NE(count.validate().find("events: 2000 per window, more than max_events = 1000"), std::string::npos);
+}

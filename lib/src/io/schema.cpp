@@ -44,6 +44,8 @@ void describe(FieldVisitor& v, WindowOptions& o) {
           o.partial_min_share);
   v.field({"max_windows_per_second", "1/s", "a window policy making more windows per second of data is an error"},
           o.max_windows_per_second);
+  v.field({"max_events", "events", "a window that would hold more events is an error naming its time"},
+          o.max_events);
 }
 
 void describe(FieldVisitor& v, GyroWindowOptions& o) {

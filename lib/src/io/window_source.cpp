@@ -36,7 +36,19 @@ std::string WindowOptions::validate() const {
   }
   if (std::isnan(t_start) || std::isnan(t_end) || !(t_end > t_start)) e << "t_start, t_end: need t_start < t_end; ";
   if (read_batch < 1) e << "read_batch: must be >= 1; ";
+  if (max_events < 1) e << "max_events: must be >= 1; ";
+  else if (events_per_window > max_events)
+    e << "events: " << events_per_window << " per window, more than max_events = " << max_events << "; ";
   return e.str();
+}
+
+IoError WindowSource::tooManyEvents(double t0, double t1) const {
+  char text[160];
+  std::snprintf(text, sizeof text, ": the window [%.6f, %.6f) s holds more than windows.max_events = %zu events",
+                t0, t1, o_.max_events);
+  return IoError(detail::printable(reader_.path()) + text +
+                 " (a burst of events at one time, or windows too long for the event rate; raise "
+                 "windows.max_events or shorten the windows)");
 }
 
 WindowSource::WindowSource(EventReader& reader, const WindowOptions& options) : reader_(reader), o_(options) {
@@ -138,8 +150,10 @@ bool WindowSource::next(EventWindow& w) {
   if (!(t1 > t0) || !(next_t0_ + double(step_index_ + 1) * step > t0))
     throw IoError(reader_.path() + ": time " + std::to_string(t0) + " s is too large for windows of " +
                   std::to_string(S) + " s (t0 + S == t0 in double precision)");
-  // make sure the buffer reaches t1 (or the end)
+  // make sure the buffer reaches t1 (or the end); the buffer holds the
+  // window's events and at most one batch beyond
   while ((buf_.empty() || buf_.back().t < t1) && pull()) {
+    if (buf_.size() > o_.max_events + o_.read_batch) throw tooManyEvents(t0, t1);
   }
   // complete when events reach t1, or the stream passed t_end and t1 <= t_end
   const bool complete = (!buf_.empty() && buf_.back().t >= t1) || (past_end_ && t1 <= o_.t_end);
@@ -159,6 +173,7 @@ bool WindowSource::next(EventWindow& w) {
     if (e.t >= t1) break;
     count += e.t >= t0;
   }
+  if (count > o_.max_events) throw tooManyEvents(t0, t1);
   reserveLarge(w.events, count);
   for (const Event& e : buf_) {
     if (e.t >= t1) break;

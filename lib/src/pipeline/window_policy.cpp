@@ -146,6 +146,8 @@ void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
   window.events.clear();
   std::size_t n = 0;
   for (int i = 0; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
+  if (n > source_.options().max_events)
+    throw source_.tooManyEvents(pending_.front().t0, pending_[static_cast<std::size_t>(steps - 1)].t1);
   reserveLarge(window.events, n);
   for (int i = 0; i < steps; ++i) {
     const auto& e = pending_[static_cast<std::size_t>(i)].events;

@@ -46,6 +46,10 @@ struct WindowOptions {
   /// By duration it is checked here (1 / step); by count, where it depends on
   /// the event rate, by the caller as windows arrive.
   double max_windows_per_second = 10000.0;
+  /// Upper bound on the events of one window [events]: a window by duration
+  /// (or one the parallax policy joins) that would hold more is an error
+  /// naming its time, not gigabytes of memory (24 bytes per event).
+  std::size_t max_events = 20000000;
   /// Why the options are unusable ("" = valid): "key: what; " per problem,
   /// keys as in the `windows:` section.
   std::string validate() const;
@@ -78,6 +82,9 @@ class WindowSource {
   bool next(EventWindow& window);
   /// Largest number of events held at once so far (the memory bound).
   std::size_t peakBuffered() const { return peak_; }
+  const WindowOptions& options() const { return o_; }
+  /// The error for a window [t0, t1) that holds more than options().max_events events.
+  IoError tooManyEvents(double t0, double t1) const;
   /// After next() returned false: the last, partial window, emitted or not.
   const WindowTail& tail() const { return tail_; }
   /// Gaps skipped so far, the empty windows they would have made, and up to 20
