@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "celc/core/yaml.hpp"
+#include "celc/io/event_reader.hpp"
 
 namespace celc::py {
 
@@ -211,14 +212,19 @@ void applyDict(const pyb::handle& options, const std::string& origin, const Desc
 }
 
 std::string pathString(const pyb::handle& path) {
-  return pyb::str(pyb::module_::import("os").attr("fspath")(path)).cast<std::string>();
+  // os.fsdecode: str, bytes and path-like objects alike (bytes decoded as the
+  // file system does, not printed as "b'...'").
+  const std::string p = pyb::module_::import("os").attr("fsdecode")(path).cast<std::string>();
+  if (p.find('\0') != std::string::npos)
+    throw pyb::value_error("path " + detail::printable(p, 4096) + ": contains a NUL byte");
+  return p;
 }
 
 std::string existingPath(const pyb::handle& path) {
   std::string p = pathString(path);
   std::error_code ec;
   if (!std::filesystem::exists(p, ec)) {
-    PyErr_SetString(PyExc_FileNotFoundError, (p + ": no such file or directory").c_str());
+    PyErr_SetString(PyExc_FileNotFoundError, (detail::printable(p, 4096) + ": no such file or directory").c_str());
     throw pyb::error_already_set();
   }
   return p;

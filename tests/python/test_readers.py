@@ -1,5 +1,7 @@
 """celc.read_events / read_imu / write_events / info: round trips through the
 library's writers and the files `celc synth` writes, dtypes, ownership, errors."""
+import os
+
 import numpy as np
 import pytest
 
@@ -134,6 +136,20 @@ def test_missing_file_is_oserror_naming_it(tmp_path):
     path = tmp_path / "no_such_file.aedat4"
     with pytest.raises(OSError, match="no_such_file.aedat4"):
         celc.read_events(path)
+
+
+def test_bytes_and_nul_paths(tmp_path):
+    ev = make_events(50)
+    path = tmp_path / "rec.aedat4"
+    celc.write_events(path, ev, format="aedat4")
+    # A bytes path is decoded as the file system does, not read as "b'...'".
+    assert len(celc.read_events(os.fsencode(str(path)))) == 50
+    with pytest.raises(ValueError, match="NUL byte"):
+        celc.read_events(str(path) + "\0tail")
+    # A control character in a missing file's name is shown escaped.
+    with pytest.raises(OSError) as e:
+        celc.read_events(tmp_path / "no\x1b[31mfile")
+    assert "\x1b" not in str(e.value)
 
 
 def test_corrupt_file_is_oserror_naming_it(tmp_path):
