@@ -198,6 +198,23 @@ TEST(CliTrust, ResumeRefusesAnotherConfigurationAndKeepsRows) {
   fs::remove_all(d);
 }
 
+// --resume continues the same recording only: rows of one sequence followed
+// by another's would be one table of neither.
+TEST(CliTrust, ResumeRefusesAnotherRecording) {
+  const fs::path d = test::freshTempDir("trust_resume_input");
+  fs::copy(kSample, d / "other", fs::copy_options::recursive);
+  ASSERT_EQ(runCelc("run '" + kSample + "' -o " + q(d / "o") + kFast + "--window-events 15000", d).status, 0);
+  const std::string rows = readAll(d / "o" / "windows.csv");
+  EXPECT_NE(readAll(d / "o" / "input.txt").find("sample_seq"), std::string::npos);
+  expectOneLineError(runCelc("run " + q(d / "other") + " -o " + q(d / "o") + kFast + "--window-events 15000 --resume", d),
+                     {"input.txt: holds a run of other inputs", "--resume continues the same recording only"});
+  EXPECT_EQ(readAll(d / "o" / "windows.csv"), rows);  // nothing deleted
+  // The same recording resumes.
+  const auto same = runCelc("run '" + kSample + "' -o " + q(d / "o") + kFast + "--window-events 15000 --resume", d);
+  EXPECT_EQ(same.status, 0) << same.err;
+  fs::remove_all(d);
+}
+
 // ---- tables that name runs ----
 
 TEST(CliTrust, TableKeepsRunsOfTheSameNameApart) {
@@ -283,9 +300,11 @@ TEST(CliTrust, RunStoppingOnAnErrorIsMarkedAndTableRefusesIt) {
   auto r = runCelc("table --allow-incomplete " + q(d / "r"), d);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("| seq (incomplete) | eps"), std::string::npos) << r.out;
-  // A new run without --force/--resume is refused; --resume completes it and removes the marker.
-  expectOneLineError(runCelc("run " + q(good) + " -o " + q(d / "r" / "seq") + opts, d), {"--force", "--resume"});
-  r = runCelc("run " + q(good) + " -o " + q(d / "r" / "seq") + opts + "--resume", d);
+  // A new run without --force/--resume is refused; once the file is repaired
+  // in place, --resume completes it and removes the marker.
+  expectOneLineError(runCelc("run " + q(bad) + " -o " + q(d / "r" / "seq") + opts, d), {"--force", "--resume"});
+  fs::copy_file(good / "events.txt", bad / "events.txt", fs::copy_options::overwrite_existing);
+  r = runCelc("run " + q(bad) + " -o " + q(d / "r" / "seq") + opts + "--resume", d);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_FALSE(fs::exists(d / "r" / "seq" / "INCOMPLETE"));
   EXPECT_EQ(runCelc("table " + q(d / "r"), d).status, 0);

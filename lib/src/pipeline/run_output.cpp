@@ -3,6 +3,7 @@
 #include <cmath>
 #include <ctime>
 #include <iomanip>
+#include <iterator>
 #include <set>
 #include <filesystem>
 #include <map>
@@ -116,9 +117,24 @@ std::string nowText() {
 
 }  // namespace
 
-RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config)
+std::string inputIdentity(const RunInputs& inputs) {
+  std::string out;
+  const std::pair<const char*, std::string> files[] = {{"events", inputs.events},
+                                                       {"calibration", inputs.calib},
+                                                       {"ground truth", inputs.groundtruth},
+                                                       {"imu", inputs.imu}};
+  for (const auto& [what, path] : files) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    out += std::string(what) + ": " + fs::absolute(path, ec).lexically_normal().string() + "\n";
+  }
+  return out;
+}
+
+RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config, const std::string& inputs)
     : dir_(dir), csv_path_((fs::path(dir) / "windows.csv").string()) {
   const fs::path config_path = fs::path(dir) / "config.yaml";
+  const fs::path input_path = fs::path(dir) / "input.txt";
   const bool has_run = holdsRows(csv_path_);
   if (has_run && mode == OutputMode::Create)
     throw std::runtime_error(dir + ": holds an earlier run (windows.csv); use --force to replace it or --resume to continue it");
@@ -141,6 +157,21 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& c
         throw std::runtime_error(config_path.string() + ": " + difference +
                                  "; --resume continues the same configuration only (--resume --force replaces the run)");
       notes_.push_back("replaced the earlier run: its config.yaml " + difference);
+      resume = false;
+    }
+  }
+  if (resume && !inputs.empty() && fs::exists(input_path)) {
+    // Rows of another recording are not continued either.
+    std::ifstream in(input_path);
+    const std::string stored((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (stored != inputs) {
+      const auto firstLine = [](const std::string& text) { return text.substr(0, text.find('\n')); };
+      const std::string difference = "holds a run of other inputs (stored: " + firstLine(stored) +
+                                     "; now: " + firstLine(inputs) + ")";
+      if (mode == OutputMode::Resume)
+        throw std::runtime_error(input_path.string() + ": " + difference +
+                                 "; --resume continues the same recording only (--resume --force replaces the run)");
+      notes_.push_back("replaced the earlier run: its input.txt " + difference);
       resume = false;
     }
   }
@@ -193,6 +224,7 @@ RunOutput::RunOutput(const std::string& dir, OutputMode mode, const RunConfig& c
   }
   if (!csv_) throw std::runtime_error(csv_path_ + ": cannot write");
   writeFileAtomically(config_path.string(), toYaml(config));
+  if (!inputs.empty()) writeFileAtomically(input_path.string(), inputs);
 }
 
 void RunOutput::writeMarker(const std::string& text) const {
@@ -233,7 +265,7 @@ void RunOutput::abandon(const std::string& error) {
   std::error_code ec;
   if (appended_ == 0 && resume_after_ < 0) {
     // Nothing of a result: remove what this run created.
-    for (const char* f : {"windows.csv", "config.yaml", "summary.md", kIncompleteMarker})
+    for (const char* f : {"windows.csv", "config.yaml", "input.txt", "summary.md", kIncompleteMarker})
       fs::remove(fs::path(dir_) / f, ec);
     if (created_dir_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
     return;
@@ -274,7 +306,7 @@ SequenceOutcome runSequence(const SequenceJob& job,
                             const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   SequenceOutcome out;
   SequenceRunner runner(job.inputs, job.config);  // opens the inputs: nothing written yet
-  RunOutput output(job.outdir, job.mode, job.config);
+  RunOutput output(job.outdir, job.mode, job.config, inputIdentity(job.inputs));
   if (!job.dump_windows.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(job.dump_windows, ec);

@@ -43,7 +43,10 @@ class RunOutput {
   /// first differing key); the existing windows.csv is kept up to its last
   /// complete window (only a torn last window is dropped) and resumeAfter()
   /// says where to continue. Writes config.yaml and the INCOMPLETE marker.
-  RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config);
+  /// `inputs`: what the rows are of (inputIdentity()), kept in input.txt;
+  /// Resume also requires the same inputs (a run of another recording is
+  /// not continued).
+  RunOutput(const std::string& dir, OutputMode mode, const RunConfig& config, const std::string& inputs = "");
 
   /// Index of the last complete window already in windows.csv (-1: none).
   std::int64_t resumeAfter() const { return resume_after_; }
@@ -72,6 +75,10 @@ class RunOutput {
   std::size_t appended_ = 0;  ///< windows appended by this run
   std::vector<std::string> notes_;
 };
+
+/// The inputs of a run as text for input.txt: each input's absolute path (a
+/// file repaired in place is still the same recording).
+std::string inputIdentity(const RunInputs& inputs);
 
 /// One sequence run into an output folder (what `celc run` and each entry of
 /// `celc batch` do).
