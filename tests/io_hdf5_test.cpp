@@ -103,6 +103,17 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
   EXPECT_NE(m.find("bad_unwritten_mvsec.h5: dataset /davis/left/events: contiguous data of 0 bytes for 32000000000 bytes"),
             std::string::npos)
       << m;
+  // An index entry past the events (2^63) and IMU times going back: errors
+  // naming the dataset and the entry, not 0 windows or windows `not_covered`.
+  m = ioErrorOf([] {
+    auto r = openEventSource(fixture("bad_ms_to_idx.h5"));
+    r->seekTime(0.2);
+  });
+  EXPECT_NE(m.find("bad_ms_to_idx.h5: dataset /ms_to_idx: entry "), std::string::npos) << m;
+  EXPECT_NE(m.find("is event 9223372036854775808, beyond the"), std::string::npos) << m;
+  m = ioErrorOf([] { openEventSource(fixture("bad_imu_ts.h5"))->readImu(); });
+  EXPECT_NE(m.find("bad_imu_ts.h5: dataset /davis/left/imu_ts: row 100: time"), std::string::npos) << m;
+  EXPECT_NE(m.find("(times must not decrease)"), std::string::npos) << m;
   celc::test::TempDir dir;
   std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
   const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -154,6 +154,9 @@ class Hdf5Reader final : public EventReader {
       imu[i].gyro = gyro_first ? Vec3(r[0], r[1], r[2]) : Vec3(r[3], r[4], r[5]);
       if (!std::isfinite(t[i]) || !imu[i].accel.allFinite() || !imu[i].gyro.allFinite())
         fail(values.name, "row " + std::to_string(i) + ": a non-finite value");
+      if (i > 0 && t[i] < t[i - 1])
+        fail(stamps.name, "row " + std::to_string(i) + ": time " + std::to_string(t[i]) + " s is before row " +
+                              std::to_string(i - 1) + "'s " + std::to_string(t[i - 1]) + " s (times must not decrease)");
     }
     return imu;
   }
@@ -175,6 +178,9 @@ class Hdf5Reader final : public EventReader {
       const Mat3 R = T.topLeftCorner<3, 3>();
       if (!T.allFinite() || !std::isfinite(t[i]) || (R.transpose() * R - Mat3::Identity()).norm() > 1e-3)
         fail(values.name, "pose " + std::to_string(i) + ": not a finite rigid transform");
+      if (i > 0 && t[i] < t[i - 1])
+        fail(stamps.name, "row " + std::to_string(i) + ": time " + std::to_string(t[i]) + " s is before row " +
+                              std::to_string(i - 1) + "'s " + std::to_string(t[i - 1]) + " s (times must not decrease)");
       poses[i].t = t[i];
       poses[i].position = T.topRightCorner<3, 1>();
       poses[i].orientation = Eigen::Quaterniond(R).normalized();
@@ -195,7 +201,11 @@ class Hdf5Reader final : public EventReader {
     H5Sselect_hyperslab(ms.space.get(), H5S_SELECT_SET, &start, nullptr, &one, nullptr);
     if (H5Dread(ms.id.get(), H5T_NATIVE_UINT64, mem.get(), ms.space.get(), H5P_DEFAULT, &idx) < 0)
       fail(ms.name, "cannot read entry " + std::to_string(k));
-    next_ = std::min<hsize_t>(idx, count_);
+    // An index past the events would start after the data: 0 windows, silently.
+    if (idx > count_)
+      fail(ms.name, "entry " + std::to_string(k) + " is event " + std::to_string(idx) + ", beyond the " +
+                        std::to_string(count_) + " events (damaged index)");
+    next_ = idx;
     cur_ = have_ = 0;
     return true;
   }
