@@ -145,6 +145,7 @@ class Hdf5Reader final : public EventReader {
       fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
                             " IMU rows");
     const std::vector<double> v = readAll(values, 6), t = readAll(stamps, 1);
+    checkTimesDoNotDecrease(stamps, t);
     const bool gyro_first = options_.imu_columns == ImuColumns::GyroFirst;
     imu.resize(t.size());
     for (std::size_t i = 0; i < t.size(); ++i) {
@@ -154,9 +155,6 @@ class Hdf5Reader final : public EventReader {
       imu[i].gyro = gyro_first ? Vec3(r[0], r[1], r[2]) : Vec3(r[3], r[4], r[5]);
       if (!std::isfinite(t[i]) || !imu[i].accel.allFinite() || !imu[i].gyro.allFinite())
         fail(values.name, "row " + std::to_string(i) + ": a non-finite value");
-      if (i > 0 && t[i] < t[i - 1])
-        fail(stamps.name, "row " + std::to_string(i) + ": time " + std::to_string(t[i]) + " s is before row " +
-                              std::to_string(i - 1) + "'s " + std::to_string(t[i - 1]) + " s (times must not decrease)");
     }
     return imu;
   }
@@ -170,6 +168,7 @@ class Hdf5Reader final : public EventReader {
       fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
                             " poses");
     const std::vector<double> v = readAll(values, 16), t = readAll(stamps, 1);
+    checkTimesDoNotDecrease(stamps, t);
     poses.resize(t.size());
     for (std::size_t i = 0; i < t.size(); ++i) {
       Eigen::Matrix4d T;
@@ -178,9 +177,6 @@ class Hdf5Reader final : public EventReader {
       const Mat3 R = T.topLeftCorner<3, 3>();
       if (!T.allFinite() || !std::isfinite(t[i]) || (R.transpose() * R - Mat3::Identity()).norm() > 1e-3)
         fail(values.name, "pose " + std::to_string(i) + ": not a finite rigid transform");
-      if (i > 0 && t[i] < t[i - 1])
-        fail(stamps.name, "row " + std::to_string(i) + ": time " + std::to_string(t[i]) + " s is before row " +
-                              std::to_string(i - 1) + "'s " + std::to_string(t[i - 1]) + " s (times must not decrease)");
       poses[i].t = t[i];
       poses[i].position = T.topRightCorner<3, 1>();
       poses[i].orientation = Eigen::Quaterniond(R).normalized();
@@ -213,6 +209,15 @@ class Hdf5Reader final : public EventReader {
  private:
   [[noreturn]] void fail(const std::string& dataset, const std::string& what) const {
     throw IoError(path_ + ": dataset " + dataset + ": " + what);
+  }
+
+  /// A time dataset of IMU samples or poses must not go back (the gyro
+  /// windows and the ground truth would silently find no samples).
+  void checkTimesDoNotDecrease(const Dataset& stamps, const std::vector<double>& t) const {
+    for (std::size_t i = 1; i < t.size(); ++i)
+      if (t[i] < t[i - 1])
+        fail(stamps.name, "row " + std::to_string(i) + ": time " + std::to_string(t[i]) + " s is before row " +
+                              std::to_string(i - 1) + "'s " + std::to_string(t[i - 1]) + " s (times must not decrease)");
   }
 
   /// Checks the object header at `address` once (hdf5_object_header.hpp).
