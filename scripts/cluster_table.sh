@@ -5,7 +5,8 @@
 # labels.txt, so every window of windows.csv carries the clusters' quality
 # against the true edges and the oracle: celc_ml on the window's true
 # clusters, with the same lines code, gyro and seed (docs/clustering.md).
-#   scripts/cluster_table.sh [OUTDIR] [--seed S] [--count N] [--kinds K] [-- extra celc run arguments]
+#   scripts/cluster_table.sh [OUTDIR] [--seed S] [--count N] [--kinds K] [--speed LO,HI] [--rate LO,HI]
+#                            [-- extra celc run arguments]
 # Defaults: OUTDIR out/cluster-table, seed 30000, 12 scenes of the kinds
 # room,hand,rect,deep. Prints one row per window, then the issue's targets:
 # event-weighted purity, impure clusters per window, edge completeness,
@@ -19,11 +20,14 @@ count=12
 kinds="room,hand,rect,deep"
 if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then out="$1"; shift; fi
 extra=()
+draw=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seed) seed="$2"; shift 2 ;;
     --count) count="$2"; shift 2 ;;
     --kinds) kinds="$2"; shift 2 ;;
+    --speed) draw+=(--speed "$2"); shift 2 ;;
+    --rate) draw+=(--rate "$2"); shift 2 ;;
     --) shift; extra=("$@"); break ;;
     *) echo "cluster_table.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
@@ -32,7 +36,7 @@ celc="${CELC_BINARY:-${CELC_BUILD_DIR:-$root/build}/celc}"
 [ -x "$celc" ] || "$root/scripts/setup.sh"
 mkdir -p "$out/scenes" "$out/run"
 /usr/bin/python3 "$root/scripts/heldout_scenes.py" "$out/scenes" --count "$count" --seed "$seed" \
-  --kinds "$kinds" > "$out/scenes.txt"
+  --kinds "$kinds" "${draw[@]}" > "$out/scenes.txt"
 for f in "$out"/scenes/*.yaml; do
   name=$(basename "$f" .yaml)
   seq="$out/scenes/$name"

@@ -11,6 +11,10 @@ and 0.05-1 rad/s for 2 s, long enough for two windows of a second. Render
 them with `celc synth FILE -o DIR`.
 
     scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect]
+                              [--speed LO,HI] [--rate LO,HI]
+
+--speed [m/s] and --rate [rad/s] replace every kind's ranges (e.g. 1,1 for
+1 m/s at every scene).
 
 Writes OUTDIR/hNN_<base>.yaml and prints one line per scene (its motion)."""
 import argparse
@@ -44,9 +48,10 @@ def set_key(text, pattern, value):
     return new
 
 
-def variant(rng, index, kind, base):
+def variant(rng, index, kind, base, speed_range=None, rate_range=None):
     text = open(os.path.join(ROOT, "config", "scenes", base + ".yaml")).read()
     speeds, rates, duration = RANGES[kind]
+    speeds, rates = speed_range or speeds, rate_range or rates
     speed, rate = rng.uniform(*speeds), rng.uniform(*rates)
     v, w = random_vector(rng, speed), random_vector(rng, rate)
     noise = rng.choice([0.1, 0.5, 1.0, 2.0])
@@ -70,7 +75,21 @@ def main():
     ap.add_argument("--seed", type=int, default=2026, help="seed of the draw (default 2026)")
     ap.add_argument("--kinds", default="room,hand,rect",
                     help="bases, taken in turn: room, hand, rect, deep (default room,hand,rect)")
+    ap.add_argument("--speed", help="speed range LO,HI [m/s] for every kind")
+    ap.add_argument("--rate", help="rotation rate range LO,HI [rad/s] for every kind")
     a = ap.parse_args()
+
+    def pair(text, name):
+        if text is None:
+            return None
+        try:
+            lo, hi = (float(x) for x in text.split(","))
+        except ValueError:
+            raise SystemExit(f"heldout_scenes.py: --{name}: expected LO,HI, got {text!r}")
+        if not (0 <= lo <= hi):
+            raise SystemExit(f"heldout_scenes.py: --{name}: need 0 <= LO <= HI, got {text!r}")
+        return (lo, hi)
+    speed_range, rate_range = pair(a.speed, "speed"), pair(a.rate, "rate")
     if a.count < 1:
         raise SystemExit("heldout_scenes.py: --count must be >= 1")
     kinds = a.kinds.split(",")
@@ -82,7 +101,7 @@ def main():
     for i in range(a.count):
         kind = kinds[i % len(kinds)]
         base = BASES[kind]
-        text, motion = variant(rng, i, kind, base)
+        text, motion = variant(rng, i, kind, base, speed_range, rate_range)
         name = f"h{i:02d}_{kind}"
         with open(os.path.join(a.outdir, name + ".yaml"), "w") as f:
             f.write(text)
