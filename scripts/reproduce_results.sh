@@ -10,6 +10,7 @@
 #   sigma       scripts/sigma_calibration.sh: sigma_calibration.md, sigma_calibration_sim.md (5 min)
 #   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
+#   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
 #   summary     the README's results table from simulation, peers and scenes: summary.md;
 #               then the tables the pages of docs/ include (<!-- include results/NAME.md -->)
@@ -27,7 +28,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax clusters studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax clusters speeds studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -87,6 +88,16 @@ PY
       scripts/cluster_table.sh "$work/clusters" > "$work/clusters.txt"
       { $tables table 1 < "$work/clusters.txt"; echo; $tables table 0 < "$work/clusters.txt"; } |
         put clusters.md clusters "scripts/cluster_table.sh"
+      ;;
+    speeds)
+      for v in 1 3; do
+        scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 \
+          > "$work/speed$v.txt"
+      done
+      { echo "At 1 m/s:"; $tables table 1 < "$work/speed1.txt"; echo; echo "At 3 m/s, the same scenes:";
+        $tables table 1 < "$work/speed3.txt"; echo; $tables table 0 < "$work/speed1.txt"; echo;
+        $tables table 0 < "$work/speed3.txt"; } |
+        put clusters_speeds.md speeds "scripts/cluster_table.sh --seed 50000 --count 8 --speed V,V --rate 0.3,3, V = 1 and 3"
       ;;
     studies)
       for s in acceleration rate_offset solve_path; do
