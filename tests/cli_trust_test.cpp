@@ -4,6 +4,8 @@
 // the exit status and the one-line message.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -167,6 +169,40 @@ TEST(CliTrust, LastPartialWindowProcessedFromHalfAWindowElseReported) {
   r = runCelc("run '" + kSample + "' -o " + q(d / "c") + kFast + "--window-events 20000 --set windows.partial_min_share=0.4", d);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(readWindowsCsv((d / "c" / "windows.csv").string()).size(), 5 * n_methods);
+  fs::remove_all(d);
+}
+
+// Events outside the sensor of a recording that states no size (text) are
+// checked against the calibration's image (calib.yaml: 346x260): a few are
+// counted and dropped, many stop the run with one line, never used silently.
+TEST(CliTrust, PixelsOutsideTheCalibratedImageAreNotUsedSilently) {
+  const fs::path d = test::freshTempDir("trust_outside");
+  auto sequenceWithOutside = [&](const fs::path& dir, int every, int limit) {
+    fs::create_directories(dir);
+    for (const char* f : {"calib.yaml", "imu.txt"})
+      fs::copy_file(kSample + "/" + f, dir / f, fs::copy_options::overwrite_existing);
+    std::ifstream in(kSample + "/events.txt");
+    std::ofstream out(dir / "events.txt");
+    std::string line;
+    int moved = 0;
+    for (int no = 1; std::getline(in, line); ++no) {
+      std::istringstream fields(line);
+      std::string t, x, y, p;
+      fields >> t >> x >> y >> p;
+      if (no % every == 0 && moved < limit) {
+        ++moved;
+        x = std::to_string(346 + no % 60000);  // outside the 346 px wide image
+      }
+      out << t << " " << x << " " << y << " " << p << "\n";
+    }
+    return dir;
+  };
+  const fs::path many = sequenceWithOutside(d / "many", 7, 1 << 30), few = sequenceWithOutside(d / "few", 1000, 10);
+  expectOneLineError(runCelc("run " + q(many) + " -o " + q(d / "o_many") + kFast + "--window-events 15000", d),
+                     {"outside the 346x260 sensor", "input.max_outside_share"});
+  const auto r = runCelc("run " + q(few) + " -o " + q(d / "o_few") + kFast + "--window-events 15000 -v", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(readAll(d / "o_few" / "summary.md").find("reader warnings"), std::string::npos);
   fs::remove_all(d);
 }
 

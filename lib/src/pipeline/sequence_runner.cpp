@@ -160,6 +160,17 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
   const int w = m.reader->width() > 0 ? m.reader->width() : 240;
   const int h = m.reader->height() > 0 ? m.reader->height() : 180;
   m.calib = loadCalibration(m.inputs.calib, w, h);
+  // A recording that states no sensor size is read against the size a YAML
+  // calibration states: pixels outside it are counted and dropped (an error
+  // beyond input.max_outside_share), as for a file that states its size,
+  // instead of used silently. (calib.txt states no size.)
+  const std::string calib_ext = fs::path(m.inputs.calib).extension().string();
+  if (m.reader->width() <= 0 && m.config.reader.width <= 0 && m.config.reader.height <= 0 &&
+      (calib_ext == ".yaml" || calib_ext == ".yml") && m.calib.camera.width > 0 && m.calib.camera.height > 0) {
+    m.config.reader.width = m.calib.camera.width;
+    m.config.reader.height = m.calib.camera.height;
+    m.reader = openEventSource(in.events, m.config.reader);
+  }
   // A calibration of another sensor maps every pixel to a wrong bearing.
   if (m.reader->width() > 0 && m.reader->height() > 0 &&
       (m.calib.camera.width != m.reader->width() || m.calib.camera.height != m.reader->height()))
