@@ -248,3 +248,30 @@ TEST(IoTextConformance, EcdSlices) {
   auto ev = readAllEvents(*r);
   EXPECT_NEAR(ev.front().t, 18.5799, 1e-4);  // README: boxes_translation starts at t = 18.5799 s
 }
+
+// CR-only line endings (classic Mac) read as one line: named as such, not
+// as an unsupported column count.
+TEST(IoText, CrOnlyLineEndingsAreNamed) {
+  TempDir d;
+  for (int lines : {3, 40}) {
+    {
+      std::ofstream f(d.file("cr.txt"), std::ios::binary);
+      for (int i = 0; i < lines; ++i) f << 0.001 * i << " " << i % 200 << " 7 " << i % 2 << "\r";
+    }
+    std::string m;
+    try {
+      auto r = openEventSource(d.file("cr.txt"));
+      readAllEvents(*r);
+    } catch (const IoError& e) {
+      m = e.what();
+    }
+    EXPECT_NE(m.find("cr.txt: line 1: line endings are CR only"), std::string::npos) << lines << " lines: " << m;
+  }
+  // CRLF files still read.
+  {
+    std::ofstream f(d.file("crlf.txt"), std::ios::binary);
+    for (int i = 0; i < 5; ++i) f << 0.001 * i << " " << i << " 7 1\r\n";
+  }
+  auto r = openEventSource(d.file("crlf.txt"));
+  EXPECT_EQ(readAllEvents(*r).size(), 5u);
+}

@@ -108,6 +108,10 @@ bool nextRecord(LineReader& lr, Layout& layout, std::size_t nfields, Classify cl
       continue;
     }
     nfound = detail::splitFields(line, fields.data(), kMaxCols);
+    // A file with CR-only line endings (classic Mac) reads as one long line.
+    if (const std::size_t cr = line.find('\r'); cr != std::string_view::npos && cr + 1 < line.size() &&
+                                                 line.find_first_not_of(" \t\r", cr) != std::string_view::npos)
+      lr.fail("line endings are CR only (\\r without \\n): convert them to \\n, e.g. tr '\\r' '\\n'");
     if (!layout.known) {
       if (nfound > kMaxCols || !byCount(nfound, layout))
         lr.fail("unsupported column count " +
