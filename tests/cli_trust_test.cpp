@@ -4,6 +4,7 @@
 // the exit status and the one-line message.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <sstream>
 
 #include <filesystem>
@@ -35,19 +36,23 @@ void expectOneLineError(const test::CliRun& r, std::initializer_list<std::string
 }
 
 // A sequence folder from the sample: its calibration and IMU, and its events
-// with a line that is not an event inserted before line `bad_line` (0: none).
-fs::path sequenceWithBadLine(const fs::path& dir, int bad_line) {
+// with each line (numbered from 1) as `edit(no, line)` returns it.
+fs::path sequenceWithEditedEvents(const fs::path& dir,
+                                  const std::function<std::string(int, const std::string&)>& edit) {
   fs::create_directories(dir);
   for (const char* f : {"calib.yaml", "imu.txt"})
     fs::copy_file(kSample + "/" + f, dir / f, fs::copy_options::overwrite_existing);
   std::ifstream in(kSample + "/events.txt");
   std::ofstream out(dir / "events.txt");
   std::string line;
-  for (int no = 1; std::getline(in, line); ++no) {
-    if (no == bad_line) out << "not an event\n";
-    out << line << "\n";
-  }
+  for (int no = 1; std::getline(in, line); ++no) out << edit(no, line) << "\n";
   return dir;
+}
+
+// ... with a line that is not an event inserted before line `bad_line` (0: none).
+fs::path sequenceWithBadLine(const fs::path& dir, int bad_line) {
+  return sequenceWithEditedEvents(
+      dir, [&](int no, const std::string& line) { return no == bad_line ? "not an event\n" + line : line; });
 }
 }  // namespace
 
@@ -178,24 +183,15 @@ TEST(CliTrust, LastPartialWindowProcessedFromHalfAWindowElseReported) {
 TEST(CliTrust, PixelsOutsideTheCalibratedImageAreNotUsedSilently) {
   const fs::path d = test::freshTempDir("trust_outside");
   auto sequenceWithOutside = [&](const fs::path& dir, int every, int limit) {
-    fs::create_directories(dir);
-    for (const char* f : {"calib.yaml", "imu.txt"})
-      fs::copy_file(kSample + "/" + f, dir / f, fs::copy_options::overwrite_existing);
-    std::ifstream in(kSample + "/events.txt");
-    std::ofstream out(dir / "events.txt");
-    std::string line;
     int moved = 0;
-    for (int no = 1; std::getline(in, line); ++no) {
+    return sequenceWithEditedEvents(dir, [&](int no, const std::string& line) {
+      if (no % every != 0 || moved >= limit) return line;
+      ++moved;
       std::istringstream fields(line);
       std::string t, x, y, p;
       fields >> t >> x >> y >> p;
-      if (no % every == 0 && moved < limit) {
-        ++moved;
-        x = std::to_string(346 + no % 60000);  // outside the 346 px wide image
-      }
-      out << t << " " << x << " " << y << " " << p << "\n";
-    }
-    return dir;
+      return t + " " + std::to_string(346 + no % 60000) + " " + y + " " + p;  // outside the 346 px wide image
+    });
   };
   const fs::path many = sequenceWithOutside(d / "many", 7, 1 << 30), few = sequenceWithOutside(d / "few", 1000, 10);
   expectOneLineError(runCelc("run " + q(many) + " -o " + q(d / "o_many") + kFast + "--window-events 15000", d),
