@@ -64,6 +64,7 @@ std::string ClusterOptions::validate() const {
   if (!(max_plane_rms_px > 0.0)) err << "max_plane_rms_px must be > 0; ";
   if (!(ransac_threshold_px > 0.0)) err << "ransac_threshold_px must be > 0; ";
   if (max_split < 1 || max_split > 64) err << "max_split must be in [1, 64]; ";
+  if (!(line_split_px >= 0.0 && line_split_px <= 50.0)) err << "line_split_px must be in [0, 50]; ";
   if (!(min_time_span_s >= 0.0)) err << "min_time_span_s must be >= 0; ";
   if (!(min_extent_px >= 0.0)) err << "min_extent_px must be >= 0; ";
   if (!(min_density_per_px2 >= 0.0)) err << "min_density_per_px2 must be >= 0; ";

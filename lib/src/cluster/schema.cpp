@@ -34,6 +34,10 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
   v.field({"max_plane_rms_px", "px", "max RMS distance to the cluster's plane"}, o.max_plane_rms_px);
   v.field({"ransac_threshold_px", "px", "inlier distance when splitting a region"}, o.ransac_threshold_px);
   v.field({"max_split", "", "planes extracted from one region at most"}, o.max_split);
+  v.field({"line_split_px", "px",
+           "cut each cluster to the events one moving line explains within this distance (sequential RANSAC); "
+           "0 = not cut"},
+          o.line_split_px);
   v.field({"min_time_span_s", "s", "shortest cluster duration"}, o.min_time_span_s);
   v.field({"min_extent_px", "px", "smallest spatial extent"}, o.min_extent_px);
   v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane"}, o.min_density_per_px2);

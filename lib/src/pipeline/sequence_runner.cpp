@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "celc/cluster/line_split.hpp"
 #include "celc/core/parallel.hpp"
 #include "celc/eval/metrics.hpp"
 #include "celc/geometry/undistort.hpp"
@@ -299,7 +300,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // Clustering in pixel space-time.
   start = Clock::now();
-  const ClusterResult clusters = clusterEvents(events, cfg.cluster);
+  ClusterResult clusters = clusterEvents(events, cfg.cluster);
+  splitByMovingLines(events, clusters, [&](const Vec2& p) { return m.bearing(p); }, m.calib.camera.focal(), &motion,
+                     cfg.cluster);
   rec.times.cluster = secondsSince(start);
   if (m.dump) {
     const GyroWindow gw = cfg.omega_source == OmegaSource::Gyro && !m.gyro.empty() ? m.gyro.window(t0, t1)
@@ -338,9 +341,12 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // The parallax policy grew the window as far as it could (to
   // windows.max_seconds, or to the end of the data) and its lines still show
   // too little translation: no method is asked for a direction. D is the
-  // probe's that chose the length, or the whole window's where the probe
-  // could not measure it.
-  const double shown_px = probe_px && std::isfinite(*probe_px) ? *probe_px : rec.translation_px;
+  // whole window's (all its events clustered), or the probe's that chose the
+  // length where the whole window's could not be measured: a probe clusters
+  // a sparse subset, whose fragments show less of the lines' motion.
+  const double shown_px = std::isfinite(rec.translation_px) ? rec.translation_px
+                          : probe_px                         ? *probe_px
+                                                             : NAN;
   if (probe_px && std::isfinite(shown_px) && shown_px < cfg.parallax.no_parallax_px) {
     for (MethodRow& row : rec.rows) {
       row.result.status = SolveStatus::Degenerate;

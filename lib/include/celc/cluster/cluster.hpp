@@ -84,7 +84,11 @@ struct ClusterOptions {
   // Checks after growing.
   double max_plane_rms_px = 1.5;   ///< max RMS distance to the cluster's plane [px]
   double ransac_threshold_px = 1.5;  ///< inlier distance when splitting [px]
-  int max_split = 4;               ///< at most this many planes extracted from one region
+  int max_split = 4;               ///< at most this many planes (or moving lines) extracted from one region
+  /// A cluster is cut to the events that one moving line explains within this
+  /// distance [px], by sequential RANSAC (line_split.hpp; needs the camera and
+  /// the rotation, so `celc run` does it after clusterEvents); 0 = not cut.
+  double line_split_px = 2.0;
   double min_time_span_s = 0.0005; ///< minimum duration of a cluster [s]
   double min_extent_px = 5.0;      ///< minimum spatial extent of a cluster [px]
   /// Minimum density on the cluster's plane [events/px^2], area = 12 sqrt(l1 l2) from the

@@ -1,0 +1,44 @@
+#pragma once
+/// \file line_split.hpp
+/// Clusters cut to the events that one moving line explains.
+///
+/// Region growing joins what is locally smooth in (x, y, c t); where two
+/// edges meet (a corner, a junction) a region can grow from one edge's
+/// surface onto the other's. Under the window's rotation R(t) and a constant
+/// velocity, an edge's events satisfy n(t)^T R(t) f = 0 with a plane normal
+/// linear in time,
+///   n(t) = a + s(t) b,   s = (t - t_mid) / (t_end - t_begin),   |a| = 1,
+/// (the plane through the centre c(t) and the 3D line (P, d) has normal
+/// (P - c(t)) x d), so one cluster should be one such moving line. Each
+/// cluster is split by sequential RANSAC over moving lines: the line that
+/// explains the most events within `line_split_px` (pixel distance in the
+/// image of the camera at the event's time) becomes a cluster, then the next
+/// one among the rest, up to ClusterOptions::max_split; parts with fewer than
+/// min_cluster_size events, and the events no line explains, become noise.
+#include <vector>
+
+#include "celc/cluster/cluster.hpp"
+#include "celc/cluster/to_observations.hpp"
+#include "celc/geometry/motion_model.hpp"
+
+namespace celc {
+
+/// What splitByMovingLines did to a window's clusters.
+struct LineSplitReport {
+  int n_split = 0;         ///< clusters cut into two or more moving lines
+  int n_removed = 0;       ///< events taken out of clusters (no moving line within line_split_px)
+  int n_dropped = 0;       ///< clusters left with fewer than min_cluster_size events explained
+};
+
+/// Cuts every cluster of `clusters` to its moving lines (see the file
+/// comment); new parts get ids after the existing ones and clusters are
+/// renumbered in order of their first event, as clusterEvents does. `bearing`
+/// and `focal_px` as in toObservations; `motion` gives R(t) (null: no
+/// rotation). Does nothing when options.line_split_px is 0 or the status is
+/// not Ok; a window whose clusters all vanish gets status NoClusters.
+/// Deterministic for a given options.seed. Never throws on data.
+LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResult& clusters,
+                                   const BearingFunction& bearing, double focal_px, const MotionModel* motion,
+                                   const ClusterOptions& options);
+
+}  // namespace celc

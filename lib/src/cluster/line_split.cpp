@@ -1,0 +1,286 @@
+// Clusters cut to the events that one moving line explains (line_split.hpp).
+#include "celc/cluster/line_split.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "celc/core/parallel.hpp"
+
+namespace celc {
+
+namespace {
+
+constexpr int kMinIterations = 60;    // RANSAC hypotheses per part, at least
+constexpr int kMaxIterations = 400;   // ... and at most (a 5-event sample all on a line with
+                                      // half the events: 99% in 145)
+constexpr std::size_t kScored = 320;  // events a hypothesis is scored on, at most
+constexpr int kSample = 5;            // a moving line linear in time has 5 degrees of freedom
+constexpr double kLooseFactor = 1.5;  // hypotheses (linear in time) are scored at this times the threshold
+constexpr double kRefineFactors[] = {3.0, 2.0, 1.5, 1.0, 1.0};  // the local optimisation's thresholds
+constexpr double kShadowFactor = 3.0;  // a part within this times the threshold of an earlier one is its residuals' tail
+
+/// One event in the motion model's reference frame: g = R(t) f with
+/// f = (x, y, 1), z = R(t) e_z (the optical axis at t), t its time [s].
+struct LinePoint {
+  Vec3 g, z;
+  double t = 0.0;
+};
+
+/// n(s) = a + s b + s^2 c: linear in time for a camera translating at a
+/// constant velocity in the reference frame; the quadratic term takes the
+/// curvature of the path when the camera turns with a constant body-frame
+/// velocity (or accelerates), a few pixels over the longest windows.
+struct Line {
+  Vec3 a = Vec3::UnitZ(), b = Vec3::Zero(), c = Vec3::Zero();
+  double t_mid = 0.0, span = 1.0;  ///< s = (t - t_mid) / span [s]
+  double s(const LinePoint& p) const { return (p.t - t_mid) / span; }
+  /// Distance of the point to the line in the image of the camera at its time
+  /// [normalised units]: |m^T f| / |(m_x, m_y)| with m = R^T n, i.e.
+  /// |n^T g| / sqrt(|n|^2 - (n^T z)^2).
+  double distance(const LinePoint& p) const {
+    const double sp = s(p);
+    const Vec3 n = a + sp * (b + sp * c);
+    const double den2 = n.squaredNorm() - std::pow(n.dot(p.z), 2);
+    if (!(den2 > 1e-18)) return std::numeric_limits<double>::infinity();
+    return std::abs(n.dot(p.g)) / std::sqrt(den2);
+  }
+};
+
+/// Least squares over the points `idx` of sum w_i (n(s_i)^T g_i)^2 with |a| = 1:
+/// the time terms B = (b, c) eliminated, B = -M_BB^-1 M_Ba a, and a the
+/// eigenvector of the Schur complement's smallest eigenvalue. `quadratic`
+/// false keeps c = 0 (5 unknowns: the minimal samples). Weights w_i = 1 /
+/// |(m_x, m_y)|^2 of `prior` turn the algebraic residual into the pixel
+/// distance (prior null: unit weights).
+bool fitLine(const std::vector<LinePoint>& pts, const std::vector<std::size_t>& idx, const Line* prior,
+             bool quadratic, Line& out) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Mat36 = Eigen::Matrix<double, 3, 6>;
+  Mat3 maa = Mat3::Zero();
+  Mat36 mab = Mat36::Zero();
+  Mat6 mbb = Mat6::Zero();
+  double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;
+  for (std::size_t i : idx) t_lo = std::min(t_lo, pts[i].t), t_hi = std::max(t_hi, pts[i].t);
+  out.t_mid = 0.5 * (t_lo + t_hi);
+  out.span = std::max(t_hi - t_lo, 1e-9);
+  for (std::size_t i : idx) {
+    const LinePoint& p = pts[i];
+    double w = 1.0;
+    if (prior) {
+      const double sp = prior->s(p);
+      const Vec3 n = prior->a + sp * (prior->b + sp * prior->c);
+      const double den2 = n.squaredNorm() - std::pow(n.dot(p.z), 2);
+      if (!(den2 > 1e-18)) continue;
+      w = 1.0 / den2;
+    }
+    const double sp = out.s(p);
+    Eigen::Matrix<double, 6, 1> time_terms;
+    time_terms << sp * p.g, sp * sp * p.g;
+    maa += w * p.g * p.g.transpose();
+    mab += w * p.g * time_terms.transpose();
+    mbb += w * time_terms * time_terms.transpose();
+  }
+  const int nb = quadratic ? 6 : 3;
+  const Eigen::MatrixXd m_bb = mbb.topLeftCorner(nb, nb);
+  const Eigen::MatrixXd m_ab = mab.leftCols(nb);
+  const double ridge = 1e-12 * std::max(m_bb.trace(), 1e-300);
+  const Eigen::LDLT<Eigen::MatrixXd> solve_b(m_bb + ridge * Eigen::MatrixXd::Identity(nb, nb));
+  const Eigen::MatrixXd k = solve_b.solve(m_ab.transpose());  // B = -k a
+  const Mat3 schur = maa - m_ab * k;
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (schur + schur.transpose()));
+  if (es.info() != Eigen::Success) return false;
+  out.a = es.eigenvectors().col(0);
+  const Eigen::VectorXd time_part = -k * out.a;
+  out.b = time_part.head<3>();
+  out.c = quadratic ? Vec3(time_part.tail<3>()) : Vec3::Zero();
+  return out.a.allFinite() && out.b.allFinite() && out.c.allFinite();
+}
+
+/// The indices of `candidates` within `threshold` of the line.
+std::vector<std::size_t> inliersOf(const std::vector<LinePoint>& pts, const std::vector<std::size_t>& candidates,
+                                   const Line& line, double threshold) {
+  std::vector<std::size_t> in;
+  for (std::size_t i : candidates)
+    if (line.distance(pts[i]) <= threshold) in.push_back(i);
+  return in;
+}
+
+/// Median distance of the points `idx` to the line [normalised units].
+double medianDistance(const std::vector<LinePoint>& pts, const std::vector<std::size_t>& idx, const Line& line) {
+  std::vector<double> d;
+  d.reserve(idx.size());
+  for (std::size_t i : idx) d.push_back(line.distance(pts[i]));
+  if (d.empty()) return std::numeric_limits<double>::infinity();
+  auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid;
+}
+
+/// Parts of a cluster: each a list of indices into its points, and its line.
+struct Parts {
+  std::vector<std::vector<std::size_t>> members;
+  std::vector<Line> lines;
+};
+
+/// Sequential RANSAC over moving lines on one cluster's points (sorted by
+/// time); what is in no part is noise.
+Parts splitCluster(const std::vector<LinePoint>& pts, double threshold, int min_size, int max_parts,
+                   std::mt19937& rng) {
+  Parts result;
+  auto& parts = result.members;
+  auto& lines = result.lines;
+  std::vector<std::size_t> rest(pts.size());
+  std::iota(rest.begin(), rest.end(), std::size_t{0});
+  while (static_cast<int>(parts.size()) < max_parts && static_cast<int>(rest.size()) >= min_size &&
+         rest.size() >= 2 * kSample) {
+    const std::size_t n = rest.size();
+    std::vector<std::size_t> scored;
+    const std::size_t stride = std::max<std::size_t>(1, n / kScored);
+    for (std::size_t k = 0; k < n; k += stride) scored.push_back(rest[k]);
+    Line best;
+    std::size_t best_count = 0;
+    std::vector<std::size_t> sample(kSample);
+    int iterations = kMaxIterations;
+    for (int it = 0; it < iterations; ++it) {
+      for (int q = 0; q < kSample; ++q) {  // one event from each fifth of the time order
+        std::uniform_int_distribution<std::size_t> pick(q * n / kSample, (q + 1) * n / kSample - 1);
+        sample[q] = rest[pick(rng)];
+      }
+      Line line;
+      if (!fitLine(pts, sample, nullptr, false, line)) continue;
+      std::size_t count = 0;
+      for (std::size_t i : scored) count += line.distance(pts[i]) <= kLooseFactor * threshold ? 1 : 0;
+      if (count > best_count) {
+        best_count = count, best = line;
+        // Enough hypotheses that one sample of 5 inliers was drawn with 99%.
+        const double w = static_cast<double>(count) / static_cast<double>(scored.size());
+        const double p_clean = std::pow(w, kSample);
+        iterations = p_clean >= 1.0 ? kMinIterations
+                                    : std::clamp(static_cast<int>(std::ceil(std::log(0.01) / std::log1p(-p_clean))),
+                                                 kMinIterations, kMaxIterations);
+      }
+    }
+    if (best_count == 0) break;
+    // Local optimisation: the quadratic line fitted to the inliers of the
+    // current line at a threshold that shrinks to the final one (a minimal
+    // sample's line can be a few pixels off at the ends of the window).
+    for (double factor : kRefineFactors) {
+      const std::vector<std::size_t> near = inliersOf(pts, rest, best, factor * threshold);
+      Line fitted;
+      if (near.size() < 3 * kSample || !fitLine(pts, near, &best, true, fitted)) break;
+      best = fitted;
+    }
+    std::vector<std::size_t> in = inliersOf(pts, rest, best, threshold);
+    if (static_cast<int>(in.size()) < min_size) break;
+    std::vector<std::size_t> left;
+    left.reserve(n - in.size());
+    std::set_difference(rest.begin(), rest.end(), in.begin(), in.end(), std::back_inserter(left));
+    rest.swap(left);
+    // The tails of an earlier line's residuals, on both its sides, fit a line
+    // parallel to it just beyond the threshold: such a shadow is noise.
+    const bool shadow = std::any_of(lines.begin(), lines.end(), [&](const Line& earlier) {
+      return medianDistance(pts, in, earlier) < kShadowFactor * threshold;
+    });
+    if (shadow) continue;
+    parts.push_back(std::move(in));
+    lines.push_back(best);
+  }
+  return result;
+}
+
+
+/// A part of a cluster after the split: its events (input indices).
+struct Part {
+  ClusterStats stats;
+  std::vector<int> events;
+};
+
+}  // namespace
+
+LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResult& clusters,
+                                   const BearingFunction& bearing, double focal_px, const MotionModel* motion,
+                                   const ClusterOptions& options) {
+  LineSplitReport report;
+  if (!(options.line_split_px > 0.0) || clusters.status != ClusterStatus::Ok || !bearing || !(focal_px > 0.0) ||
+      clusters.labels.size() != events.size())
+    return report;
+  const std::size_t k = clusters.clusters.size();
+  std::vector<std::vector<int>> members(k);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const int l = clusters.labels[i];
+    if (l >= 0 && static_cast<std::size_t>(l) < k) members[static_cast<std::size_t>(l)].push_back(static_cast<int>(i));
+  }
+  const double threshold = options.line_split_px / focal_px;
+  // Per cluster: its parts.
+  std::vector<std::vector<Part>> parts_of(k);
+  std::vector<int> removed(k, 0);
+  parallelFor(k, options.threads, [&](std::size_t c) {
+    std::vector<int>& idx = members[c];
+    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return events[a].t < events[b].t; });
+    std::vector<LinePoint> pts;
+    std::vector<int> source;
+    pts.reserve(idx.size());
+    for (int i : idx) {
+      const Event& e = events[i];
+      const Vec3 f = bearing(Vec2(e.x, e.y));
+      if (!f.allFinite() || !(std::abs(f.z()) > 0.0)) continue;
+      const Mat3 r = motion ? motion->rotation(e.t) : Mat3::Identity();
+      pts.push_back({r * (f / f.z()), r.col(2), e.t});
+      source.push_back(i);
+    }
+    std::mt19937 rng(options.seed + static_cast<unsigned>(c));
+    const Parts parts = splitCluster(pts, threshold, options.min_cluster_size, options.max_split, rng);
+    std::size_t kept = 0;
+    for (std::size_t q = 0; q < parts.members.size(); ++q) {
+      const auto& member = parts.members[q];
+      Part part{clusters.clusters[c], {}};
+      part.events.reserve(member.size());
+      for (std::size_t j : member) part.events.push_back(source[j]);
+      kept += member.size();
+      parts_of[c].push_back(std::move(part));
+    }
+    removed[c] = static_cast<int>(idx.size() - kept);
+  });
+  std::vector<Part> all;
+  for (std::size_t c = 0; c < k; ++c) {
+    report.n_removed += removed[c];
+    if (parts_of[c].empty()) ++report.n_dropped;
+    if (parts_of[c].size() > 1) ++report.n_split;
+    for (Part& p : parts_of[c]) all.push_back(std::move(p));
+  }
+  // New clusters: each part keeps its cluster's plane statistics.
+  for (Part& p : all) {
+    double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;
+    std::size_t n_on = 0;
+    for (int i : p.events) {
+      t_lo = std::min(t_lo, events[i].t), t_hi = std::max(t_hi, events[i].t);
+      n_on += events[i].on ? 1 : 0;
+    }
+    p.stats.size = static_cast<int>(p.events.size());
+    p.stats.t_begin = t_lo;
+    p.stats.t_end = t_hi;
+    p.stats.on = 2 * n_on >= p.events.size();
+  }
+  std::stable_sort(all.begin(), all.end(),
+                   [](const Part& a, const Part& b) { return a.stats.t_begin < b.stats.t_begin; });
+  std::fill(clusters.labels.begin(), clusters.labels.end(), -1);
+  clusters.clusters.clear();
+  clusters.n_clustered = 0;
+  for (Part& p : all) {
+    p.stats.id = static_cast<int>(clusters.clusters.size());
+    for (int i : p.events) clusters.labels[static_cast<std::size_t>(i)] = p.stats.id;
+    clusters.n_clustered += p.stats.size;
+    clusters.clusters.push_back(p.stats);
+  }
+  if (clusters.clusters.empty()) {
+    clusters.status = ClusterStatus::NoClusters;
+    clusters.message = "no cluster holds a moving line (cluster.line_split_px)";
+  }
+  return report;
+}
+
+}  // namespace celc

@@ -1,0 +1,128 @@
+// Clusters cut to their moving lines (celc::splitByMovingLines) on labelled
+// synthetic windows: two lines in one cluster come apart, noise leaves, a
+// cluster of one line keeps its events.
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "celc/cluster/line_split.hpp"
+#include "celc/cluster/synthetic.hpp"
+
+namespace celc {
+namespace {
+
+LabelledWindow window(unsigned seed) {
+  LabelledWindowOptions o;
+  o.seed = seed;
+  o.omega_rad_per_s = 1.0;  // the rotation must be removed for a line to be one moving line
+  return generateLabelledWindow(o);
+}
+
+struct SplitScore {
+  int lines = 0, recovered = 0;     // >= 80% of the line's events in one cluster of purity >= 0.95
+  int noise = 0, noise_kept = 0;    // noise events, and those still in a cluster
+  int line_events = 0, line_kept = 0;
+};
+
+SplitScore score(const LabelledWindow& w, const ClusterResult& r) {
+  SplitScore s;
+  s.lines = w.n_lines();
+  std::vector<int> cluster_size(r.clusters.size(), 0), line_size(w.n_lines(), 0);
+  std::map<std::pair<int, int>, int> joint;
+  for (std::size_t i = 0; i < w.events.size(); ++i) {
+    const int c = r.labels[i], l = w.labels[i];
+    if (c >= 0) ++cluster_size[c];
+    if (l < 0) {
+      ++s.noise;
+      s.noise_kept += c >= 0 ? 1 : 0;
+      continue;
+    }
+    ++line_size[l], ++s.line_events;
+    if (c >= 0) ++joint[{l, c}], ++s.line_kept;
+  }
+  for (int l = 0; l < w.n_lines(); ++l) {
+    bool ok = false;
+    for (const auto& [key, n] : joint)
+      ok = ok || (key.first == l && n >= 0.8 * line_size[l] && n >= 0.95 * cluster_size[key.second]);
+    s.recovered += ok ? 1 : 0;
+  }
+  return s;
+}
+
+LineSplitReport split(const LabelledWindow& w, ClusterResult& r, double line_split_px = ClusterOptions{}.line_split_px) {
+  ClusterOptions options;
+  options.line_split_px = line_split_px;
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  return splitByMovingLines(w.events, r, [&](const Vec2& p) { return w.camera.bearing(p); }, w.camera.focal(),
+                            &motion, options);
+}
+
+// Pairs of true lines given as one cluster, the noise events spread over
+// them: a pair's cluster holds at most half its events from one line, so no
+// line is recovered (>= 80% of its events in one cluster of purity >= 0.95)
+// before the split. After it, at least 75% of the lines are (26 of 32
+// measured): the rest lose to the other line of their pair the events near
+// where the two cross in the image (10-12% of a line in these draws), which
+// no geometry can give back. At most 10% of the noise stays (noise within
+// 2 px of a line's surface is indistinguishable from it).
+TEST(LineSplit, TwoLinesInOneClusterComeApartAndNoiseLeaves) {
+  int lines = 0, recovered = 0, noise = 0, noise_kept = 0;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    const LabelledWindow w = window(seed);
+    std::vector<int> paired(w.events.size());
+    for (std::size_t i = 0; i < w.events.size(); ++i)
+      paired[i] = w.labels[i] < 0 ? static_cast<int>(i % 4) : w.labels[i] / 2;
+    ClusterResult r = clustersFromLabels(w.events, paired);
+    EXPECT_EQ(score(w, r).recovered, 0);
+    const LineSplitReport rep = split(w, r);
+    ASSERT_EQ(r.status, ClusterStatus::Ok);
+    EXPECT_GE(rep.n_split, w.n_lines() / 2 - 1) << "seed " << seed;
+    const SplitScore s = score(w, r);
+    lines += s.lines, recovered += s.recovered, noise += s.noise, noise_kept += s.noise_kept;
+  }
+  EXPECT_GE(recovered, 0.75 * lines) << recovered << " of " << lines;
+  EXPECT_LE(noise_kept, 0.1 * noise) << noise_kept << " of " << noise;
+}
+
+// The true clusters are one moving line each: at least 97% of their events stay.
+TEST(LineSplit, OneLinePerClusterKeepsItsEvents) {
+  const LabelledWindow w = window(7);
+  std::vector<int> labels = w.labels;
+  ClusterResult r = clustersFromLabels(w.events, labels);
+  const LineSplitReport rep = split(w, r);
+  EXPECT_EQ(rep.n_split, 0);
+  EXPECT_EQ(static_cast<int>(r.clusters.size()), w.n_lines());
+  const SplitScore s = score(w, r);
+  EXPECT_EQ(s.recovered, w.n_lines());
+  EXPECT_GE(s.line_kept, 0.97 * s.line_events);
+}
+
+TEST(LineSplit, OffLeavesTheClustersAndIsDeterministic) {
+  const LabelledWindow w = window(3);
+  std::vector<int> paired(w.events.size());
+  for (std::size_t i = 0; i < w.events.size(); ++i) paired[i] = w.labels[i] < 0 ? -1 : w.labels[i] / 2;
+  ClusterResult off = clustersFromLabels(w.events, paired);
+  const std::vector<int> before = off.labels;
+  split(w, off, 0.0);
+  EXPECT_EQ(off.labels, before);
+  ClusterResult a = clustersFromLabels(w.events, paired), b = a;
+  split(w, a);
+  split(w, b);
+  EXPECT_EQ(a.labels, b.labels);
+  for (std::size_t k = 0; k < a.clusters.size(); ++k) EXPECT_EQ(a.clusters[k].id, static_cast<int>(k));
+}
+
+// Clusters of a handful of events: nothing to split, no crash; all gone -> NoClusters.
+TEST(LineSplit, TinyClustersBecomeNoise) {
+  const LabelledWindow w = window(2);
+  std::vector<int> labels(w.events.size(), -1);
+  for (std::size_t i = 0; i < 40; ++i) labels[i] = static_cast<int>(i % 4);  // 10 events each, < min_cluster_size
+  ClusterResult r = clustersFromLabels(w.events, labels);
+  const LineSplitReport rep = split(w, r);
+  EXPECT_EQ(rep.n_dropped, 4);
+  EXPECT_EQ(r.status, ClusterStatus::NoClusters);
+  EXPECT_TRUE(r.clusters.empty());
+}
+
+}  // namespace
+}  // namespace celc
