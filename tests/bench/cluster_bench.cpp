@@ -22,6 +22,7 @@
 #include <new>
 
 #include "celc/cluster/cluster.hpp"
+#include "celc/cluster/line_split.hpp"
 #include "celc/cluster/synthetic.hpp"
 
 namespace {
@@ -91,7 +92,7 @@ double recoveredShare(const celc::LabelledWindow& w, const celc::ClusterResult& 
   return w.n_lines() ? static_cast<double>(rec) / w.n_lines() : 0.0;
 }
 
-void runCluster(benchmark::State& state, celc::ClusterMethod method) {
+void runCluster(benchmark::State& state, celc::ClusterMethod method, bool line_split = false) {
   const celc::LabelledWindow& w = window(static_cast<int>(state.range(0)));
   celc::ClusterOptions opt;
   opt.method = method;
@@ -109,6 +110,11 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method) {
     const long long before = g_current.load();
     g_peak.store(before);
     r = celc::clusterEvents(w.events, opt);
+    if (line_split) {
+      const celc::MotionModel motion = celc::MotionModel::constantTwist(w.omega, 0.0);
+      celc::splitByMovingLines(w.events, r, [&](const celc::Vec2& p) { return w.camera.bearing(p); },
+                               w.camera.focal(), &motion, opt);
+    }
     peak_extra = std::max(peak_extra, g_peak.load() - before);
     benchmark::DoNotOptimize(r.labels.data());
     cpu_ms += cpuNow() - cpu0;
@@ -134,8 +140,11 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method) {
 
 void BM_ClusterGrid(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Grid); }
 void BM_ClusterPcl(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Pcl); }
+/// The grid grower, then each cluster cut to its moving lines (line_split.hpp), as `celc run` clusters.
+void BM_ClusterGridLineSplit(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Grid, true); }
 
 }  // namespace
 
 BENCHMARK(BM_ClusterGrid)->Arg(1000000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_ClusterGridLineSplit)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_ClusterPcl)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);

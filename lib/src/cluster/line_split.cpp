@@ -18,6 +18,8 @@ constexpr int kMinIterations = 60;    // RANSAC hypotheses per part, at least
 constexpr int kMaxIterations = 400;   // ... and at most (a 5-event sample all on a line with
                                       // half the events: 99% in 145)
 constexpr std::size_t kScored = 320;  // events a hypothesis is scored on, at most
+constexpr std::size_t kRefined = 4000;  // events the local optimisation fits, at most
+constexpr double kRotationStep = 5e-5;  // [s] events this close in time share one R(t) (3 rad/s: 0.03 px at f = 200 px)
 constexpr int kSample = 5;            // a moving line linear in time has 5 degrees of freedom
 constexpr double kLooseFactor = 1.5;  // hypotheses (linear in time) are scored at this times the threshold
 constexpr double kRefineFactors[] = {3.0, 2.0, 1.5, 1.0, 1.0};  // the local optimisation's thresholds
@@ -168,8 +170,11 @@ Parts splitCluster(const std::vector<LinePoint>& pts, double threshold, int min_
     // Local optimisation: the quadratic line fitted to the inliers of the
     // current line at a threshold that shrinks to the final one (a minimal
     // sample's line can be a few pixels off at the ends of the window).
+    std::vector<std::size_t> refined;  // the local optimisation's points
+    const std::size_t refine_stride = std::max<std::size_t>(1, n / kRefined);
+    for (std::size_t k = 0; k < n; k += refine_stride) refined.push_back(rest[k]);
     for (double factor : kRefineFactors) {
-      const std::vector<std::size_t> near = inliersOf(pts, rest, best, factor * threshold);
+      const std::vector<std::size_t> near = inliersOf(pts, refined, best, factor * threshold);
       Line fitted;
       if (near.size() < 3 * kSample || !fitLine(pts, near, &best, true, fitted)) break;
       best = fitted;
@@ -220,15 +225,18 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
   std::vector<int> removed(k, 0);
   parallelFor(k, options.threads, [&](std::size_t c) {
     std::vector<int>& idx = members[c];
-    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return events[a].t < events[b].t; });
+    auto earlier = [&](int a, int b) { return events[a].t < events[b].t; };
+    if (!std::is_sorted(idx.begin(), idx.end(), earlier)) std::stable_sort(idx.begin(), idx.end(), earlier);
     std::vector<LinePoint> pts;
     std::vector<int> source;
     pts.reserve(idx.size());
+    Mat3 r = Mat3::Identity();  // R(r_time); the events are in time order
+    double r_time = std::numeric_limits<double>::quiet_NaN();
     for (int i : idx) {
       const Event& e = events[i];
       const Vec3 f = bearing(Vec2(e.x, e.y));
       if (!f.allFinite() || !(std::abs(f.z()) > 0.0)) continue;
-      const Mat3 r = motion ? motion->rotation(e.t) : Mat3::Identity();
+      if (motion && !(std::abs(e.t - r_time) <= kRotationStep)) r = motion->rotation(e.t), r_time = e.t;
       pts.push_back({r * (f / f.z()), r.col(2), e.t});
       source.push_back(i);
     }
