@@ -812,3 +812,24 @@ TEST(IoRobustness, Aedat4SevenDigitSensorSizeIsRefusedLikeAnyHugeSize) {
   writeBytes(d.file("c.aedat4"), b);
   EXPECT_EQ(openEventSource(d.file("c.aedat4"))->width(), 240);
 }
+
+TEST(IoRobustness, HeldEventsNeverMakeABatchLargerThanItsMax) {
+  // A held first event, an outlier, a gap and the end of the stream: every
+  // batch size gives the same events, none more than its max.
+  TempDir d;
+  writeBytes(d.file("e.txt"), "100.0 1 1 1\n50.0 1 1 1\n100.001 1 1 1\n100.002 1 1 1\n500.0 1 1 1\n"
+                              "100.003 1 1 1\n200.0 1 1 1\n200.001 1 1 1\n900.0 1 1 1\n");
+  auto whole = openEventSource(d.file("e.txt"));
+  const auto all = readAllEvents(*whole);
+  ASSERT_EQ(all.size(), 7u);  // 50.0 and 500.0 dropped; the gap to 200 and the jump to 900 at the end kept
+  for (std::size_t max : {1u, 2u, 3u}) {
+    auto r = openEventSource(d.file("e.txt"));
+    std::vector<Event> got, b;
+    while (r->next(b, max)) {
+      ASSERT_LE(b.size(), max);
+      got.insert(got.end(), b.begin(), b.end());
+    }
+    ASSERT_EQ(got.size(), all.size()) << max;
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].t, all[i].t) << max << " " << i;
+  }
+}

@@ -161,8 +161,7 @@ class Aedat2Reader final : public EventReader {
   Format format() const override { return Format::Aedat2; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     batch.reserve(std::min<std::size_t>(max, std::size_t(1) << 20));
     decode(&batch, max, nullptr);
     if (batch.size() < max) release(batch, max);

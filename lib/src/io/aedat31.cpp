@@ -61,8 +61,7 @@ class Aedat31Reader final : public EventReader {
   Format format() const override { return Format::Aedat31; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     decode(&batch, max, nullptr);
     if (batch.size() < max) release(batch, max);
     return !batch.empty();

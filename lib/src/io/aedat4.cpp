@@ -160,8 +160,7 @@ class Aedat4Reader final : public EventReader {
   Format format() const override { return Format::Aedat4; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == count_ && !nextPacket(true, nullptr)) break;
       drain(batch, max);

@@ -150,11 +150,26 @@ void EventReader::outsideSensor(const std::string& where, double x, double y) {
   }
 }
 
+std::size_t EventReader::startBatch(std::vector<Event>& batch, std::size_t max) {
+  batch.clear();
+  if (max == 0) max = 1;
+  batch_max_ = max;
+  const std::size_t k = std::min(max, ready_.size());
+  batch.assign(ready_.begin(), ready_.begin() + std::ptrdiff_t(k));
+  ready_.erase(ready_.begin(), ready_.begin() + std::ptrdiff_t(k));
+  return max;
+}
+
 void EventReader::accept(std::vector<Event>& out, const Event& e) {
   prev_t_ = e.t;
   have_prev_ = true;
+  // A held event passed on with the one that releases it may be one more than the batch takes.
+  auto emit = [&](const Event& x) {
+    if (out.size() < batch_max_) out.push_back(x);
+    else ready_.push_back(x);
+  };
   if (options_.backwards != BackwardsPolicy::Sort) {
-    out.push_back(e);
+    emit(e);
     return;
   }
   reorder_.push(e);
@@ -170,7 +185,7 @@ void EventReader::accept(std::vector<Event>& out, const Event& e) {
     }
     emitted_any_ = true;
     last_emitted_ = first.t;
-    out.push_back(first);
+    emit(first);
   }
 }
 

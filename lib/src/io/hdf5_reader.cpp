@@ -153,8 +153,7 @@ class Hdf5Reader final : public EventReader {
   Format format() const override { return Format::Hdf5; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == have_) {
         if (!refill()) break;

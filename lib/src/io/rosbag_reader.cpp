@@ -379,8 +379,7 @@ class RosBagReader final : public EventReader {
   Format format() const override { return Format::RosBag; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == count_) {
         if (!nextMessage()) break;

@@ -193,7 +193,7 @@ class EventReader {
   template <class Where>
   void admit(std::vector<Event>& out, const Event& e, Where&& where) {
     ++admitted_;
-    if (have_prev_ && !holding_ && reorder_.empty() && e.t >= prev_t_ &&
+    if (have_prev_ && !holding_ && reorder_.empty() && out.size() < batch_max_ && e.t >= prev_t_ &&
         e.t - prev_t_ <= options_.max_time_jump) {
       prev_t_ = e.t;
       out.push_back(e);
@@ -204,6 +204,10 @@ class EventReader {
   /// At the end of the stream: moves held events into `out` (at most up to
   /// `max` events in `out`). Readers call it when a batch comes out short.
   void release(std::vector<Event>& out, std::size_t max);
+  /// Every next() starts with it: clears `batch`, puts in it the events that
+  /// a held event released beyond the previous batch's `max`, and returns max
+  /// (at least 1). A batch therefore never holds more than `max` events.
+  std::size_t startBatch(std::vector<Event>& batch, std::size_t max);
 
   std::string path_;
   int width_ = 0, height_ = 0;
@@ -232,6 +236,8 @@ class EventReader {
   std::string held_where_;
   std::uint64_t admitted_ = 0;  ///< events offered to admit() (for the outside share)
   std::priority_queue<Event, std::vector<Event>, Later> reorder_;
+  std::size_t batch_max_ = std::size_t(-1);  ///< the current batch's max (startBatch)
+  std::vector<Event> ready_;                  ///< passed events beyond batch_max_, for the next batch
   bool emitted_any_ = false;
   double last_emitted_ = 0.0;  ///< sort mode: time of the last event released from the buffer
 };
