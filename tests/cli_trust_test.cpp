@@ -233,7 +233,7 @@ TEST(CliTrust, PathsInErrorsAreEscaped) {
   const fs::path d = test::freshTempDir("trust_escape");
   const fs::path bad = d / "e\x1b[31mred\x07.txt";
   { std::ofstream(bad) << std::string("\x01\x02binary", 8); }
-  for (const std::string& cmd : {"info " + q(bad), "run " + q(bad) + " --calib " + q(kSample + "/calib.yaml") + kFast,
+  for (const std::string& cmd : {"info " + q(bad), "run " + q(bad) + " --calib " + q(kSample + "/calib.yaml") + " -o " + q(d / "o") + kFast,
                                  "info " + q(d / "missing\x1b[0m")}) {
     const auto r = runCelc(cmd, d);
     EXPECT_NE(r.status, 0) << cmd;
