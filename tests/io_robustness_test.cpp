@@ -801,9 +801,9 @@ TEST(IoRobustness, Aedat4SevenDigitSensorSizeIsRefusedLikeAnyHugeSize) {
   TempDir d;
   const auto ev = celc::test::randomEvents(100, 240, 180, 2);
   writeAedat4(d.file("a.aedat4"), ev, {}, 1234567, 180, Aedat4Compression::None, 50, true);
-  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14", "1234567x180", "at most 4096x4096");
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14: stream 0 declares a 1234567x180 sensor (at most 4096x4096)");
   writeAedat4(d.file("b.aedat4"), ev, {}, 30000, 180, Aedat4Compression::None, 50, true);
-  EXPECT_IO_ERROR(openEventSource(d.file("b.aedat4")), "a sensor", "30000x180", "at most 4096x4096");
+  EXPECT_IO_ERROR(openEventSource(d.file("b.aedat4")), "b.aedat4: byte 14: stream 0 declares a 30000x180 sensor (at most 4096x4096)");
   // the digits are the value: leading zeros do not make a size unknown
   std::string b = readBytes(d.file("b.aedat4"));
   const std::size_t at = b.find(">30000<");
