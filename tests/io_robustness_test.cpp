@@ -608,7 +608,7 @@ TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
                        "    while q < p + 4 + hl:\n"
                        "        n = struct.unpack_from('<I', data, q)[0]; k = bytes(data[q + 4:q + 4 + n]).split(b'=')[0]\n"
                        "        f[k] = q + 4 + len(k) + 1; q += 4 + n\n"
-                       "    recs.append((p, data[f[b'op']], f)); p = q + 4 + struct.unpack_from('<I', data, q)[0]\n"
+                       "    recs.append((p, data[f[b'op']], f, q + 4)); p = q + 4 + struct.unpack_from('<I', data, q)[0]\n"
                        "chunks = [i for i, r in enumerate(recs) if r[1] == 5]\n"
                        "assert len(chunks) >= 3\n"
                        "ix = recs[chunks[1] + 1]; assert ix[1] == 4\n"
@@ -618,12 +618,15 @@ TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
                        "info = [r for r in recs if r[1] == 6][0]\n"
                        "c = bytearray(data); struct.pack_into('<I', c, info[2][b'count'], 0x7FFFFFFF)\n"
                        "open(out + '.ci', 'wb').write(c)\n"
-                       "open(out + '.at', 'w').write('%d %d %d' % (ix[0], conn, info[0]))\n"))
+                       "q = recs[chunks[0]][3] + 4 + struct.unpack_from('<I', data, recs[chunks[0]][3])[0] + 4\n"
+                       "at_msg = data.index(b'conn=', q) + 5\n"
+                       "c = bytearray(data); struct.pack_into('<I', c, at_msg, 7); open(out + '.msg', 'wb').write(c)\n"
+                       "open(out + '.at', 'w').write('%d %d %d %d' % (ix[0], conn, info[0], recs[chunks[0]][0]))\n"))
     GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
   EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
   std::istringstream at(readBytes(bag + ".at"));
-  std::uint64_t index_at = 0, conn = 0, info_at = 0;
-  ASSERT_TRUE(at >> index_at >> conn >> info_at);
+  std::uint64_t index_at = 0, conn = 0, info_at = 0, chunk_at = 0;
+  ASSERT_TRUE(at >> index_at >> conn >> info_at >> chunk_at);
   const std::string other = std::to_string(1 - conn);
   // the first entry of the index data record: its data follows the header
   EXPECT_IO_ERROR(celc::test::drain(bag + ".mis"), "c.bag.mis: byte ",
@@ -633,7 +636,10 @@ TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
                   "index data record of connection 7, which no connection record of the index declares");
   EXPECT_IO_ERROR(celc::test::drain(bag + ".ci"), "c.bag.ci: byte " + std::to_string(info_at),
                   "chunk info record of 2147483647 connection counts (8 bytes each) in 16 bytes of data");
-  for (const char* ext : {".mis", ".unk", ".ci"}) {
+  // a message record inside the first chunk naming connection 7
+  EXPECT_IO_ERROR(celc::test::drain(bag + ".msg"), "c.bag.msg: byte " + std::to_string(chunk_at) + ": chunk record at offset ",
+                  "message data record of connection 7, which no connection record of the index declares");
+  for (const char* ext : {".mis", ".unk", ".ci", ".msg"}) {
     try {
       celc::test::drain(bag + ext);
     } catch (const IoError& e) {
