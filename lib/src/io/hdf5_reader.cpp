@@ -5,7 +5,7 @@
 //    /t_offset), /events/p (0/1), /t_offset (int64 [us], 0 when absent),
 //    /ms_to_idx (index of the first event of each millisecond; used to seek);
 //  - MVSEC: /davis/left/events (N x 4 float64: x [px], y [px], t [s], p in
-//    {-1, 1}), /davis/left/imu (N x 6: accel [m/s^2] then gyro [rad/s], or
+//    {-1, 1}; 0 is read as OFF), /davis/left/imu (N x 6: accel [m/s^2] then gyro [rad/s], or
 //    gyro first with input.imu_columns: gyro_first) with /davis/left/imu_ts
 //    [s], /davis/left/pose (N x 4 x 4 T_world_body [m]) with /davis/left/pose_ts [s].
 // Events are read in hyperslabs of kBlockEvents: a window never loads the file.
