@@ -78,7 +78,8 @@ rm -rf "$seeds"
 # small sequence has, so it stops there: the HDF5 seeds come from celc_fuzz_seeds)
 /usr/bin/python3 "$root/tests/fixtures/make_fixtures.py" "$seeds/bag_sequence" "$seeds/bag_fixtures" \
   >"$seeds/make_fixtures.log" 2>&1 || true
-for b in seq_none seq_bz2 seq_lz4 seq_odom bad_truncated bad_unindexed bad_type; do
+for b in seq_none seq_bz2 seq_lz4 seq_odom bad_truncated bad_unindexed bad_type bad_conn_swapped bad_conn_unknown \
+         bad_chunk_info_count; do
   [ -f "$seeds/bag_fixtures/$b.bag" ] || { cat "$seeds/make_fixtures.log" >&2; echo "fuzz: no $b.bag" >&2; exit 1; }
   cp "$seeds/bag_fixtures/$b.bag" "$seeds/rosbag/seed_$b"
 done

@@ -202,6 +202,48 @@ TEST(CliTrust, PixelsOutsideTheCalibratedImageAreNotUsedSilently) {
   fs::remove_all(d);
 }
 
+TEST(CliTrust, CalibTxtWithoutASizeIsNotTakenForTheSensorSilently) {
+  // The 346x260 sample with only its calib.txt, which states no image size:
+  // the 240x180 it assumes is said, and events beyond it are an error naming the options.
+  const fs::path d = test::freshTempDir("trust_calibtxt");
+  const fs::path seq = d / "seq";
+  fs::create_directories(seq);
+  for (const char* f : {"events.txt", "imu.txt", "calib.txt"}) fs::copy_file(kSample + "/" + f, seq / f);
+  auto r = runCelc("run " + q(seq) + " -o " + q(d / "o") + kFast + "--window-events 15000", d);
+  EXPECT_NE(r.status, 0) << r.out;
+  EXPECT_NE(r.err.find("neither it nor"), std::string::npos) << r.err;  // the warning, before the run
+  const std::size_t error = r.err.find("celc: error: ");
+  ASSERT_NE(error, std::string::npos) << r.err;
+  const std::string line = r.err.substr(error);
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << r.err;
+  for (const char* f : {"events.txt: line", "outside the 240x180 sensor", "input.width / input.height"})
+    EXPECT_NE(line.find(f), std::string::npos) << "'" << f << "' not in " << line;
+  r = runCelc("run " + q(seq) + " -o " + q(d / "o2") + kFast +
+                  "--window-events 15000 --set input.width=346 --set input.height=260",
+              d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("neither it nor"), std::string::npos) << r.err;
+  const std::string summary = readAll(d / "o2" / "summary.md");
+  EXPECT_NE(summary.find("calib.txt (346x260"), std::string::npos) << summary;
+  fs::remove_all(d);
+}
+
+TEST(CliTrust, PathsInErrorsAreEscaped) {
+  // A file name holding an ANSI escape: the message quotes it as \x1B, never raw.
+  const fs::path d = test::freshTempDir("trust_escape");
+  const fs::path bad = d / "e\x1b[31mred\x07.txt";
+  { std::ofstream(bad) << std::string("\x01\x02binary", 8); }
+  for (const std::string& cmd : {"info " + q(bad), "run " + q(bad) + " --calib " + q(kSample + "/calib.yaml") + " -o " + q(d / "o") + kFast,
+                                 "info " + q(d / "missing\x1b[0m")}) {
+    const auto r = runCelc(cmd, d);
+    EXPECT_NE(r.status, 0) << cmd;
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_EQ(r.err.find('\x07'), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find("\\x1B["), std::string::npos) << cmd << ": " << r.err;
+  }
+  fs::remove_all(d);
+}
+
 // ---- resume that checks ----
 
 TEST(CliTrust, ResumeRefusesAnotherConfigurationAndKeepsRows) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -17,6 +18,7 @@
 #include "celc/pipeline/batch.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/render_sequence.hpp"
+#include "io/ros_messages.hpp"
 #include "io_test_util.hpp"
 
 using namespace celc;
@@ -96,14 +98,25 @@ TEST(IoRobustness, Aedat31TimestampOffsetInt32MaxIsAnErrorNotOverflow) {
   putLE32(b, data + 8, 0x7FFFFFFF);  // eventTSOffset: tsoff + 4 overflowed int before
   writeBytes(d.file("o.aedat31"), b);
   EXPECT_IO_ERROR(celc::test::drain(d.file("o.aedat31")), "byte " + std::to_string(data), "invalid packet header");
-  // the largest overflow counter is representable: 2^31-1 << 31 fits in int64
+  // The largest overflow counter fits in int64 but puts the times near 4.6e12 s,
+  // where a double in seconds resolves about 1 ms: an error naming the packet.
   b = readBytes(d.file("a.aedat31"));
   putLE32(b, data + 12, 0x7FFFFFFF);
   writeBytes(d.file("v.aedat31"), b);
-  auto r = openEventSource(d.file("v.aedat31"));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("v.aedat31")), "v.aedat31: byte " + std::to_string(data),
+                  "eventTSOverflow 2147483647", "beyond 2^33 s");
+  // Just below 2^33 s (overflow 3,999,999) every microsecond still has its own double.
+  b = readBytes(d.file("a.aedat31"));
+  putLE32(b, data + 12, 3999999);
+  writeBytes(d.file("w.aedat31"), b);
+  auto r = openEventSource(d.file("w.aedat31"));
   const auto ev = readAllEvents(*r);
   ASSERT_EQ(ev.size(), 50u);
-  EXPECT_GT(ev.front().t, 4.6e12);
+  EXPECT_GT(ev.front().t, 8.589e9);
+  EXPECT_LE(std::nextafter(ev.front().t, 1e300) - ev.front().t, 1e-6);
+  putLE32(b, data + 12, 4000000);
+  writeBytes(d.file("w.aedat31"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("w.aedat31")), "eventTSOverflow 4000000");
 }
 
 // ---- sizes from headers bounded before allocation -------------------------------
@@ -365,7 +378,7 @@ TEST(IoRobustness, ForwardJumpOutlierDroppedGapKeptBothReported) {
   ReaderOptions tight;
   tight.max_time_jump = 100.0;  // the bound is the schema option input.max_time_jump
   auto r2 = openEventSource(d.file("o.txt"), tight);
-  EXPECT_IO_ERROR(readAllEvents(*r2), "line 4", "before the previous event");
+  EXPECT_IO_ERROR(readAllEvents(*r2), "line 4", "before the latest event so far");
   writeBytes(d.file("g.txt"), "1.0 1 2 1\n1.1 1 2 1\n99.0 1 2 1\n99.1 1 2 1\n");
   auto r3 = openEventSource(d.file("g.txt"));
   EXPECT_EQ(readAllEvents(*r3).size(), 4u);
@@ -567,4 +580,262 @@ TEST(IoRobustness, Bag12RecordHeaderLongerThanTheFileIsAnError) {
   writeBytes(d.file("o.bag"), b);
   EXPECT_IO_ERROR(celc::test::drain(d.file("o.bag")), "o.bag: byte 13: record: record header length 1397751808",
                   "beyond the end of the file");
+}
+
+// ---- a bag's index against its messages ------------------------------------------
+
+TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
+  // A bag of two std_msgs/String topics in several chunks (python3-rosbag),
+  // then three copies: the connection id of the first index data record after
+  // the second chunk swapped for the other topic's (the library decoded those
+  // messages as the other topic's type) or for an id no connection declares
+  // (the messages vanished), and a chunk info's count made 0x7FFFFFFF (the
+  // library's "wanted 4 bytes").
+  TempDir d;
+  const std::string bag = d.file("c.bag");
+  if (!writeWithPython(d, bag,
+                       "import sys, struct, genpy, genpy.dynamic, rosbag\n"
+                       "S = genpy.dynamic.generate_dynamic('std_msgs/String', 'string data\\n')['std_msgs/String']\n"
+                       "out = sys.argv[1]\n"
+                       "with rosbag.Bag(out, 'w', chunk_threshold=300) as b:\n"
+                       "    for i in range(12):\n"
+                       "        m = S(); m.data = 'x' * 64\n"
+                       "        b.write('/a', m, genpy.Time(1 + i, 0)); b.write('/b', m, genpy.Time(1 + i, 5))\n"
+                       "data = bytearray(open(out, 'rb').read())\n"
+                       "recs, p = [], 13\n"
+                       "while p < len(data):\n"
+                       "    hl = struct.unpack_from('<I', data, p)[0]; q, f = p + 4, {}\n"
+                       "    while q < p + 4 + hl:\n"
+                       "        n = struct.unpack_from('<I', data, q)[0]; k = bytes(data[q + 4:q + 4 + n]).split(b'=')[0]\n"
+                       "        f[k] = q + 4 + len(k) + 1; q += 4 + n\n"
+                       "    recs.append((p, data[f[b'op']], f, q + 4)); p = q + 4 + struct.unpack_from('<I', data, q)[0]\n"
+                       "chunks = [i for i, r in enumerate(recs) if r[1] == 5]\n"
+                       "assert len(chunks) >= 3\n"
+                       "ix = recs[chunks[1] + 1]; assert ix[1] == 4\n"
+                       "at = ix[2][b'conn']; conn = struct.unpack_from('<I', data, at)[0]\n"
+                       "for name, value in (('mis', 1 - conn), ('unk', 7)):\n"
+                       "    c = bytearray(data); struct.pack_into('<I', c, at, value); open(out + '.' + name, 'wb').write(c)\n"
+                       "info = [r for r in recs if r[1] == 6][0]\n"
+                       "c = bytearray(data); struct.pack_into('<I', c, info[2][b'count'], 0x7FFFFFFF)\n"
+                       "open(out + '.ci', 'wb').write(c)\n"
+                       "q = recs[chunks[0]][3] + 4 + struct.unpack_from('<I', data, recs[chunks[0]][3])[0] + 4\n"
+                       "at_msg = data.index(b'conn=', q) + 5\n"
+                       "c = bytearray(data); struct.pack_into('<I', c, at_msg, 7); open(out + '.msg', 'wb').write(c)\n"
+                       "open(out + '.at', 'w').write('%d %d %d %d' % (ix[0], conn, info[0], recs[chunks[0]][0]))\n"))
+    GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
+  EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
+  std::istringstream at(readBytes(bag + ".at"));
+  std::uint64_t index_at = 0, conn = 0, info_at = 0, chunk_at = 0;
+  ASSERT_TRUE(at >> index_at >> conn >> info_at >> chunk_at);
+  const std::string other = std::to_string(1 - conn);
+  // the first entry of the index data record: its data follows the header
+  EXPECT_IO_ERROR(celc::test::drain(bag + ".mis"), "c.bag.mis: byte ",
+                  "index data record of connection " + other + " points at a message record of connection " +
+                      std::to_string(conn));
+  EXPECT_IO_ERROR(celc::test::drain(bag + ".unk"), "c.bag.unk: byte " + std::to_string(index_at),
+                  "index data record of connection 7, which no connection record of the index declares");
+  EXPECT_IO_ERROR(celc::test::drain(bag + ".ci"), "c.bag.ci: byte " + std::to_string(info_at),
+                  "chunk info record of 2147483647 connection counts (8 bytes each) in 16 bytes of data");
+  // a message record inside the first chunk naming connection 7
+  EXPECT_IO_ERROR(celc::test::drain(bag + ".msg"), "c.bag.msg: byte " + std::to_string(chunk_at) + ": chunk record at offset ",
+                  "message data record of connection 7, which no connection record of the index declares");
+  for (const char* ext : {".mis", ".unk", ".ci", ".msg"}) {
+    try {
+      celc::test::drain(bag + ext);
+    } catch (const IoError& e) {
+      expectPrintable(e.what());
+    }
+  }
+}
+
+TEST(IoRobustness, BagImuValuesBeyondAnyImuAreAnErrorNotARate) {
+  // sensor_msgs/Imu: header (seq, stamp, empty frame_id: 16 bytes), orientation
+  // and its covariance (104), angular_velocity at byte 120, its covariance,
+  // linear_acceleration at byte 216, its covariance: 312 bytes.
+  std::vector<unsigned char> m(312, 0);
+  auto put = [&](std::size_t at, double v) { std::memcpy(&m[at], &v, 8); };
+  put(120, 0.5);
+  put(216 + 16, 9.81);
+  const ImuSample s = detail::decodeImu(m.data(), m.size());
+  EXPECT_EQ(s.gyro.x(), 0.5);
+  EXPECT_EQ(s.accel.z(), 9.81);
+  auto offsetOf = [&]() -> std::size_t {
+    try {
+      detail::decodeImu(m.data(), m.size());
+    } catch (const detail::RosDecodeError& e) {
+      EXPECT_NE(std::string(e.what()).find("not an IMU sample"), std::string::npos) << e.what();
+      return e.offset;
+    }
+    ADD_FAILURE() << "no error";
+    return 0;
+  };
+  put(120, -1.4e302);  // what an EventArray read as an Imu gave
+  EXPECT_EQ(offsetOf(), 120u);
+  put(120, 1001.0);  // beyond kMaxImuGyro
+  EXPECT_EQ(offsetOf(), 120u);
+  put(120, 999.0);
+  EXPECT_NO_THROW(detail::decodeImu(m.data(), m.size()));
+  put(216, std::nan(""));
+  EXPECT_EQ(offsetOf(), 216u);
+  put(216, 2e4);  // beyond kMaxImuAccel
+  EXPECT_EQ(offsetOf(), 216u);
+}
+
+// ---- a corrupt first timestamp; backwards steps that add up ----------------------
+
+TEST(IoRobustness, CorruptFirstTimestampIsAnOutlierNotTheReference) {
+  TempDir d;
+  std::string text = "10000000 5 5 1\n";
+  for (int i = 0; i < 2000; ++i) text += std::to_string(1.0 + i * 1e-3) + " " + std::to_string(i % 240) + " 7 1\n";
+  writeBytes(d.file("e.txt"), text);
+  for (BackwardsPolicy policy : {BackwardsPolicy::Error, BackwardsPolicy::Drop, BackwardsPolicy::Sort}) {
+    ReaderOptions o;
+    o.backwards = policy;
+    auto r = openEventSource(d.file("e.txt"), o);
+    const auto ev = readAllEvents(*r);
+    ASSERT_EQ(ev.size(), 2000u) << toString(policy);  // the bogus first event dropped, every good one kept
+    EXPECT_DOUBLE_EQ(ev.front().t, 1.0);
+    EXPECT_EQ(r->warnings().time_outliers, 1u);
+    EXPECT_EQ(r->warnings().backwards_time, 0u);
+    ASSERT_FALSE(r->warnings().messages.empty());
+    EXPECT_NE(r->warnings().messages[0].find("e.txt: line 1: timestamp 1e+07 s of the first event"),
+              std::string::npos) << r->warnings().messages[0];
+  }
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), strictOptions()), "line 1", "first event", "outlier");
+  // The second event far back, the third near the first: the second is the outlier.
+  writeBytes(d.file("s.txt"), "100.0 1 1 1\n50.0 1 1 1\n100.001 1 1 1\n100.002 1 1 1\n");
+  auto s = openEventSource(d.file("s.txt"));
+  const auto sv = readAllEvents(*s);
+  ASSERT_EQ(sv.size(), 3u);
+  EXPECT_DOUBLE_EQ(sv[0].t, 100.0);
+  EXPECT_EQ(s->warnings().time_outliers, 1u);
+  EXPECT_NE(s->warnings().messages.at(0).find("line 2"), std::string::npos) << s->warnings().messages.at(0);
+  // AEDAT 2.0 whose first timestamp word is 0xFFFFFFFF: not taken for a wrap-around of the good ones.
+  const auto ev = celc::test::randomEvents(3000, 240, 180, 5, 1.0);
+  writeAedat2(d.file("a.aedat"), ev, {});
+  std::string b = readBytes(d.file("a.aedat"));
+  const std::size_t data = b.size() - 8 * ev.size();
+  putBE32(b, data + 4, 0xFFFFFFFFu);
+  writeBytes(d.file("f.aedat"), b);
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto a = openEventSource(d.file("f.aedat"), drop);
+  const auto got = readAllEvents(*a);
+  ASSERT_EQ(got.size(), ev.size() - 1);
+  EXPECT_EQ(got.front().t, ev[1].t);
+  EXPECT_EQ(got.back().t, ev.back().t);  // nothing shifted by 2^32 us
+  EXPECT_EQ(a->warnings().time_outliers, 1u);
+  EXPECT_EQ(a->warnings().backwards_dropped, 0u);
+  EXPECT_NE(a->warnings().messages.at(0).find("byte " + std::to_string(data)), std::string::npos)
+      << a->warnings().messages.at(0);
+}
+
+TEST(IoRobustness, BackwardsToleranceIsCumulativeNotPerStep) {
+  // 0.9 ms back per event for 9 s: every step is within the 1 ms tolerance, the walk is not.
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 10000; ++i) {
+    char line[64];
+    std::snprintf(line, sizeof line, "%.6f 1 2 1\n", 10.0 - i * 0.9e-3);
+    text += line;
+  }
+  writeBytes(d.file("w.txt"), text);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("w.txt")), "w.txt: line 3", "0.0018 s before the latest event so far",
+                  "input.backwards_tolerance");
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto r = openEventSource(d.file("w.txt"), drop);
+  EXPECT_EQ(readAllEvents(*r).size(), 2u);
+  EXPECT_EQ(r->warnings().backwards_dropped, 9998u);
+  // Jitter within the tolerance around a rising time is kept, as before.
+  writeBytes(d.file("j.txt"), "1.0000 1 1 1\n1.0010 1 1 1\n1.0005 1 1 1\n1.0008 1 1 1\n1.0020 1 1 1\n");
+  auto j = openEventSource(d.file("j.txt"));
+  EXPECT_EQ(readAllEvents(*j).size(), 5u);
+  EXPECT_EQ(j->warnings().backwards_time, 2u);
+}
+
+// ---- HDF5: dataset types and values checked as stored ----------------------------
+
+TEST(IoRobustness, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
+  TempDir d;
+  auto dsec = [&](const std::string& name, const std::string& x, const std::string& y, const std::string& t,
+                  const std::string& p) {
+    return writeWithH5py(d, d.file(name),
+                         "    n = 6\n"
+                         "    f['events/x'] = " + x + "\n    f['events/y'] = " + y + "\n    f['events/t'] = " + t +
+                             "\n    f['events/p'] = " + p + "\n");
+  };
+  const std::string x = "np.arange(6, dtype=np.uint16)", y = "np.arange(6, dtype=np.int32)",
+                    t = "np.arange(6, dtype=np.int64) * 10", p = "np.array([0, 1, 1, 0, 1, 0], np.uint8)";
+  if (!dsec("ok.h5", x, y, t, p)) GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  {
+    auto r = openEventSource(d.file("ok.h5"));
+    const auto ev = readAllEvents(*r);
+    ASSERT_EQ(ev.size(), 6u);
+    EXPECT_EQ(ev[5].y, 5.0f);
+    EXPECT_DOUBLE_EQ(ev[5].t, 50e-6);
+    EXPECT_TRUE(ev[1].on);
+    EXPECT_FALSE(ev[3].on);
+  }
+  ASSERT_TRUE(dsec("tf.h5", x, y, "np.arange(6) * 0.01", p));  // float64 seconds
+  EXPECT_IO_ERROR(openEventSource(d.file("tf.h5")), "tf.h5: dataset /events/t: type float64, expected integers",
+                  "microseconds as integers");
+  ASSERT_TRUE(dsec("yn.h5", x, "np.array([0, 1, 2, -5, 4, 5], np.int32)", t, p));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("yn.h5")), "yn.h5: dataset /events/y: row 3: value -5 outside [0, 65535]");
+  ASSERT_TRUE(dsec("yb.h5", x, "np.array([0, 1, 70000, 3, 4, 5], np.int32)", t, p));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("yb.h5")), "yb.h5: dataset /events/y: row 2: value 70000 outside");
+  ASSERT_TRUE(dsec("pf.h5", x, y, t, "np.array([0, 0.9, 1, 0, 1, 0], np.float32)"));
+  EXPECT_IO_ERROR(openEventSource(d.file("pf.h5")), "pf.h5: dataset /events/p: type float32, expected integers");
+  ASSERT_TRUE(dsec("p7.h5", x, y, t, "np.array([0, 1, 7, 0, 1, 0], np.uint8)"));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("p7.h5")), "p7.h5: dataset /events/p: row 2: polarity 7 (expected 0 or 1)");
+  ASSERT_TRUE(dsec("xs.h5", "np.array(['1', '2', '3', '4', '5', '6'], dtype=h5py.string_dtype())", y, t, p));
+  EXPECT_IO_ERROR(openEventSource(d.file("xs.h5")),
+                  "xs.h5: dataset /events/x: type variable-length string, expected integers");
+  // MVSEC: N x 4 numbers, polarity -1 / 1 (0 read as OFF); 0.9 is not a polarity.
+  ASSERT_TRUE(writeWithH5py(d, d.file("mp.h5"),
+                            "    ev = np.zeros((5, 4)); ev[:, 2] = 1.0 + np.arange(5) * 1e-3; ev[:, 3] = 1.0\n"
+                            "    ev[3, 3] = 0.9\n"
+                            "    f['davis/left/events'] = ev\n"));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("mp.h5")), "mp.h5: dataset /davis/left/events, event 3: polarity 0.9");
+  ASSERT_TRUE(writeWithH5py(d, d.file("ms.h5"), "    f['davis/left/events'] = np.array([b'a', b'b'])\n"));
+  EXPECT_IO_ERROR(openEventSource(d.file("ms.h5")), "ms.h5: dataset /davis/left/events: type string of 1 bytes");
+}
+
+// ---- AEDAT 4.0: a size of any number of digits is bounded ------------------------
+
+TEST(IoRobustness, Aedat4SevenDigitSensorSizeIsRefusedLikeAnyHugeSize) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(100, 240, 180, 2);
+  writeAedat4(d.file("a.aedat4"), ev, {}, 1234567, 180, Aedat4Compression::None, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14: stream 0 declares a 1234567x180 sensor (at most 4096x4096)");
+  writeAedat4(d.file("b.aedat4"), ev, {}, 30000, 180, Aedat4Compression::None, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("b.aedat4")), "b.aedat4: byte 14: stream 0 declares a 30000x180 sensor (at most 4096x4096)");
+  // the digits are the value: leading zeros do not make a size unknown
+  std::string b = readBytes(d.file("b.aedat4"));
+  const std::size_t at = b.find(">30000<");
+  ASSERT_NE(at, std::string::npos);
+  b.replace(at + 1, 5, "00240");
+  writeBytes(d.file("c.aedat4"), b);
+  EXPECT_EQ(openEventSource(d.file("c.aedat4"))->width(), 240);
+}
+
+TEST(IoRobustness, HeldEventsNeverMakeABatchLargerThanItsMax) {
+  // A held first event, an outlier, a gap and the end of the stream: every
+  // batch size gives the same events, none more than its max.
+  TempDir d;
+  writeBytes(d.file("e.txt"), "100.0 1 1 1\n50.0 1 1 1\n100.001 1 1 1\n100.002 1 1 1\n500.0 1 1 1\n"
+                              "100.003 1 1 1\n200.0 1 1 1\n200.001 1 1 1\n900.0 1 1 1\n");
+  auto whole = openEventSource(d.file("e.txt"));
+  const auto all = readAllEvents(*whole);
+  ASSERT_EQ(all.size(), 7u);  // 50.0 and 500.0 dropped; the gap to 200 and the jump to 900 at the end kept
+  for (std::size_t max : {1u, 2u, 3u}) {
+    auto r = openEventSource(d.file("e.txt"));
+    std::vector<Event> got, b;
+    while (r->next(b, max)) {
+      ASSERT_LE(b.size(), max);
+      got.insert(got.end(), b.begin(), b.end());
+    }
+    ASSERT_EQ(got.size(), all.size()) << max;
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].t, all[i].t) << max << " " << i;
+  }
 }

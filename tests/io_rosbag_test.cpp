@@ -151,6 +151,30 @@ TEST(IoRosbag, BadBagsGiveOneLineErrors) {
   EXPECT_NE(m.find("topic /dvs/events: unknown message type std_msgs/String"), std::string::npos) << m;
 }
 
+// The index decides which topic a message is read as: an index data record
+// whose connection is not its messages' (EventArray messages that would decode
+// as IMU samples of 1e302 rad/s), or is declared nowhere (messages that would
+// vanish), and a chunk info count beyond its data are errors with the byte.
+TEST(IoRosbag, IndexConnectionsAndCountsAreCheckedAgainstTheData) {
+  CELC_REQUIRE_IO_FIXTURES();
+  for (const char* name : {"bad_conn_swapped.bag", "bad_conn_unknown.bag", "bad_chunk_info_count.bag"}) {
+    SCOPED_TRACE(name);
+    const std::string m = ioErrorOf([&] { openEventSource(fixture(name)); });
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_NE(m.find(std::string(name) + ": byte "), std::string::npos) << m;
+    EXPECT_NE(m.find("rosbag reindex"), std::string::npos) << m;
+  }
+  EXPECT_NE(ioErrorOf([] { openEventSource(fixture("bad_conn_swapped.bag")); })
+                .find("points at a message record of connection"),
+            std::string::npos);
+  EXPECT_NE(ioErrorOf([] { openEventSource(fixture("bad_conn_unknown.bag")); })
+                .find("index data record of connection 99, which no connection record of the index declares"),
+            std::string::npos);
+  EXPECT_NE(ioErrorOf([] { openEventSource(fixture("bad_chunk_info_count.bag")); })
+                .find("chunk info record of 2147483647 connection counts"),
+            std::string::npos);
+}
+
 // Damaged bytes anywhere (compressed and uncompressed chunks, record headers,
 // the index): an IoError or a clean read, never a crash, a hang or a huge allocation.
 TEST(IoRosbag, DamagedBytesNeverCrash) {

@@ -180,7 +180,7 @@ TEST(IoTextBad, BadPolarityHeaderAndQuaternion) {
 TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   TempDir d;
   celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.3 1 2 1\n0.2 1 2 1\n0.4 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), "line 3", "before the previous event");  // beyond 1 ms
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), "line 3", "before the latest event so far");  // beyond 1 ms
   ReaderOptions tolerant;
   tolerant.backwards_tolerance = 0.5;
   auto r = openEventSource(d.file("e.txt"), tolerant);
@@ -190,7 +190,7 @@ TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   EXPECT_NE(r->warnings().messages[0].find("line 3"), std::string::npos);
   ReaderOptions strict = tolerant;
   strict.strict = true;
-  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), strict), "line 3", "before the previous event");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), strict), "line 3", "before the latest event so far");
 }
 
 TEST(IoTextBad, PixelsOutsideSensorDropped) {

@@ -115,7 +115,7 @@ void registerInfo(CLI::App& app) {
   cmd->add_option("--topic-pose", args->topic_pose,
                   "ROS bag pose topic (default: the geometry_msgs/PoseStamped or nav_msgs/Odometry topic)");
   cmd->add_option("--backwards", args->backwards,
-                  "timestamps more than input.backwards_tolerance before the previous event: error | drop | sort")
+                  "timestamps more than input.backwards_tolerance before the latest earlier one: error | drop | sort")
       ->check(CLI::IsMember({"error", "drop", "sort"}))
       ->capture_default_str();
   cmd->add_option("--max-time-jump", args->max_time_jump,

@@ -3,13 +3,34 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <exception>
 #include <iostream>
+#include <sstream>
+#include <string>
 
 #include "celc/core/memory.hpp"
+#include "celc/io/event_reader.hpp"
 #include "commands.hpp"
 
 namespace celc::app {
+namespace {
+/// `text` with every line made printable ASCII (control bytes and bytes >=
+/// 0x7F as \xNN, as the readers quote file contents): a file name holding an
+/// escape sequence never reaches the terminal raw. Line breaks are kept.
+std::string printableLines(const std::string& text) {
+  std::string out;
+  std::size_t p = 0;
+  while (p < text.size()) {
+    const std::size_t e = std::min(text.find('\n', p), text.size());
+    out += celc::detail::printable(text.substr(p, e - p), e - p);
+    if (e < text.size()) out += '\n';
+    p = e + 1;
+  }
+  return out;
+}
+}  // namespace
+
 void configureLogging(bool quiet, bool verbose) {
   spdlog::set_level(quiet ? spdlog::level::warn
                           : (verbose ? spdlog::level::debug : spdlog::level::info));
@@ -56,13 +77,17 @@ int main(int argc, char** argv) {
         is_known = is_known || sub->get_name() == argv[1];
       }
       if (!is_known) {
-        std::cerr << "celc: error: unknown subcommand '" << argv[1] << "' (the subcommands: " << known << ")\n";
+        std::cerr << "celc: error: unknown subcommand '" << celc::app::printableLines(argv[1])
+                  << "' (the subcommands: " << known << ")\n";
         return 2;
       }
     }
-    return app.exit(e);
+    std::ostringstream err;  // CLI11's messages quote the arguments (a path): escaped like every message
+    const int status = app.exit(e, std::cout, err);
+    std::cerr << celc::app::printableLines(err.str());
+    return status;
   } catch (const std::exception& e) {
-    std::cerr << "celc: error: " << e.what() << "\n";
+    std::cerr << "celc: error: " << celc::app::printableLines(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <random>
 
 #include "celc/core/yaml.hpp"
@@ -126,6 +127,47 @@ void writeMvsec(const fs::path& path, const std::vector<Event>& ev, const std::v
   H5Fclose(f);
 }
 
+/// DSEC files whose datasets hold other types or values than the layout's
+/// (int32 y of -5 and 70000, float64 seconds t, float p, p = 7, a
+/// variable-length string x): the reader must name the dataset and row.
+void writeDsecOddTypes(const fs::path& dir) {
+  const std::uint16_t x[6] = {0, 1, 2, 3, 4, 5};
+  const std::int32_t y[6] = {0, 1, 2, -5, 4, 70000};
+  const std::int64_t t[6] = {0, 10, 20, 30, 40, 50};
+  const double t_s[6] = {0.0, 1e-5, 2e-5, 3e-5, 4e-5, 5e-5};
+  const std::uint8_t p[6] = {0, 1, 1, 0, 1, 0}, p7[6] = {0, 1, 7, 0, 1, 0};
+  const float p_f[6] = {0.0f, 0.9f, 1.0f, 0.0f, 1.0f, 0.0f};
+  const char* x_s[6] = {"0", "1", "2", "3", "4", "5"};
+  const std::vector<hsize_t> n{6};
+  auto file = [&](const char* name, bool y32, bool t_float, int p_kind, bool x_string) {
+    const hid_t f = H5Fcreate((dir / name).c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    const hid_t vstr = H5Tcopy(H5T_C_S1);
+    H5Tset_size(vstr, H5T_VARIABLE);
+    if (x_string) dataset(f, "/events/x", vstr, n, x_s);
+    else dataset(f, "/events/x", H5T_NATIVE_UINT16, n, x);
+    if (y32) dataset(f, "/events/y", H5T_NATIVE_INT32, n, y);
+    else dataset(f, "/events/y", H5T_NATIVE_UINT16, n, x);
+    if (t_float) dataset(f, "/events/t", H5T_NATIVE_DOUBLE, n, t_s);
+    else dataset(f, "/events/t", H5T_NATIVE_INT64, n, t);
+    if (p_kind == 1) dataset(f, "/events/p", H5T_NATIVE_FLOAT, n, p_f);
+    else dataset(f, "/events/p", H5T_NATIVE_UINT8, n, p_kind == 2 ? p7 : p);
+    H5Tclose(vstr);
+    H5Fclose(f);
+  };
+  file("seed_dsec_int32_y", true, false, 0, false);
+  file("seed_dsec_float_t", false, true, 0, false);
+  file("seed_dsec_float_p", false, false, 1, false);
+  file("seed_dsec_p7", false, false, 2, false);
+  file("seed_dsec_vlen_x", false, false, 0, true);
+}
+
+/// `path` with `bytes` written over it at `at`.
+void patch(const fs::path& path, std::size_t at, const std::string& bytes) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(std::streamoff(at));
+  f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -148,6 +190,9 @@ int main(int argc, char** argv) {
   o.header = "id timestamp x y polarity";
   writeEventsText((out / "events_text/seed_header").string(), ev, o);
   text(out / "events_text/seed_outlier", "1.0 1 2 1\n1.001 3 4 0\n10000000 5 5 1\n1.002 6 7 1\n");
+  // a corrupt first time; a walk back of 0.9 ms per event
+  text(out / "events_text/seed_first_outlier", "10000000 5 5 1\n1.0 1 2 1\n1.001 3 4 0\n1.002 6 7 1\n");
+  text(out / "events_text/seed_walking_back", "9.0 1 2 1\n8.9991 1 2 1\n8.9982 1 2 1\n8.9973 1 2 1\n");
 
   // RPG sequence files
   writeImuText((out / "rpg_sequence/seed_imu_rpg").string(), im, false);
@@ -186,6 +231,19 @@ int main(int argc, char** argv) {
   writeAedat2((out / "aedat2/seed").string(), ev, im);
   writeAedat2((out / "aedat2/seed_davis346").string(), events(40, 346, 260, 2, 4294.967), {}, "DAVIS346B", 500, 4);
   writeAedat31((out / "aedat31/seed").string(), ev, im, "DAVIS240C", 20);
+  {  // the first packet's eventTSOverflow at INT32_MAX (times near 4.6e12 s)
+    writeAedat31((out / "aedat31/seed_overflow").string(), ev, {}, "DAVIS240C", 20);
+    std::ifstream in(out / "aedat31/seed_overflow", std::ios::binary);
+    const std::string b((std::istreambuf_iterator<char>(in)), {});
+    patch(out / "aedat31/seed_overflow", b.find("#!END-HEADER\r\n") + 14 + 12, std::string("\xFF\xFF\xFF\x7F", 4));
+  }
+  {  // the first event's timestamp word 0xFFFFFFFF (bytes 4-7 of the first 8-byte record)
+    writeAedat2((out / "aedat2/seed_first_all_ones").string(), ev, {});
+    patch(out / "aedat2/seed_first_all_ones", fs::file_size(out / "aedat2/seed_first_all_ones") - 8 * ev.size() + 4,
+          std::string(4, '\xFF'));
+  }
+  writeAedat4((out / "aedat4_none/seed_size_7_digits").string(), ev, {}, 1234567, 180, Aedat4Compression::None, 30,
+              true);
   writeAedat4((out / "aedat4_none/seed").string(), ev, im, 240, 180, Aedat4Compression::None, 20, true);
   writeAedat4((out / "aedat4_none/seed_no_table").string(), ev, im, 240, 180, Aedat4Compression::None, 30, false);
   writeAedat4((out / "aedat4_lz4/seed").string(), ev, im, 240, 180, Aedat4Compression::Lz4, 20, true);
@@ -197,6 +255,7 @@ int main(int argc, char** argv) {
   writeDsec(out / "hdf5/seed_dsec_deflate", ev, 32, true);
   writeMvsec(out / "hdf5/seed_mvsec", ev, im, 0);
   writeMvsec(out / "hdf5/seed_mvsec_chunked", ev, im, 16);
+  writeDsecOddTypes(out / "hdf5");
 
   // ROS bags: the sequence make_fixtures.py turns into bags (fuzz.sh runs it)
   writeEventsText((out / "bag_sequence/events.txt").string(), ev);

@@ -161,8 +161,7 @@ class Aedat2Reader final : public EventReader {
   Format format() const override { return Format::Aedat2; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     batch.reserve(std::min<std::size_t>(max, std::size_t(1) << 20));
     decode(&batch, max, nullptr);
     if (batch.size() < max) release(batch, max);
@@ -251,7 +250,9 @@ class Aedat2Reader final : public EventReader {
   /// the last trusted time across 2^32 us. A raw value far from the trusted time
   /// (one corrupt word such as 0xFFFFFFFF) is not unwrapped and does not move
   /// the trusted time unless the next word confirms it (a gap); admit() then
-  /// reports it as an outlier or a gap.
+  /// reports it as an outlier or a gap. The first word is trusted only once
+  /// another agrees with it: a corrupt first word (0xFFFFFFFF) does not make
+  /// the good words that follow a wrap-around.
   std::int64_t unwrap(std::uint32_t raw) {
     const std::int64_t here = wrap_ + std::int64_t(raw);
     if (!have_raw_) {
@@ -263,9 +264,11 @@ class Aedat2Reader final : public EventReader {
     if (std::llabs(here - ref_) <= jump_us_ || (have_cand_ && std::llabs(here - cand_) <= jump_us_)) {
       ref_ = here;
       have_cand_ = false;
+      confirmed_ = true;
       return here;
     }
-    if (std::llabs(wrapped - ref_) <= jump_us_ || (have_cand_ && std::llabs(wrapped - cand_) <= jump_us_)) {
+    if (confirmed_ &&
+        (std::llabs(wrapped - ref_) <= jump_us_ || (have_cand_ && std::llabs(wrapped - cand_) <= jump_us_))) {
       wrap_ += std::int64_t(1) << 32;
       ref_ = wrapped;
       have_cand_ = false;
@@ -306,6 +309,7 @@ class Aedat2Reader final : public EventReader {
   std::size_t pos_ = 0, len_ = 0;
   bool started_ = false;
   bool have_raw_ = false;
+  bool confirmed_ = false;  ///< two words have agreed on the trusted time
   std::int64_t wrap_ = 0;
   std::int64_t ref_ = 0;   ///< last trusted unwrapped time [us]
   std::int64_t cand_ = 0;  ///< a time far from ref_, trusted when the next word agrees [us]

@@ -61,8 +61,7 @@ class Aedat31Reader final : public EventReader {
   Format format() const override { return Format::Aedat31; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     decode(&batch, max, nullptr);
     if (batch.size() < max) release(batch, max);
     return !batch.empty();
@@ -140,6 +139,12 @@ class Aedat31Reader final : public EventReader {
         std::int64_t(tsoff) + 4 > std::int64_t(size))
       f_.fail(at, "invalid packet header (type " + std::to_string(type) + ", size " + std::to_string(size) +
                       ", capacity " + std::to_string(capacity) + ", number " + std::to_string(number) + ")");
+    // (overflow << 31) us reaches 2^33 s at overflow 4,000,000: seconds in a
+    // double would no longer resolve microseconds (kMaxExactMicroseconds).
+    if ((std::int64_t(overflow) << 31) + 0x7FFFFFFF >= kMaxExactMicroseconds)
+      f_.fail(at, "eventTSOverflow " + std::to_string(overflow) + " puts the times at " +
+                      std::to_string((std::int64_t(overflow) << 31) / 1000000) +
+                      " s, beyond 2^33 s, where seconds in a double lose microseconds (a damaged header?)");
     const std::uint64_t bytes = std::uint64_t(size) * std::uint64_t(capacity);
     if (bytes > f_.size() - f_.tell()) {  // the last packet cut by the end of the file: the complete ones are read
       warnTruncated(f_.size(), path_ + ": byte " + std::to_string(at) + ": packet of " +

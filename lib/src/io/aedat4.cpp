@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "io/aedat_readers.hpp"
@@ -63,9 +64,15 @@ std::vector<StreamInfo> parseStreams(const std::string& xml) {
     StreamInfo s;
     s.id = starts[i].second;
     s.type = xmlAttr(block, "typeIdentifier");
-    const std::string w = xmlAttr(block, "sizeX"), h = xmlAttr(block, "sizeY");
-    if (!w.empty() && w.size() < 7 && std::all_of(w.begin(), w.end(), ::isdigit)) s.width = std::stoi(w);
-    if (!h.empty() && h.size() < 7 && std::all_of(h.begin(), h.end(), ::isdigit)) s.height = std::stoi(h);
+    // A size of any number of digits is read (beyond 9 digits as INT_MAX), so
+    // that the bound check refuses it like any other size above the limit.
+    auto side = [](const std::string& v) {
+      if (v.empty() || !std::all_of(v.begin(), v.end(), ::isdigit)) return 0;
+      const std::size_t lead = std::min(v.find_first_not_of('0'), v.size());
+      return v.size() - lead > 9 ? std::numeric_limits<int>::max() : std::stoi(v);
+    };
+    s.width = side(xmlAttr(block, "sizeX"));
+    s.height = side(xmlAttr(block, "sizeY"));
     out.push_back(s);
   }
   return out;
@@ -153,8 +160,7 @@ class Aedat4Reader final : public EventReader {
   Format format() const override { return Format::Aedat4; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == count_ && !nextPacket(true, nullptr)) break;
       drain(batch, max);
@@ -214,6 +220,9 @@ class Aedat4Reader final : public EventReader {
         outsideSensor(where(), double(x), double(y));
         continue;
       }
+      if (t >= kMaxExactMicroseconds || t <= -kMaxExactMicroseconds)
+        throw IoError(where() + ": timestamp " + std::to_string(t) +
+                      " us beyond 2^33 s, where seconds in a double lose microseconds");
       Event e;
       e.t = double(t) / 1e6;  // correctly rounded: the same double as the text "S.UUUUUU"
       e.x = float(x);

@@ -150,11 +150,26 @@ void EventReader::outsideSensor(const std::string& where, double x, double y) {
   }
 }
 
+std::size_t EventReader::startBatch(std::vector<Event>& batch, std::size_t max) {
+  batch.clear();
+  if (max == 0) max = 1;
+  batch_max_ = max;
+  const std::size_t k = std::min(max, ready_.size());
+  batch.assign(ready_.begin(), ready_.begin() + std::ptrdiff_t(k));
+  ready_.erase(ready_.begin(), ready_.begin() + std::ptrdiff_t(k));
+  return max;
+}
+
 void EventReader::accept(std::vector<Event>& out, const Event& e) {
   prev_t_ = e.t;
   have_prev_ = true;
+  // A held event passed on with the one that releases it may be one more than the batch takes.
+  auto emit = [&](const Event& x) {
+    if (out.size() < batch_max_) out.push_back(x);
+    else ready_.push_back(x);
+  };
   if (options_.backwards != BackwardsPolicy::Sort) {
-    out.push_back(e);
+    emit(e);
     return;
   }
   reorder_.push(e);
@@ -170,16 +185,50 @@ void EventReader::accept(std::vector<Event>& out, const Event& e) {
     }
     emitted_any_ = true;
     last_emitted_ = first.t;
-    out.push_back(first);
+    emit(first);
   }
+}
+
+bool EventReader::admitStart(std::vector<Event>& out, const Event& e, const std::string& where) {
+  const double J = options_.max_time_jump;
+  char msg[320];
+  auto dropOutlier = [&](const Event& o, const std::string& at, const char* what) {
+    std::snprintf(msg, sizeof msg, ": timestamp %.6g s %s: outlier dropped (input.max_time_jump = %g s)", o.t, what, J);
+    warn(&ReaderWarnings::time_jumps, at + msg);
+    ++warnings_.time_outliers;
+  };
+  if (start_ == Start::None) {
+    first_ = e;
+    first_where_ = where;
+    start_ = Start::First;
+    return true;
+  }
+  if (start_ == Start::First) {
+    if (first_.t - e.t > J) {  // far before the first: which of the two is wrong, the third event says
+      second_ = e;
+      second_where_ = where;
+      start_ = Start::Second;
+      return true;
+    }
+    start_ = Start::Done;
+    accept(out, first_);
+    return false;
+  }
+  // Start::Second: the first event lies more than J after the second.
+  start_ = Start::Done;
+  if (std::abs(e.t - first_.t) <= J && std::abs(e.t - second_.t) > J) {
+    dropOutlier(second_, second_where_, "lies before the first event and the next comes back");
+    accept(out, first_);
+  } else {
+    dropOutlier(first_, first_where_, "of the first event lies ahead of the events that follow");
+    accept(out, second_);
+  }
+  return false;
 }
 
 void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::string& where) {
   char msg[320];
-  if (!have_prev_) {
-    accept(out, e);
-    return;
-  }
+  if (start_ != Start::Done && admitStart(out, e, where)) return;
   const double J = options_.max_time_jump;
   if (holding_) {
     holding_ = false;
@@ -204,30 +253,29 @@ void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::
     held_where_ = where;
     return;
   }
+  // prev_t_ is the latest time so far (kept and sorted events leave it), so
+  // that decreases add up against the tolerance: a stream walking back in
+  // small steps goes beyond it as a whole.
   if (d < 0.0) {
     const bool beyond = -d > options_.backwards_tolerance;
     if (!beyond || options_.backwards == BackwardsPolicy::Sort) {
-      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the previous event (%s)", e.t, -d,
+      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the latest event so far (%s)", e.t, -d,
                     beyond ? "sorted" : "kept");
       warn(&ReaderWarnings::backwards_time, where + msg);
-      if (beyond) {  // sort mode: keep the running maximum as the reference
-        ++warnings_.backwards_sorted;
-        const double keep = prev_t_;
-        accept(out, e);
-        prev_t_ = keep;
-        return;
-      }
+      if (beyond) ++warnings_.backwards_sorted;
+      const double keep = prev_t_;
       accept(out, e);
+      prev_t_ = keep;
       return;
     }
     if (options_.backwards == BackwardsPolicy::Drop) {
-      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the previous event: dropped", e.t, -d);
+      std::snprintf(msg, sizeof msg, ": timestamp %.6f s is %.6g s before the latest event so far: dropped", e.t, -d);
       warn(&ReaderWarnings::backwards_time, where + msg);
       ++warnings_.backwards_dropped;
       return;
     }
     std::snprintf(msg, sizeof msg,
-                  ": timestamp %.6f s is %.6g s before the previous event (more than input.backwards_tolerance = "
+                  ": timestamp %.6f s is %.6g s before the latest event so far (more than input.backwards_tolerance = "
                   "%g s): the events are not time-ordered (input.backwards: drop or sort)",
                   e.t, -d, options_.backwards_tolerance);
     throw IoError(where + msg);
@@ -236,6 +284,18 @@ void EventReader::admitSlow(std::vector<Event>& out, const Event& e, const std::
 }
 
 void EventReader::release(std::vector<Event>& out, std::size_t max) {
+  if (start_ == Start::First) accept(out, first_);  // a single event
+  if (start_ == Start::Second) {  // two events and nothing after them: the later one is taken for the outlier
+    char msg[200];
+    std::snprintf(msg, sizeof msg,
+                  ": timestamp %.6g s of the first event lies ahead of the event that follows: outlier dropped "
+                  "(input.max_time_jump = %g s)",
+                  first_.t, options_.max_time_jump);
+    warn(&ReaderWarnings::time_jumps, first_where_ + msg);
+    ++warnings_.time_outliers;
+    accept(out, second_);
+  }
+  start_ = Start::Done;
   if (holding_) {  // a jump at the very end: nothing confirms or refutes it; keep it, reported
     holding_ = false;
     char msg[200];

@@ -5,11 +5,14 @@
 //    /t_offset), /events/p (0/1), /t_offset (int64 [us], 0 when absent),
 //    /ms_to_idx (index of the first event of each millisecond; used to seek);
 //  - MVSEC: /davis/left/events (N x 4 float64: x [px], y [px], t [s], p in
-//    {-1, 1}), /davis/left/imu (N x 6: accel [m/s^2] then gyro [rad/s], or
+//    {-1, 1}; 0 is read as OFF), /davis/left/imu (N x 6: accel [m/s^2] then gyro [rad/s], or
 //    gyro first with input.imu_columns: gyro_first) with /davis/left/imu_ts
 //    [s], /davis/left/pose (N x 4 x 4 T_world_body [m]) with /davis/left/pose_ts [s].
 // Events are read in hyperslabs of kBlockEvents: a window never loads the file.
-// Every dimension read from the file is checked before it sizes anything.
+// Every dimension read from the file is checked before it sizes anything, and
+// every dataset's type class before its values are read: integers where the
+// layout stores them (a float /events/t is an error, not times of 0), values
+// range-checked as stored (HDF5's conversion would clamp -5 to 0).
 #include <hdf5.h>
 
 #include <algorithm>
@@ -62,6 +65,32 @@ struct Dataset {
 
 enum class Layout { Dsec, Mvsec };
 
+/// The element type of a dataset as its class, size and sign ("uint16",
+/// "float64", "variable-length string", "compound of 12 bytes", ...).
+std::string typeName(hid_t type) {
+  const std::size_t bytes = H5Tget_size(type);
+  const std::string bits = std::to_string(8 * bytes);
+  switch (H5Tget_class(type)) {
+    case H5T_INTEGER: return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + bits;
+    case H5T_FLOAT: return "float" + bits;
+    case H5T_STRING:
+      return H5Tis_variable_str(type) > 0 ? std::string("variable-length string")
+                                          : "string of " + std::to_string(bytes) + " bytes";
+    case H5T_ENUM: return "enum of " + std::to_string(bytes) + " bytes";
+    case H5T_COMPOUND: return "compound of " + std::to_string(bytes) + " bytes";
+    case H5T_VLEN: return "variable-length sequence";
+    case H5T_ARRAY: return "array of " + std::to_string(bytes) + " bytes";
+    case H5T_BITFIELD: return "bitfield" + bits;
+    case H5T_OPAQUE: return "opaque of " + std::to_string(bytes) + " bytes";
+    case H5T_REFERENCE: return "reference";
+    default: return "unknown type class";
+  }
+}
+
+/// What a dataset's values must be, checked before they are read (the
+/// library's conversion would otherwise clamp, truncate or zero them).
+enum class Values { Integer, Number };
+
 class Hdf5Reader final : public EventReader {
  public:
   Hdf5Reader(const std::string& path, const ReaderOptions& o) {
@@ -80,14 +109,15 @@ class Hdf5Reader final : public EventReader {
     if (exists("/events/x") || exists("/events/t")) {
       layout_ = Layout::Dsec;
       for (const char* n : {"x", "y", "t", "p"}) {
-        dsec_[n[0] == 'x' ? 0 : n[0] == 'y' ? 1 : n[0] == 't' ? 2 : 3] = open(std::string("/events/") + n, 1);
+        dsec_[n[0] == 'x' ? 0 : n[0] == 'y' ? 1 : n[0] == 't' ? 2 : 3] =
+            open(std::string("/events/") + n, 1, Values::Integer);
       }
       count_ = dsec_[0].dims[0];
       for (const Dataset& d : dsec_)
         if (d.dims[0] != count_)
           fail(d.name, "holds " + std::to_string(d.dims[0]) + " values, /events/x " + std::to_string(count_));
       if (exists("/t_offset")) {
-        Dataset off = open("/t_offset", 0);
+        Dataset off = open("/t_offset", 0, Values::Integer);
         if (H5Dread(off.id.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &t_offset_us_) < 0)
           fail(off.name, "cannot read the scalar offset");
       }
@@ -95,7 +125,7 @@ class Hdf5Reader final : public EventReader {
                        ", t_offset " + std::to_string(t_offset_us_) + " us");
     } else if (exists("/davis/left/events")) {
       layout_ = Layout::Mvsec;
-      mvsec_ = open("/davis/left/events", 2);
+      mvsec_ = open("/davis/left/events", 2, Values::Number);
       if (mvsec_.dims[1] != 4)
         fail(mvsec_.name, "has " + std::to_string(mvsec_.dims[1]) + " columns, expected 4 (x, y, t, p)");
       count_ = mvsec_.dims[0];
@@ -123,8 +153,7 @@ class Hdf5Reader final : public EventReader {
   Format format() const override { return Format::Hdf5; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == have_) {
         if (!refill()) break;
@@ -139,7 +168,7 @@ class Hdf5Reader final : public EventReader {
   std::vector<ImuSample> readImu() override {
     std::vector<ImuSample> imu;
     if (layout_ != Layout::Mvsec || !exists("/davis/left/imu")) return imu;
-    Dataset values = open("/davis/left/imu", 2), stamps = open("/davis/left/imu_ts", 1);
+    Dataset values = open("/davis/left/imu", 2, Values::Number), stamps = open("/davis/left/imu_ts", 1, Values::Number);
     if (values.dims[1] != 6) fail(values.name, "has " + std::to_string(values.dims[1]) + " columns, expected 6");
     if (values.dims[0] != stamps.dims[0])
       fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
@@ -162,7 +191,8 @@ class Hdf5Reader final : public EventReader {
   std::vector<PoseSample> readPoses() override {
     std::vector<PoseSample> poses;
     if (layout_ != Layout::Mvsec || !exists("/davis/left/pose")) return poses;
-    Dataset values = open("/davis/left/pose", 3), stamps = open("/davis/left/pose_ts", 1);
+    Dataset values = open("/davis/left/pose", 3, Values::Number),
+            stamps = open("/davis/left/pose_ts", 1, Values::Number);
     if (values.dims[1] != 4 || values.dims[2] != 4) fail(values.name, "is not N x 4 x 4");
     if (values.dims[0] != stamps.dims[0])
       fail(stamps.name, "holds " + std::to_string(stamps.dims[0]) + " times for " + std::to_string(values.dims[0]) +
@@ -186,7 +216,7 @@ class Hdf5Reader final : public EventReader {
 
   bool seekTime(double t_start) override {
     if (layout_ != Layout::Dsec || !exists("/ms_to_idx") || !std::isfinite(t_start)) return false;
-    Dataset ms = open("/ms_to_idx", 1);
+    Dataset ms = open("/ms_to_idx", 1, Values::Integer);
     const double rel_ms = std::floor((t_start * 1e6 - double(t_offset_us_)) / 1000.0);
     if (rel_ms <= 0) return true;
     const hsize_t k = hsize_t(std::min(rel_ms, double(ms.dims[0] ? ms.dims[0] - 1 : 0)));
@@ -249,13 +279,27 @@ class Hdf5Reader final : public EventReader {
     return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0;
   }
 
-  Dataset open(const std::string& name, int rank) const {
+  /// Opens dataset `name` of rank `rank` whose element type holds `values`:
+  /// integers (of any size and sign: read as int64, then range-checked) or
+  /// numbers (integers or floats, read as double). Any other type (a float
+  /// where integers are stored, a string, a compound) is an error naming it.
+  Dataset open(const std::string& name, int rank, Values values) const {
     Dataset d;
     d.name = name;
     if (!exists(name)) throw IoError(path_ + ": dataset " + name + " is missing");
     checkLinkTarget(name);
     d.id = H5Id(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
     if (!d.id.valid()) fail(name, "cannot be opened (not a dataset?)");
+    {
+      H5Id type(H5Dget_type(d.id.get()), H5Tclose);
+      if (!type.valid()) fail(name, "its type cannot be read (damaged file)");
+      const H5T_class_t c = H5Tget_class(type.get());
+      const bool ok = c == H5T_INTEGER || (values == Values::Number && c == H5T_FLOAT);
+      if (!ok || H5Tget_size(type.get()) > 8)
+        fail(name, "type " + typeName(type.get()) + ", expected " +
+                       (values == Values::Integer ? "integers" : "numbers (integers or floats)") +
+                       (name == "/events/t" ? " (the DSEC layout stores microseconds as integers)" : ""));
+    }
     d.space = H5Id(H5Dget_space(d.id.get()), H5Sclose);
     const int r = H5Sget_simple_extent_ndims(d.space.get());
     if (r != rank) fail(name, "has rank " + std::to_string(r) + ", expected " + std::to_string(rank));
@@ -361,10 +405,12 @@ class Hdf5Reader final : public EventReader {
     if (next_ >= count_) return false;
     const hsize_t n = std::min(kBlockEvents, count_ - next_);
     if (layout_ == Layout::Dsec) {
-      readBlock(dsec_[0], H5T_NATIVE_UINT16, x_.data(), n);
-      readBlock(dsec_[1], H5T_NATIVE_UINT16, y_.data(), n);
+      // Every integer type converts to int64 exactly (uint64 beyond it is
+      // clamped, and out of range below): the values are checked as stored.
+      readBlock(dsec_[0], H5T_NATIVE_INT64, x_.data(), n);
+      readBlock(dsec_[1], H5T_NATIVE_INT64, y_.data(), n);
       readBlock(dsec_[2], H5T_NATIVE_INT64, t_.data(), n);
-      readBlock(dsec_[3], H5T_NATIVE_UINT8, p_.data(), n);
+      readBlock(dsec_[3], H5T_NATIVE_INT64, p_.data(), n);
     } else {
       readBlock(mvsec_, H5T_NATIVE_DOUBLE, rows_.data(), n);
     }
@@ -384,13 +430,24 @@ class Hdf5Reader final : public EventReader {
       Event e;
       double x, y;
       if (layout_ == Layout::Dsec) {
-        x = x_[cur_];
-        y = y_[cur_];
+        const std::string row = std::to_string(block_start_ + cur_);
+        for (int k = 0; k < 2; ++k) {
+          const std::int64_t v = (k == 0 ? x_ : y_)[cur_];
+          if (v < 0 || v > 65535)
+            fail(dsec_[k].name, "row " + row + ": value " + std::to_string(v) + " outside [0, 65535] (pixels)");
+        }
+        if (p_[cur_] != 0 && p_[cur_] != 1)
+          fail(dsec_[3].name, "row " + row + ": polarity " + std::to_string(p_[cur_]) + " (expected 0 or 1)");
+        x = double(x_[cur_]);
+        y = double(y_[cur_]);
         std::int64_t us = 0;
         if (__builtin_add_overflow(t_offset_us_, t_[cur_], &us))
-          throw IoError(where() + ": timestamp " + std::to_string(t_[cur_]) + " us plus t_offset overflows");
+          fail(dsec_[2].name, "row " + row + ": timestamp " + std::to_string(t_[cur_]) + " us plus t_offset overflows");
+        if (us >= kMaxExactMicroseconds || us <= -kMaxExactMicroseconds)
+          fail(dsec_[2].name, "row " + row + ": time " + std::to_string(us) +
+                                  " us (with t_offset) beyond 2^33 s, where seconds in a double lose microseconds");
         e.t = double(us) / 1e6;  // as exact as the text: a correctly rounded quotient
-        e.on = p_[cur_] != 0;
+        e.on = p_[cur_] == 1;
       } else {
         const double* r = &rows_[4 * cur_];
         x = r[0];
@@ -400,6 +457,8 @@ class Hdf5Reader final : public EventReader {
         if (!std::isfinite(e.t) || !(x >= 0 && x < 65536) || !(y >= 0 && y < 65536) || x != std::floor(x) ||
             y != std::floor(y))
           throw IoError(where() + ": not an event (x, y whole pixels, t finite)");
+        if (r[3] != -1.0 && r[3] != 0.0 && r[3] != 1.0)
+          throw IoError(where() + ": polarity " + std::to_string(r[3]) + " (expected -1 or 1; 0 is read as OFF)");
       }
       if ((width_ > 0 && x >= width_) || (height_ > 0 && y >= height_)) {
         outsideSensor(where(), x, y);
@@ -422,9 +481,7 @@ class Hdf5Reader final : public EventReader {
   std::int64_t t_offset_us_ = 0;
   hsize_t count_ = 0, next_ = 0, block_start_ = 0;
   std::size_t have_ = 0, cur_ = 0;
-  std::vector<std::uint16_t> x_, y_;
-  std::vector<std::int64_t> t_;
-  std::vector<std::uint8_t> p_;
+  std::vector<std::int64_t> x_, y_, t_, p_;  ///< a block of the DSEC datasets as stored (range-checked per row)
   std::vector<double> rows_;
 };
 

@@ -2,6 +2,7 @@
 #include "io/ros_messages.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace celc::detail {
 
@@ -23,11 +24,21 @@ ImuSample decodeImu(const unsigned char* data, std::size_t size) {
   ImuSample s;
   s.t = c.header();
   c.skip(4 * 8 + 9 * 8, "orientation");
+  const std::size_t gyro_at = c.offset();
   s.gyro = c.vec3("angular_velocity");
   c.skip(9 * 8, "angular_velocity_covariance");
+  const std::size_t accel_at = c.offset();
   s.accel = c.vec3("linear_acceleration");
   c.skip(9 * 8, "linear_acceleration_covariance");
-  if (!s.gyro.allFinite() || !s.accel.allFinite()) throw RosDecodeError(0, "non-finite IMU value");
+  auto check = [](const Vec3& v, double bound, std::size_t at, const char* what, const char* unit) {
+    if (v.allFinite() && v.cwiseAbs().maxCoeff() <= bound) return;
+    char m[160];
+    std::snprintf(m, sizeof m, "%s (%.6g, %.6g, %.6g) %s: non-finite or beyond %g %s (not an IMU sample)", what,
+                  v.x(), v.y(), v.z(), unit, bound, unit);
+    throw RosDecodeError(at, m);
+  };
+  check(s.gyro, kMaxImuGyro, gyro_at, "angular_velocity", "rad/s");
+  check(s.accel, kMaxImuAccel, accel_at, "linear_acceleration", "m/s^2");
   return s;
 }
 

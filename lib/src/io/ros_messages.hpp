@@ -137,7 +137,14 @@ inline RosEvent loadRosEvent(const unsigned char* p) {
   return e;
 }
 
-/// sensor_msgs/Imu: time = header stamp; gyro = angular_velocity, accel = linear_acceleration.
+/// Largest |component| of a decoded IMU sample: a gyro rate beyond 1000 rad/s
+/// or an acceleration beyond 10^4 m/s^2 (about 1000 g) is no IMU's reading but
+/// another message or damaged bytes.
+inline constexpr double kMaxImuGyro = 1e3;    ///< [rad/s]
+inline constexpr double kMaxImuAccel = 1e4;   ///< [m/s^2]
+/// sensor_msgs/Imu: time = header stamp; gyro = angular_velocity, accel =
+/// linear_acceleration. A non-finite value or one beyond kMaxImuGyro /
+/// kMaxImuAccel is a RosDecodeError at the vector's offset.
 ImuSample decodeImu(const unsigned char* data, std::size_t size);
 /// geometry_msgs/PoseStamped or nav_msgs/Odometry (its pose.pose): T_world_body at the header stamp;
 /// the quaternion is normalised (a zero quaternion is an error).

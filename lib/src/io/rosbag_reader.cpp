@@ -8,7 +8,10 @@
 // unindexed bag, position beyond the end = a truncated bag: both point at
 // `rosbag reindex`), every record of the index section (connections and chunk
 // infos) within the file, and every chunk's header (compression known,
-// uncompressed size at most input.max_packet_bytes, data within the file).
+// uncompressed size at most input.max_packet_bytes, data within the file), and
+// every index data entry on a message record of the chunk whose connection id
+// is the entry's and one the index declares (the index decides which topic,
+// hence which layout, a message is decoded as).
 //
 // Layout of a 2.0 record: uint32 header_len, header (fields: uint32 len,
 // "name=value"), uint32 data_len, data. op 0x03 bag header {index_pos,
@@ -28,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
 
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
@@ -104,11 +108,20 @@ std::string badHeaderFields(const unsigned char* p, const unsigned char* end) {
   return {};
 }
 
-/// The records of one decompressed chunk (offset -> op): each header's fields
-/// and each data length must lie inside the chunk.
-std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64_t chunk_at,
-                                                  const std::vector<unsigned char>& b) {
-  std::map<std::uint32_t, std::uint8_t> ops;
+/// One record inside a chunk: its op and, for a message data record, its connection id.
+struct ChunkRecord {
+  std::uint8_t op = 0;
+  std::uint32_t conn = 0;
+  bool has_conn = false;
+};
+
+/// The records of one decompressed chunk (offset -> record): each header's
+/// fields and each data length must lie inside the chunk, and a message data
+/// record must name a connection of `conns` (the index section's).
+std::map<std::uint32_t, ChunkRecord> chunkRecords(const BinFile& f, std::uint64_t chunk_at,
+                                                  const std::vector<unsigned char>& b,
+                                                  const std::set<std::uint32_t>& conns) {
+  std::map<std::uint32_t, ChunkRecord> ops;
   auto bad = [&](std::size_t p, const std::string& what) {
     f.fail(chunk_at, "chunk record at offset " + std::to_string(p) + ": " + what + kReindexHint);
   };
@@ -121,6 +134,7 @@ std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64
     if (hlen > b.size() - p) bad(start, "header of " + std::to_string(hlen) + " bytes beyond the chunk's end");
     const std::size_t hend = p + hlen;
     std::uint8_t op = 0;
+    ChunkRecord rec;
     while (p < hend) {
       if (hend - p < 4) bad(start, "cut header field");
       const auto flen = loadLE<std::uint32_t>(b.data() + p);
@@ -130,6 +144,10 @@ std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64
       const void* eq = std::memchr(field, '=', flen);
       if (!eq) bad(start, "header field without '='");
       if (flen == 4 && std::memcmp(field, "op=", 3) == 0) op = std::uint8_t(field[3]);
+      if (flen == 9 && std::memcmp(field, "conn=", 5) == 0) {
+        rec.conn = loadLE<std::uint32_t>(b.data() + p + 5);
+        rec.has_conn = true;
+      }
       p += flen;
     }
     if (b.size() - p < 4) bad(start, "cut data length");
@@ -141,7 +159,12 @@ std::map<std::uint32_t, std::uint8_t> chunkRecords(const BinFile& f, std::uint64
     if (op == 0x07)
       if (const std::string e = badHeaderFields(b.data() + p - dlen, b.data() + p); !e.empty())
         bad(start, "connection data: " + e);
-    ops[std::uint32_t(start)] = op;
+    if (op == 0x02 && !rec.has_conn) bad(start, "message data record without a connection id");
+    if (op == 0x02 && !conns.count(rec.conn))
+      bad(start, "message data record of connection " + std::to_string(rec.conn) +
+                     ", which no connection record of the index declares");
+    rec.op = op;
+    ops[std::uint32_t(start)] = rec;
   }
   return ops;
 }
@@ -166,10 +189,14 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
                       std::to_string(f.size()) + " bytes): truncated bag" + kReindexHint);
   std::vector<std::uint64_t> chunks;
   std::uint32_t conns = 0;
+  std::set<std::uint32_t> conn_ids;
   for (std::uint64_t at = index_pos; at < f.size();) {
     const BagRecord r = readRecord(f, at, "index record");
     if (r.op() == 0x07) {
       ++conns;
+      std::uint32_t id = 0;
+      if (!r.value("conn", id)) f.fail(at, "connection record without a connection id" + std::string(kReindexHint));
+      conn_ids.insert(id);
       // its data is the connection header (topic, type, md5sum, definition): found by the rosbag fuzz target
       if (r.data_len > kMaxRecordHeaderBytes)
         f.fail(at, "connection record data of " + std::to_string(r.data_len) + " bytes");
@@ -182,6 +209,12 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
       std::uint64_t chunk_pos = 0;
       if (!r.value("chunk_pos", chunk_pos) || chunk_pos < head.data_at || chunk_pos >= index_pos)
         f.fail(at, "chunk info without a chunk position inside the file");
+      // Its data: `count` pairs (uint32 connection, uint32 messages), which the
+      // library reads one by one from the file without a bound.
+      std::uint32_t count = 0;
+      if (!r.value("count", count) || std::uint64_t(count) * 8 != r.data_len)
+        f.fail(at, "chunk info record of " + std::to_string(count) + " connection counts (8 bytes each) in " +
+                       std::to_string(r.data_len) + " bytes of data" + kReindexHint);
       chunks.push_back(chunk_pos);
     } else
       f.fail(at, "unexpected record op " + std::to_string(int(r.op())) + " in the index section");
@@ -231,24 +264,35 @@ std::map<std::string, int> checkBag20(const std::string& path, const ReaderOptio
         f.fail(at, "corrupt " + comp->second + " chunk (it does not decompress to its " + std::to_string(size) +
                        " bytes)");
     }
-    const std::map<std::uint32_t, std::uint8_t> records = chunkRecords(f, at, plain);
+    const std::map<std::uint32_t, ChunkRecord> records = chunkRecords(f, at, plain, conn_ids);
     // The index records after the chunk: each entry on a message record of the chunk.
     for (std::uint64_t r = end; r < index_pos;) {
       const BagRecord ix = readRecord(f, r, "index data record");
       if (ix.op() != 0x04) break;
-      std::uint32_t count = 0;
+      std::uint32_t count = 0, conn = 0;
       if (!ix.value("count", count) || std::uint64_t(count) * 12 != ix.data_len)
         f.fail(r, "index data record whose count does not match its length");
+      // The index decides which topic a message is read as: its connection
+      // must be declared and be the one the message record itself names.
+      if (!ix.value("conn", conn)) f.fail(r, "index data record without a connection id" + std::string(kReindexHint));
+      if (!conn_ids.count(conn))
+        f.fail(r, "index data record of connection " + std::to_string(conn) +
+                      ", which no connection record of the index declares" + kReindexHint);
       std::vector<unsigned char> entries(ix.data_len);
       f.seek(ix.data_at);
       f.readExact(entries.data(), entries.size(), "index data");
       for (std::uint32_t k = 0; k < count; ++k) {
         const auto offset = loadLE<std::uint32_t>(entries.data() + 12 * k + 8);
         auto it = records.find(offset);
-        if (it == records.end() || it->second != 0x02)
+        if (it == records.end() || it->second.op != 0x02)
           f.fail(ix.data_at + 12 * k + 8, "index entry offset " + std::to_string(offset) +
                                                " is not a message record of the chunk at byte " + std::to_string(at) +
                                                kReindexHint);
+        if (it->second.conn != conn)
+          f.fail(ix.data_at + 12 * k + 8, "index data record of connection " + std::to_string(conn) +
+                                               " points at a message record of connection " +
+                                               std::to_string(it->second.conn) + " (offset " + std::to_string(offset) +
+                                               " of the chunk at byte " + std::to_string(at) + ")" + kReindexHint);
       }
       r = ix.data_at + ix.data_len;
     }
@@ -335,8 +379,7 @@ class RosBagReader final : public EventReader {
   Format format() const override { return Format::RosBag; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     while (batch.size() < max) {
       if (cur_ == count_) {
         if (!nextMessage()) break;

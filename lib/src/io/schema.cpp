@@ -17,7 +17,7 @@ void describe(FieldVisitor& v, ReaderOptions& o) {
   v.field({"aedat_source", "", "AEDAT 3.1: only this source id (-1 = all)"}, o.aedat_source);
   v.field({"max_time_jump", "s", "larger forward steps between events: one outlier dropped, or a gap (reported)"},
           o.max_time_jump);
-  v.field({"backwards_tolerance", "s", "timestamp decreases up to this are counted and kept"},
+  v.field({"backwards_tolerance", "s", "timestamp decreases below the latest time so far up to this are counted and kept"},
           o.backwards_tolerance);
   v.enumeration({"backwards", "", "larger decreases: error, drop the event, or sort (bounded buffer)"},
                 o.backwards, {BackwardsPolicy::Error, BackwardsPolicy::Drop, BackwardsPolicy::Sort});

@@ -148,8 +148,7 @@ class TextEventReader final : public EventReader {
   Format format() const override { return Format::Text; }
 
   bool next(std::vector<Event>& batch, std::size_t max) override {
-    batch.clear();
-    if (max == 0) max = 1;
+    max = startBatch(batch, max);
     auto byCount = [](std::size_t n, Layout& l) {
       if (n == 4) l.idx = {0, 1, 2, 3};
       else if (n == 5) l.idx = {1, 2, 3, 4};

@@ -35,6 +35,7 @@ struct SequenceRunner::Impl {
   RunConfig config;
   RunInputs inputs;
   Calibration calib;
+  bool size_assumed = false;  ///< the image size is calib.txt's default, stated by no file
   std::unique_ptr<EventReader> reader;
   std::unique_ptr<UndistortLut> lut;
   GyroTrack gyro;
@@ -161,16 +162,24 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
   const int w = m.reader->width() > 0 ? m.reader->width() : 240;
   const int h = m.reader->height() > 0 ? m.reader->height() : 180;
   m.calib = loadCalibration(m.inputs.calib, w, h);
-  // A recording that states no sensor size is read against the size a YAML
-  // calibration states: pixels outside it are counted and dropped (an error
-  // beyond input.max_outside_share), as for a file that states its size,
-  // instead of used silently. (calib.txt states no size.)
+  // A recording that states no sensor size is read against the calibration's
+  // size: pixels outside it are counted and dropped (an error beyond
+  // input.max_outside_share, naming input.width / input.height), as for a
+  // file that states its size, instead of used silently. A calib.txt states
+  // no size either: its camera is the 240x180 DAVIS240C's, and the summary
+  // says that size is assumed.
   const std::string calib_ext = fs::path(m.inputs.calib).extension().string();
   if (m.reader->width() <= 0 && m.config.reader.width <= 0 && m.config.reader.height <= 0 &&
-      (calib_ext == ".yaml" || calib_ext == ".yml") && m.calib.camera.width > 0 && m.calib.camera.height > 0) {
+      m.calib.camera.width > 0 && m.calib.camera.height > 0) {
+    m.size_assumed = calib_ext != ".yaml" && calib_ext != ".yml" && !isContainerFile(m.inputs.calib);
     m.config.reader.width = m.calib.camera.width;
     m.config.reader.height = m.calib.camera.height;
     m.reader = openEventSource(in.events, m.config.reader);
+    if (m.size_assumed)
+      spdlog::warn("{}: neither it nor {} states an image size: the events are read as from a {}x{} sensor "
+                   "(pixels outside are dropped and counted, an error beyond input.max_outside_share); set "
+                   "input.width / input.height for another camera",
+                   m.inputs.calib, in.events, m.calib.camera.width, m.calib.camera.height);
   }
   // A calibration of another sensor maps every pixel to a wrong bearing.
   if (m.reader->width() > 0 && m.reader->height() > 0 &&
@@ -233,7 +242,10 @@ std::vector<std::string> SequenceRunner::describe() const {
   std::vector<std::string> d;
   d.push_back("events: " + m.reader->path() + " (" + toString(m.reader->format()) + ")");
   d.push_back("calibration: " + m.inputs.calib + " (" + std::to_string(m.calib.camera.width) + "x" +
-              std::to_string(m.calib.camera.height) + ", " + toString(m.calib.camera.distortion) + ")");
+              std::to_string(m.calib.camera.height) +
+              (m.size_assumed ? " assumed: neither the calibration nor the recording states an image size; "
+                                "set input.width / input.height" : "") +
+              ", " + toString(m.calib.camera.distortion) + ")");
   if (m.config.omega_source == OmegaSource::Fixed)
     d.push_back("angular velocity: fixed by the configuration (motion.fixed_omega)");
   else {

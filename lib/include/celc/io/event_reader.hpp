@@ -23,9 +23,11 @@
 ///    types (skipped), a truncated final packet or record (the complete ones
 ///    are read). With ReaderOptions::strict, a warning is an error too.
 ///  - time sanity (every format, the same rules; see EventReader::admit):
-///    decreases beyond ReaderOptions::backwards_tolerance are an error (or are
-///    dropped / sorted when asked), forward jumps beyond max_time_jump are an
-///    outlier when the next event comes back, a gap when it does not.
+///    decreases beyond ReaderOptions::backwards_tolerance below the latest time
+///    so far are an error (or are dropped / sorted when asked), forward jumps
+///    beyond max_time_jump are an outlier when the next event comes back, a gap
+///    when it does not; a first event more than max_time_jump after the ones
+///    that follow is an outlier too.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -58,7 +60,7 @@ ImuColumns parseImuColumns(const std::string& name);  ///< "auto" | "rpg" | "gyr
 std::string toString(ImuColumns columns);             ///< "auto" | "rpg" | "gyro_first"
 
 /// What a reader does with an event whose timestamp is more than
-/// ReaderOptions::backwards_tolerance before the previous event's.
+/// ReaderOptions::backwards_tolerance before the latest earlier time (the running maximum).
 enum class BackwardsPolicy {
   Error,  ///< stop with an error naming the line / byte (the default: the file is not time-ordered)
   Drop,   ///< drop the event, counted as a warning
@@ -70,6 +72,11 @@ std::string toString(BackwardsPolicy policy);  ///< "error" | "drop" | "sort"
 /// undistortion table holds one entry per pixel, so a hostile header must not
 /// size it (celc::kMaxSensorSide in geometry/undistort.hpp is the same bound).
 inline constexpr int kMaxReaderSensorSide = 4096;
+/// Binary formats store integer microseconds; the library holds double
+/// seconds, whose spacing is at most 2^-20 s (< 1 us) below 2^33 s (272 years).
+/// A time at or beyond this bound [us] is an error naming its place, never
+/// rounded silently to milliseconds.
+inline constexpr std::int64_t kMaxExactMicroseconds = std::int64_t(8589934592) * 1000000;
 /// Events held by BackwardsPolicy::Sort (a bounded reorder buffer).
 inline constexpr std::size_t kSortBufferEvents = std::size_t(1) << 20;
 
@@ -94,8 +101,9 @@ struct ReaderOptions {
   /// beyond it followed by one back near the previous time is an outlier
   /// (dropped, counted); a jump the next event confirms is a gap (kept, counted).
   double max_time_jump = 10.0;
-  /// Decreases of the timestamp up to this [s] are counted and the event kept;
-  /// larger ones follow `backwards`.
+  /// Decreases of the timestamp below the latest time so far up to this [s]
+  /// are counted and the event kept; larger ones follow `backwards`. Measured
+  /// from the running maximum, so small steps back add up.
   double backwards_tolerance = 1e-3;
   BackwardsPolicy backwards = BackwardsPolicy::Error;
   /// Share of events with a pixel outside the sensor beyond which reading stops
@@ -185,7 +193,7 @@ class EventReader {
   template <class Where>
   void admit(std::vector<Event>& out, const Event& e, Where&& where) {
     ++admitted_;
-    if (have_prev_ && !holding_ && reorder_.empty() && e.t >= prev_t_ &&
+    if (have_prev_ && !holding_ && reorder_.empty() && out.size() < batch_max_ && e.t >= prev_t_ &&
         e.t - prev_t_ <= options_.max_time_jump) {
       prev_t_ = e.t;
       out.push_back(e);
@@ -196,6 +204,10 @@ class EventReader {
   /// At the end of the stream: moves held events into `out` (at most up to
   /// `max` events in `out`). Readers call it when a batch comes out short.
   void release(std::vector<Event>& out, std::size_t max);
+  /// Every next() starts with it: clears `batch`, puts in it the events that
+  /// a held event released beyond the previous batch's `max`, and returns max
+  /// (at least 1). A batch therefore never holds more than `max` events.
+  std::size_t startBatch(std::vector<Event>& batch, std::size_t max);
 
   std::string path_;
   int width_ = 0, height_ = 0;
@@ -208,14 +220,24 @@ class EventReader {
     bool operator()(const Event& a, const Event& b) const { return a.t > b.t; }
   };
   void admitSlow(std::vector<Event>& out, const Event& e, const std::string& where);
+  /// The first events: the first is held until the next one; one more than
+  /// max_time_jump before it is held too, and the third decides which of the
+  /// two is an outlier (dropped, counted). True when `e` was held.
+  bool admitStart(std::vector<Event>& out, const Event& e, const std::string& where);
+  enum class Start { None, First, Second, Done };
+  Start start_ = Start::None;
+  Event first_{}, second_{};
+  std::string first_where_, second_where_;
   void accept(std::vector<Event>& out, const Event& e);
   bool have_prev_ = false;
-  double prev_t_ = 0.0;        ///< time of the last event passed on (or pushed to the sort buffer)
+  double prev_t_ = 0.0;        ///< latest time passed on (or pushed to the sort buffer); decreases are measured from it
   bool holding_ = false;       ///< `held_` is an outlier candidate (a forward jump)
   Event held_{};
   std::string held_where_;
   std::uint64_t admitted_ = 0;  ///< events offered to admit() (for the outside share)
   std::priority_queue<Event, std::vector<Event>, Later> reorder_;
+  std::size_t batch_max_ = std::size_t(-1);  ///< the current batch's max (startBatch)
+  std::vector<Event> ready_;                  ///< passed events beyond batch_max_, for the next batch
   bool emitted_any_ = false;
   double last_emitted_ = 0.0;  ///< sort mode: time of the last event released from the buffer
 };
