@@ -72,11 +72,11 @@ TEST(ImuStill, TrueRestWithABiasIsStill) {
 // gravity axis itself the accelerometer sees nothing and the rate (above a
 // bias's 0.35 rad/s) refuses it.
 TEST(ImuStill, ConstantRotationIsNotStill) {
-  const Vec3 axes[] = {Vec3::UnitX(), Vec3::UnitZ(), Vec3(1, 1, 1).normalized(), Vec3(1, 0.2, -1).normalized(),
+  const std::vector<Vec3> axes = {Vec3::UnitX(), Vec3::UnitZ(), Vec3(1, 1, 1).normalized(), Vec3(1, 0.2, -1).normalized(),
                        Vec3(-0.57, -0.61, -0.37).normalized()};
   unsigned seed = 20;
   for (const Vec3& axis : axes) {
-    for (const Vec3& bias : {Vec3::Zero(), kBoxesBias}) {
+    for (const Vec3& bias : std::vector<Vec3>{Vec3::Zero(), kBoxesBias}) {
       const StillSpan st = findFirstStill(steadyImu(0.95 * axis, bias, 3.0, ++seed));
       EXPECT_FALSE(st.found) << "axis " << axis.transpose() << ": still at " << st.t0;
       EXPECT_NE(st.refused.find("the accelerometer direction turns"), std::string::npos) << st.refused;
@@ -94,7 +94,7 @@ TEST(ImuStill, ConstantRotationIsNotStill) {
 // rad/s.
 TEST(ImuStill, SlowDriftIsNotStill) {
   unsigned seed = 50;
-  for (const Vec3& axis : {Vec3::UnitX(), Vec3::UnitZ(), Vec3(1, 1, 0).normalized()})
+  for (const Vec3& axis : std::vector<Vec3>{Vec3::UnitX(), Vec3::UnitZ(), Vec3(1, 1, 0).normalized()})
     for (double rate : {0.05, 0.02}) {
       const StillSpan st = findFirstStill(steadyImu(rate * axis, kBoxesBias, 4.0, ++seed));
       EXPECT_FALSE(st.found) << "axis " << axis.transpose() << " at " << rate << " rad/s: still at " << st.t0
