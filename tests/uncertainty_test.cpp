@@ -400,6 +400,12 @@ TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
                     d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("not one at rest"), std::string::npos) << r.err;
+  r = test::runCelc("info '" + (d / "seq").string() + "'", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("gyro at rest:  no still second (the first span [0.000, 1.000] s: the gyro reads a steady "
+                       "0.5"),
+            std::string::npos)
+      << r.out;
   // Both ways at once is an error naming the keys.
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "f").string() + "'" + common +
                         "--set motion.gyro_bias_from_still=true --set 'motion.gyro_bias=[0.01, 0, 0]'",
@@ -439,6 +445,11 @@ TEST(Uncertainty, GyroBiasFromAStillStartIsUsedByDefault) {
   EXPECT_NE(summary.find("motion.gyro_bias_from_still: auto"), std::string::npos) << summary;
   EXPECT_NE(r.err.find("gyro bias 0.01"), std::string::npos) << r.err;  // the log
   EXPECT_NE(test::readAll(d / "b" / "config.yaml").find("gyro_bias_from_still: auto"), std::string::npos);
+  r = test::runCelc("info '" + (d / "seq").string() + "'", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("gyro at rest:  mean 0.01"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("over the first still second [0.000, 1.000] s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(significant: celc run subtracts it by default)"), std::string::npos) << r.out;
 
   r = test::runCelc("run '" + (d / "seq").string() + "' -q -o '" + (d / "c").string() + "'" + common +
                         "--set windows.t_end=1.55 --set motion.gyro_bias_from_still=false",

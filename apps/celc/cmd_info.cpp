@@ -69,8 +69,8 @@ int runInfo(const InfoArgs& a) {
                     still.gyro_mean.norm() * 180.0 / M_PI, still.gyro_std.x(), still.gyro_std.y(),
                     still.gyro_std.z(), still.accel_turn, still.t0, still.t1,
                     still.significant(kStillBiasZ, kStillBiasMinRate)
-                        ? " (significant: celc run subtracts it, motion.gyro_bias_from_still: auto)"
-                        : " (within the noise: celc run leaves it)");
+                        ? " (significant: celc run subtracts it by default)"
+                        : " (within the noise: celc run leaves it by default)");
       else
         std::printf("gyro at rest:  no still second (%s)\n", still.refused.c_str());
       if (!still.warning.empty()) std::printf("gyro warning:  %s\n", still.warning.c_str());
