@@ -332,43 +332,52 @@ TEST(Uncertainty, GyroBiasIsSubtractedInThePipeline) {
   fs::remove_all(d);
 }
 
-// motion.gyro_bias_from_still: the sample shifted by 1.5 s behind an IMU
-// that rests for its first 1.5 s with a bias b (plus 1 mrad/s of noise), b
-// added to every later sample: the bias is taken from the still second, so
-// every window's angular velocity is the original sample's to within the
-// noise's mean over 1000 samples (3e-5 rad/s per axis; 2e-4 allowed). A
-// recording whose IMU never rests, and one that turns steadily, are errors
-// naming the key.
+namespace {
+// The sample shifted by `shift` seconds behind an IMU that rests for them
+// with a bias b (plus 1 mrad/s of noise; accelerometer still) turning at
+// `still_rate` on top, b added to every later sample.
+void writeStillStartImu(const fs::path& path, const Vec3& bias, const Vec3& still_rate, double shift = 1.5) {
+  std::ofstream out(path.string());
+  out.precision(10);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  for (int k = 0; k < static_cast<int>(shift * 1000); ++k) {
+    const Vec3 g = still_rate + bias + Vec3(noise(rng), noise(rng), noise(rng));
+    out << k * 1e-3 << " 0 -9.81 0 " << g.x() << ' ' << g.y() << ' ' << g.z() << '\n';
+  }
+  std::ifstream in(kSample + "/imu.txt");
+  double t, ax, ay, az, gx, gy, gz;
+  while (in >> t >> ax >> ay >> az >> gx >> gy >> gz)
+    out << t + shift << ' ' << ax << ' ' << ay << ' ' << az << ' ' << gx + bias.x() << ' ' << gy + bias.y() << ' '
+        << gz + bias.z() << '\n';
+}
+
+// A sequence folder `dir`: the sample's events and calibration shifted by
+// `shift` seconds, the IMU of writeStillStartImu.
+void writeStillStartSequence(const fs::path& dir, const Vec3& bias, double shift = 1.5) {
+  fs::create_directories(dir);
+  fs::copy_file(kSample + "/calib.yaml", dir / "calib.yaml");
+  std::ifstream in(kSample + "/events.txt");
+  std::ofstream out((dir / "events.txt").string());
+  out.precision(9);
+  double t;
+  int x, y, p;
+  while (in >> t >> x >> y >> p) out << t + shift << ' ' << x << ' ' << y << ' ' << p << '\n';
+  writeStillStartImu(dir / "imu.txt", bias, Vec3::Zero(), shift);
+}
+}  // namespace
+
+// motion.gyro_bias_from_still: true on the sample shifted by 1.5 s behind
+// an IMU that rests for its first 1.5 s with a bias b: the bias is taken
+// from the still second, so every window's angular velocity is the original
+// sample's to within the noise's mean over 1000 samples (3e-5 rad/s per
+// axis; 2e-4 allowed). A recording whose IMU never rests, and one that turns
+// steadily, are errors naming the key.
 TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
   const fs::path d = test::freshTempDir("unc_bias_still");
   const Vec3 bias(0.012, -0.021, 0.008);
-  const double shift = 1.5;
-  fs::create_directories(d / "seq");
-  fs::copy_file(kSample + "/calib.yaml", d / "seq" / "calib.yaml");
-  {
-    std::ifstream in(kSample + "/events.txt");
-    std::ofstream out((d / "seq" / "events.txt").string());
-    out.precision(9);
-    double t;
-    int x, y, p;
-    while (in >> t >> x >> y >> p) out << t + shift << ' ' << x << ' ' << y << ' ' << p << '\n';
-  }
-  auto writeImu = [&](const fs::path& path, const Vec3& still_rate) {
-    std::ofstream out(path.string());
-    out.precision(10);
-    std::mt19937_64 rng(5);
-    std::normal_distribution<double> noise(0.0, 1e-3);
-    for (int k = 0; k < 1500; ++k) {
-      const Vec3 g = still_rate + bias + Vec3(noise(rng), noise(rng), noise(rng));
-      out << k * 1e-3 << " 0 -9.81 0 " << g.x() << ' ' << g.y() << ' ' << g.z() << '\n';
-    }
-    std::ifstream in(kSample + "/imu.txt");
-    double t, ax, ay, az, gx, gy, gz;
-    while (in >> t >> ax >> ay >> az >> gx >> gy >> gz)
-      out << t + shift << ' ' << ax << ' ' << ay << ' ' << az << ' ' << gx + bias.x() << ' ' << gy + bias.y()
-          << ' ' << gz + bias.z() << '\n';
-  };
-  writeImu(d / "seq" / "imu.txt", Vec3::Zero());
+  writeStillStartSequence(d / "seq", bias);
+  auto writeImu = [&](const fs::path& path, const Vec3& still_rate) { writeStillStartImu(path, bias, still_rate); };
   const std::string common = " -q --threads 2 --methods celc --window-events 15000 ";
   auto r = test::runCelc("run '" + kSample + "' -o '" + (d / "a").string() + "'" + common + "--set windows.t_end=0.05", d);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -391,11 +400,73 @@ TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
                     d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("not one at rest"), std::string::npos) << r.err;
+  r = test::runCelc("info '" + (d / "seq").string() + "'", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("gyro at rest:  no still second (the first span [0.000, 1.000] s: the gyro reads a steady "
+                       "0.5"),
+            std::string::npos)
+      << r.out;
   // Both ways at once is an error naming the keys.
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "f").string() + "'" + common +
                         "--set motion.gyro_bias_from_still=true --set 'motion.gyro_bias=[0.01, 0, 0]'",
                     d);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("set with motion.gyro_bias"), std::string::npos) << r.err;
+  fs::remove_all(d);
+}
+
+// motion.gyro_bias_from_still: auto (the default) on the same sequence: the
+// still start's bias (1.2-2.1 deg/s, hundreds of standard errors) comes off
+// every sample, and summary.md and the log say so with the span; false keeps
+// the raw rates (every window's rate off by R_cam_imu b) and the summary names
+// no bias; an explicit motion.gyro_bias wins over auto.
+TEST(Uncertainty, GyroBiasFromAStillStartIsUsedByDefault) {
+  const fs::path d = test::freshTempDir("unc_bias_auto");
+  const Vec3 bias(0.012, -0.021, 0.008);
+  writeStillStartSequence(d / "seq", bias);
+  const std::string common = " --threads 2 --methods celc --window-events 15000 ";
+  auto r = test::runCelc("run '" + kSample + "' -q -o '" + (d / "a").string() + "'" + common +
+                             "--set windows.t_end=0.05",
+                         d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The sample itself (0.3 s of IMU) has no still second: nothing subtracted, and the summary says why.
+  const std::string plain = test::readAll(d / "a" / "summary.md");
+  EXPECT_NE(plain.find("gyro bias: none subtracted; no still second in the IMU"), std::string::npos) << plain;
+  r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "b").string() + "'" + common +
+                        "--set windows.t_end=1.55",
+                    d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& [a, b] : sameWindows(d / "a", d / "b"))
+    EXPECT_LT((a.omega - b.omega).norm(), 2e-4) << "window " << a.window;
+  const std::string summary = test::readAll(d / "b" / "summary.md");
+  EXPECT_NE(summary.find("bias 0.01"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("subtracted: the mean over the first still second [0.000, 1.000] s"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("motion.gyro_bias_from_still: auto"), std::string::npos) << summary;
+  EXPECT_NE(r.err.find("gyro bias 0.01"), std::string::npos) << r.err;  // the log
+  EXPECT_NE(test::readAll(d / "b" / "config.yaml").find("gyro_bias_from_still: auto"), std::string::npos);
+  r = test::runCelc("info '" + (d / "seq").string() + "'", d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("gyro at rest:  mean 0.01"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("over the first still second [0.000, 1.000] s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(significant: celc run subtracts it by default)"), std::string::npos) << r.out;
+
+  r = test::runCelc("run '" + (d / "seq").string() + "' -q -o '" + (d / "c").string() + "'" + common +
+                        "--set windows.t_end=1.55 --set motion.gyro_bias_from_still=false",
+                    d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& [a, c] : sameWindows(d / "a", d / "c"))
+    EXPECT_NEAR((c.omega - a.omega).norm(), bias.norm(), 2e-4) << "window " << a.window;
+  const std::string raw = test::readAll(d / "c" / "summary.md");
+  EXPECT_EQ(raw.find("subtracted"), std::string::npos) << raw;
+
+  // An explicit motion.gyro_bias wins over auto.
+  r = test::runCelc("run '" + (d / "seq").string() + "' -q -o '" + (d / "e").string() + "'" + common +
+                        "--set windows.t_end=1.55 --set 'motion.gyro_bias=[0.012, -0.021, 0.0]'",
+                    d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& [a, e] : sameWindows(d / "a", d / "e"))
+    EXPECT_NEAR((e.omega - a.omega).norm(), 0.008, 2e-4) << "window " << a.window;
+  EXPECT_NE(test::readAll(d / "e" / "summary.md").find("subtracted: motion.gyro_bias"), std::string::npos);
   fs::remove_all(d);
 }

@@ -1,12 +1,14 @@
 // `celc info FILE|DIR`: what an event recording holds.
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 
 #include "celc/io/event_reader.hpp"
 #include "celc/pipeline/imu_still.hpp"
+#include "celc/pipeline/run_config.hpp"
 #include "commands.hpp"
 
 namespace celc::app {
@@ -60,12 +62,18 @@ int runInfo(const InfoArgs& a) {
     try {
       const StillSpan still = findFirstStill(openEventSource(a.path, o)->readImu());
       if (still.found)
-        std::printf("gyro at rest:  mean %.6f,%.6f,%.6f rad/s (IMU frame; std %.4f,%.4f,%.4f) over the first "
-                    "still second [%.3f, %.3f] s: an estimate of motion.gyro_bias\n",
-                    still.gyro_mean.x(), still.gyro_mean.y(), still.gyro_mean.z(), still.gyro_std.x(),
-                    still.gyro_std.y(), still.gyro_std.z(), still.t0, still.t1);
+        std::printf("gyro at rest:  mean %.6f,%.6f,%.6f rad/s (IMU frame; |mean| %.2f deg/s; std %.4f,%.4f,%.4f; "
+                    "accelerometer direction turns %.4f rad) over the first still second [%.3f, %.3f] s: an "
+                    "estimate of motion.gyro_bias%s\n",
+                    still.gyro_mean.x(), still.gyro_mean.y(), still.gyro_mean.z(),
+                    still.gyro_mean.norm() * 180.0 / M_PI, still.gyro_std.x(), still.gyro_std.y(),
+                    still.gyro_std.z(), still.accel_turn, still.t0, still.t1,
+                    still.significant(kStillBiasZ, kStillBiasMinRate)
+                        ? " (significant: celc run subtracts it by default)"
+                        : " (within the noise: celc run leaves it by default)");
       else
-        std::printf("gyro at rest:  no still second (gyro std <= 0.02 rad/s per axis, |accel| std <= 2%%)\n");
+        std::printf("gyro at rest:  no still second (%s)\n", still.refused.c_str());
+      if (!still.warning.empty()) std::printf("gyro warning:  %s\n", still.warning.c_str());
     } catch (const std::exception& e) {
       spdlog::warn("IMU not read for the still-second check: {}", e.what());
     }

@@ -190,6 +190,7 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows, dou
       ++s.ok;
       if (r->sigma_deg <= max_sigma_deg) {  // NaN (no sigma) is never kept
         ++s.kept;
+        s.kept_windows.push_back(r->window);
         if (r->has_v && r->v.norm() > 0) kept_sum += r->v.normalized();
         if (r->has_metrics) {
           ++s.kept_with_metrics;
@@ -214,6 +215,7 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows, dou
     s.kept_phi_mean = mean(kept_phi);
     s.kept_phi_median = median(kept_phi);
     if (s.kept > 0) s.kept_resultant_length = kept_sum.norm() / static_cast<double>(s.kept);
+    std::sort(s.kept_windows.begin(), s.kept_windows.end());
     if (!dirs.empty()) {
       s.resultant_length = sum.norm() / static_cast<double>(dirs.size());
       const Vec3 m = sum.norm() > 0 ? Vec3(sum.normalized()) : dirs.front();
@@ -222,6 +224,24 @@ std::vector<MethodSummary> summarize(const std::vector<WindowsCsvRow>& rows, dou
       s.spread_median = median(ang);
     }
     out.push_back(s);
+  }
+  return out;
+}
+
+std::string windowRanges(const std::vector<std::int64_t>& windows, std::size_t max_ranges) {
+  std::string out;
+  std::size_t ranges = 0;
+  for (std::size_t i = 0; i < windows.size();) {
+    std::size_t j = i;
+    while (j + 1 < windows.size() && windows[j + 1] <= windows[j] + 1) ++j;
+    if (ranges == max_ranges) {
+      out += ", ... (" + std::to_string(windows.size()) + " windows)";
+      break;
+    }
+    out += (out.empty() ? "" : ", ") + std::to_string(windows[i]);
+    if (windows[j] != windows[i]) out += "-" + std::to_string(windows[j]);
+    ++ranges;
+    i = j + 1;
   }
   return out;
 }
@@ -245,13 +265,14 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
   // The windows a user would keep: ok and a small enough uncertainty.
   const double thr = methods.empty() ? kDefaultKeepSigmaDeg : methods.front().max_sigma_deg;
   o << "\nThe windows a user would keep: status ok and sigma_deg <= " << fmt(thr, 1)
-    << " deg (rows without sigma_deg are not kept).\n\n"
-    << "| method | ok | kept | kept with ground truth | mean phi kept [rad] | median phi kept [rad] | R kept |\n"
-    << "|---|---|---|---|---|---|---|\n";
+    << " deg (rows without sigma_deg are not kept); kept windows: their indices (windows.csv column "
+       "window), the rows the kept columns describe.\n\n"
+    << "| method | ok | kept | kept with ground truth | mean phi kept [rad] | median phi kept [rad] | R kept | kept windows |\n"
+    << "|---|---|---|---|---|---|---|---|\n";
   for (const auto& m : methods)
     o << "| " << m.method << " | " << m.ok << " | " << m.kept << " | " << m.kept_with_metrics << " | "
       << fmt(m.kept_phi_mean) << " | " << fmt(m.kept_phi_median) << " | " << fmt(m.kept_resultant_length, 3)
-      << " |\n";
+      << " | " << (m.kept_windows.empty() ? std::string("-") : windowRanges(m.kept_windows)) << " |\n";
   return o.str();
 }
 

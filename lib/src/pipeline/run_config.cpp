@@ -9,6 +9,10 @@ namespace celc {
 
 std::string toString(OmegaSource source) { return source == OmegaSource::Gyro ? "gyro" : "fixed"; }
 
+std::string toString(StillBias mode) {
+  return mode == StillBias::Auto ? "auto" : mode == StillBias::On ? "true" : "false";
+}
+
 namespace {
 // "key: what; key: what; " of one section -> "section.key: what; ..."
 std::string inSection(const std::string& section, const std::string& problems) {
@@ -60,9 +64,9 @@ std::string RunConfig::validate() const {
     }
   if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
   if (!gyro_bias.allFinite()) e += "motion.gyro_bias must be finite; ";
-  if (gyro_bias_from_still && !gyro_bias.isZero(0.0))
+  if (gyro_bias_from_still == StillBias::On && !gyro_bias.isZero(0.0))
     e += "motion.gyro_bias_from_still: set with motion.gyro_bias (use one of them); ";
-  if (gyro_bias_from_still && omega_source != OmegaSource::Gyro)
+  if (gyro_bias_from_still == StillBias::On && omega_source != OmegaSource::Gyro)
     e += "motion.gyro_bias_from_still: needs motion.omega_source gyro; ";
   // One line: the problems joined by "; ", without the last separator.
   while (!e.empty() && (e.back() == ' ' || e.back() == ';')) e.pop_back();
@@ -93,9 +97,10 @@ void describe(FieldVisitor& v, RunConfig& c) {
     s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed"}, c.fixed_omega);
     s.field({"gyro_bias", "rad/s", "constant gyro bias, IMU frame, subtracted from every sample (celc info estimates it)"},
             c.gyro_bias);
-    s.field({"gyro_bias_from_still", "", "instead, the mean gyro rate over the recording's first still second "
-                                         "(an error without one)"},
-            c.gyro_bias_from_still);
+    s.enumeration({"gyro_bias_from_still", "",
+                   "the mean gyro rate over the recording's first still second as the bias: auto = when it is "
+                   "significant and gyro_bias is zero; true = always (an error without one); false = never"},
+                  c.gyro_bias_from_still, {StillBias::Auto, StillBias::On, StillBias::Off});
     describe(s, c.gyro);
   });
   describeClustering(v, c.cluster, c.observations.lines);

@@ -40,6 +40,8 @@ struct SequenceRunner::Impl {
   std::unique_ptr<UndistortLut> lut;
   GyroTrack gyro;
   Vec3 gyro_bias = Vec3::Zero();  ///< subtracted from every gyro sample [rad/s], IMU frame
+  std::string gyro_note;          ///< where gyro_bias comes from, when it is not zero
+  std::vector<std::string> notes; ///< the still-second check, when no bias came of it
   std::unique_ptr<GtVelocityEstimator> gt;
   std::size_t n_imu = 0, n_poses = 0;
   std::optional<WindowDumpContext> dump;  ///< dumpWindows()
@@ -201,18 +203,40 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     // The constant gyro bias (IMU frame) comes off every sample here, before
     // the track rotates the rates into the camera frame.
     m.gyro_bias = m.config.gyro_bias;
-    if (m.config.gyro_bias_from_still) {
+    if (!m.gyro_bias.isZero(0.0)) m.gyro_note = "motion.gyro_bias";
+    const StillBias from_still = m.config.gyro_bias_from_still;
+    if (from_still == StillBias::On || (from_still == StillBias::Auto && m.gyro_bias.isZero(0.0))) {
       const std::string imu_path = m.inputs.imu.empty() ? in.events : m.inputs.imu;
       const StillSpan still = findFirstStill(imu);
-      if (!still.found)
+      if (!still.warning.empty()) {
+        spdlog::warn("{}: {}", imu_path, still.warning);
+        m.notes.push_back("gyro at rest: " + still.warning);
+      }
+      const std::string span = still.found ? fmt::format("[{:.3f}, {:.3f}] s", still.t0, still.t1) : "";
+      if (from_still == StillBias::On && !still.found)
         throw std::runtime_error(imu_path + ": motion.gyro_bias_from_still: the IMU has no still second (" +
-                                 std::to_string(imu.size()) + " samples); set motion.gyro_bias instead");
-      if (still.gyro_mean.norm() > kMaxStillBias)
-        throw std::runtime_error(fmt::format(
-            "{}: motion.gyro_bias_from_still: the first still second ({:.2f}-{:.2f} s) turns at {:.3f} rad/s, "
-            "more than a bias ({:g} rad/s): a steadily turning camera, not one at rest",
-            imu_path, still.t0, still.t1, still.gyro_mean.norm(), kMaxStillBias));
-      m.gyro_bias = still.gyro_mean;
+                                 std::to_string(imu.size()) + " samples; " + still.refused +
+                                 "); set motion.gyro_bias instead");
+      if (from_still == StillBias::On) {
+        m.gyro_bias = still.gyro_mean;
+        m.gyro_note = "the mean over the first still second " + span + " (motion.gyro_bias_from_still: true)";
+      } else if (still.found && still.significant(kStillBiasZ, kStillBiasMinRate)) {
+        m.gyro_bias = still.gyro_mean;
+        m.gyro_note = fmt::format("the mean over the first still second {} (gyro std {:.4f},{:.4f},{:.4f} rad/s, "
+                                  "{} samples; motion.gyro_bias_from_still: auto, false keeps the raw rates)",
+                                  span, still.gyro_std.x(), still.gyro_std.y(), still.gyro_std.z(), still.samples);
+      } else if (still.found) {
+        m.notes.push_back(fmt::format(
+            "gyro bias: none subtracted; the first still second {} has a mean rate of {:.4f} rad/s, within the "
+            "noise (motion.gyro_bias_from_still: auto subtracts {} standard errors and {} rad/s or more)",
+            span, still.gyro_mean.norm(), kStillBiasZ, kStillBiasMinRate));
+      } else {
+        m.notes.push_back("gyro bias: none subtracted; no still second in the IMU (" + still.refused + ")");
+      }
+      for (const std::string& n : m.notes) spdlog::info("{}", n);
+      if (still.found && m.gyro_bias == still.gyro_mean)
+        spdlog::info("gyro bias {:.5f},{:.5f},{:.5f} rad/s (IMU frame) subtracted: {}", m.gyro_bias.x(),
+                     m.gyro_bias.y(), m.gyro_bias.z(), m.gyro_note);
     }
     if (!m.gyro_bias.isZero(0.0))
       for (ImuSample& sample : imu) sample.gyro -= m.gyro_bias;
@@ -250,14 +274,11 @@ std::vector<std::string> SequenceRunner::describe() const {
     d.push_back("angular velocity: fixed by the configuration (motion.fixed_omega)");
   else {
     std::string g = "gyroscope: " + std::to_string(m.n_imu) + " samples";
-    if (!m.gyro_bias.isZero(0.0)) {
-      std::ostringstream b;
-      b << ", bias " << m.gyro_bias.x() << "," << m.gyro_bias.y() << "," << m.gyro_bias.z()
-        << " rad/s (IMU frame" << (m.config.gyro_bias_from_still ? ", the first still second's mean" : "")
-        << ") subtracted";
-      g += b.str();
-    }
+    if (!m.gyro_bias.isZero(0.0))
+      g += fmt::format(", bias {:.5f},{:.5f},{:.5f} rad/s (IMU frame; {:.2f} deg/s) subtracted: {}", m.gyro_bias.x(),
+                       m.gyro_bias.y(), m.gyro_bias.z(), m.gyro_bias.norm() * 180.0 / M_PI, m.gyro_note);
     d.push_back(g);
+    d.insert(d.end(), m.notes.begin(), m.notes.end());
   }
   d.push_back(m.gt ? "ground truth: " + m.inputs.groundtruth + " (" + std::to_string(m.n_poses) + " poses)"
                    : std::string("ground truth: none (no metrics)"));

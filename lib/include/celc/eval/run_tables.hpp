@@ -88,7 +88,12 @@ struct MethodSummary {
   int kept_with_metrics = 0;
   double kept_phi_mean = NAN, kept_phi_median = NAN;   ///< [rad], over kept rows with ground truth
   double kept_resultant_length = NAN;                  ///< R over the kept rows
+  std::vector<std::int64_t> kept_windows;              ///< the kept rows' window indices, ascending
 };
+
+/// Window indices as ranges, "0-3, 7, 9-10"; after `max_ranges` ranges,
+/// ", ... (N windows)".
+std::string windowRanges(const std::vector<std::int64_t>& windows, std::size_t max_ranges = 20);
 
 /// Summaries in the order methods first appear.
 /// With max_sigma_deg finite, the ok rows whose sigma_deg exceeds it (or

@@ -13,6 +13,7 @@
 #include "celc/io/event_reader.hpp"
 #include "celc/io/imu_window.hpp"
 #include "celc/io/window_source.hpp"
+#include "celc/pipeline/imu_still.hpp"
 #include "celc/pipeline/window_policy.hpp"
 #include "celc/solver/solver.hpp"
 
@@ -25,11 +26,22 @@ enum class OmegaSource {
 };
 std::string toString(OmegaSource source);  ///< "gyro" | "fixed"
 
-/// The largest gyro bias taken from a still span [rad/s] (norm of the mean):
-/// the initial zero-rate offset of the InvenSense MPU-6x50 gyros in DAVIS
-/// cameras may reach 20 deg/s (0.35 rad/s) per axis; a span whose mean rate
-/// is larger is a camera turning at a constant rate, not one at rest.
-inline constexpr double kMaxStillBias = 0.35;
+/// Whether the gyro bias is taken from the recording's first still second
+/// (pipeline/imu_still.hpp; motion.gyro_bias_from_still).
+enum class StillBias {
+  Auto,  ///< when there is one and its mean rate is significant (kStillBiasZ, kStillBiasMinRate)
+  On,    ///< always; the run fails without a still second ("true")
+  Off,   ///< never ("false")
+};
+std::string toString(StillBias mode);  ///< "auto" | "true" | "false"
+
+/// StillBias::Auto subtracts a still second's mean rate when it stands out of
+/// the noise: on some axis at least kStillBiasZ standard errors
+/// (std / sqrt(samples)) from zero, and at least kStillBiasMinRate [rad/s]
+/// in norm (0.3 deg/s: below it a bias moves v by a few tenths of a degree,
+/// and slow drifts of the sensor's zero rate are of that size).
+inline constexpr double kStillBiasZ = 5.0;
+inline constexpr double kStillBiasMinRate = 0.005;
 
 struct RunConfig {
   ReaderOptions reader;
@@ -57,11 +69,12 @@ struct RunConfig {
   /// (SequenceRunner, where the gyro track is built). `celc info` reports the
   /// mean rate over the recording's first still second, an estimate of it.
   Vec3 gyro_bias = Vec3::Zero();
-  /// Instead, take the bias as the mean gyro rate over the recording's first
-  /// still second (pipeline/imu_still.hpp, what `celc info` reports); the
-  /// run fails when the recording has none, or when that mean exceeds
-  /// kMaxStillBias (a camera turning steadily, not at rest).
-  bool gyro_bias_from_still = false;
+  /// Or take the bias as the mean gyro rate over the recording's first still
+  /// second (pipeline/imu_still.hpp, what `celc info` reports): Auto (the
+  /// default) when there is one and its mean is significant (kStillBiasZ,
+  /// kStillBiasMinRate), unless gyro_bias is set; On always, the run failing
+  /// without a still second or with gyro_bias set; Off never.
+  StillBias gyro_bias_from_still = StillBias::Auto;
   GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;
