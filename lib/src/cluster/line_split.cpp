@@ -137,8 +137,10 @@ Parts splitCluster(const std::vector<LinePoint>& pts, double threshold, int min_
   auto& lines = result.lines;
   std::vector<std::size_t> rest(pts.size());
   std::iota(rest.begin(), rest.end(), std::size_t{0});
-  while (static_cast<int>(parts.size()) < max_parts && static_cast<int>(rest.size()) >= min_size &&
-         rest.size() >= 2 * kSample) {
+  // Each draw takes at least min_size events; shadows count as draws.
+  for (int draw = 0; draw < 2 * max_parts && static_cast<int>(parts.size()) < max_parts &&
+                     static_cast<int>(rest.size()) >= min_size && rest.size() >= 2 * kSample;
+       ++draw) {
     const std::size_t n = rest.size();
     std::vector<std::size_t> scored;
     const std::size_t stride = std::max<std::size_t>(1, n / kScored);

@@ -5,16 +5,21 @@
 /// Region growing joins what is locally smooth in (x, y, c t); where two
 /// edges meet (a corner, a junction) a region can grow from one edge's
 /// surface onto the other's. Under the window's rotation R(t) and a constant
-/// velocity, an edge's events satisfy n(t)^T R(t) f = 0 with a plane normal
-/// linear in time,
-///   n(t) = a + s(t) b,   s = (t - t_mid) / (t_end - t_begin),   |a| = 1,
-/// (the plane through the centre c(t) and the 3D line (P, d) has normal
-/// (P - c(t)) x d), so one cluster should be one such moving line. Each
-/// cluster is split by sequential RANSAC over moving lines: the line that
-/// explains the most events within `line_split_px` (pixel distance in the
-/// image of the camera at the event's time) becomes a cluster, then the next
-/// one among the rest, up to ClusterOptions::max_split; parts with fewer than
-/// min_cluster_size events, and the events no line explains, become noise.
+/// velocity in the reference frame, an edge's events satisfy n(t)^T R(t) f = 0
+/// with a plane normal linear in time (the plane through the centre c(t) and
+/// the 3D line (P, d) has normal (P - c(t)) x d); a constant body-frame
+/// velocity under rotation bends c(t), which a quadratic term takes:
+///   n(t) = a + s b + s^2 c,   s = (t - t_mid) / (t_end - t_begin),   |a| = 1.
+/// Each cluster is split by sequential RANSAC over such moving lines: samples
+/// of 5 events (one per fifth of the cluster's time) give lines linear in
+/// time, scored at 1.5 times `line_split_px` (pixel distance in the image of
+/// the camera at the event's time); the best is refitted with the quadratic
+/// term on its inliers at 3, 2, 1.5 and 1 times the threshold and its
+/// inliers become a cluster, then the next line among the rest, up to
+/// ClusterOptions::max_split parts (2 max_split draws). Parts with fewer than
+/// min_cluster_size events, a part within 3 thresholds (median) of an
+/// earlier one's line (the tails of its residuals), and the events no line
+/// explains become noise.
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
