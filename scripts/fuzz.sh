@@ -110,7 +110,7 @@ max_len_of() {
 
 # CI's executions per target: about 20 s each at the rates of a fresh corpus on
 # this machine (docs/robustness.md); the bag and HDF5 readers get as many as
-# the fewest of the others (15,000), at 50-120 s, their inputs being slower.
+# the fewest of the others (15,000: about 15 s each).
 ci_runs_of() {
   case "$1" in
     events_text) echo 20000 ;;
