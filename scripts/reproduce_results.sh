@@ -9,6 +9,7 @@
 #   sample      celc run data/sample_seq: sample.md, docs/images/sample_*.png
 #   sigma       scripts/sigma_calibration.sh: sigma_calibration.md, sigma_calibration_sim.md (5 min)
 #   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
+#   rotation    scripts/rotation_trust.sh: rotation_trust.md (pure rotation, calibration errors; 2 min)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
@@ -28,7 +29,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax clusters speeds studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -83,6 +84,10 @@ PY
     parallax)
       scripts/parallax_study.sh "$work/scenes" > "$work/parallax.txt"
       $tables table 1 < "$work/parallax.txt" | put parallax.md parallax "scripts/parallax_study.sh"
+      ;;
+    rotation)
+      scripts/rotation_trust.sh "$work/rotation" > "$work/rotation.txt"
+      $tables table 0 < "$work/rotation.txt" | put rotation_trust.md rotation "scripts/rotation_trust.sh"
       ;;
     clusters)
       scripts/cluster_table.sh "$work/clusters" > "$work/clusters.txt"
