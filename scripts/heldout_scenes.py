@@ -11,13 +11,23 @@ and 0.05-1 rad/s for 2 s, long enough for two windows of a second. Render
 them with `celc synth FILE -o DIR`.
 
     scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect]
-                              [--speed LO,HI] [--rate LO,HI]
+                              [--speed LO,HI] [--rate LO,HI] [--input-errors]
+
+--input-errors gives every scene the errors of a real sensor's inputs, drawn
+at the 1-sigma sizes of sigma_deg's default budget (docs/accuracy.md): the
+rendered IMU gets a gyro bias of N(0, 0.01) rad/s per axis and is turned
+N(0, 1) deg about each axis from the camera; OUTDIR/hNN_<base>.errors.json
+holds what the user's calibration then gets wrong (principal point N(0, 3)
+px per axis, focal length N(0, 1)%, gyro scale N(0, 1)% per axis, the IMU
+taken as aligned), which scripts/apply_input_errors.py applies to the
+rendered sequence. The scenes' motions are those drawn without the option.
 
 --speed [m/s] and --rate [rad/s] replace every kind's ranges (e.g. 1,1 for
 1 m/s at every scene).
 
 Writes OUTDIR/hNN_<base>.yaml and prints one line per scene (its motion)."""
 import argparse
+import json
 import math
 import os
 import random
@@ -68,6 +78,29 @@ def variant(rng, index, kind, base, speed_range=None, rate_range=None):
     return header + text, f"speed {speed:.2f} m/s v {v}, rotation {rate:.2f} rad/s w {w}, noise {noise}"
 
 
+def rotation_matrix(rx, ry, rz):
+    """Row-major R = Rz Ry Rx for small angles about x, y, z [rad]."""
+    cx, sx, cy, sy, cz, sz = math.cos(rx), math.sin(rx), math.cos(ry), math.sin(ry), math.cos(rz), math.sin(rz)
+    return [cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
+            sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx,
+            -sy, cy * sx, cy * cx]
+
+
+def input_errors(text, seed, index):
+    """The scene with a drawn gyro bias and IMU rotation, and the calibration errors (a dict)."""
+    rng = random.Random(seed * 7919 + index)
+    bias = [round(rng.gauss(0.0, 0.01), 5) for _ in range(3)]
+    angles = [rng.gauss(0.0, math.radians(1.0)) for _ in range(3)]
+    R = rotation_matrix(*angles)
+    text = set_key(text, r"^(\s*gyro_bias: )\[[^\]]*\]", str(bias))
+    text = set_key(text, r"^(\s*R_cam_imu: )\[[^\]]*\]", "[" + ", ".join("%.10f" % x for x in R) + "]")
+    errors = {"principal_point_px": [round(rng.gauss(0.0, 3.0), 3) for _ in range(2)],
+              "focal_share": round(rng.gauss(0.0, 0.01), 5),
+              "gyro_scale": [round(rng.gauss(0.0, 0.01), 5) for _ in range(3)],
+              "gyro_bias_rad_s": bias, "imu_rotation_deg": [round(math.degrees(x), 4) for x in angles]}
+    return text, errors
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("outdir")
@@ -77,6 +110,8 @@ def main():
                     help="bases, taken in turn: room, hand, rect, deep (default room,hand,rect)")
     ap.add_argument("--speed", help="speed range LO,HI [m/s] for every kind")
     ap.add_argument("--rate", help="rotation rate range LO,HI [rad/s] for every kind")
+    ap.add_argument("--input-errors", action="store_true",
+                    help="a real sensor's gyro and calibration errors (see above)")
     a = ap.parse_args()
 
     def pair(text, name):
@@ -103,6 +138,10 @@ def main():
         base = BASES[kind]
         text, motion = variant(rng, i, kind, base, speed_range, rate_range)
         name = f"h{i:02d}_{kind}"
+        if a.input_errors:
+            text, errors = input_errors(text, a.seed, i)
+            with open(os.path.join(a.outdir, name + ".errors.json"), "w") as f:
+                json.dump(errors, f, indent=1)
         with open(os.path.join(a.outdir, name + ".yaml"), "w") as f:
             f.write(text)
         print(f"{name}: {motion}")

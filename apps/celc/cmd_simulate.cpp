@@ -1,6 +1,7 @@
 // `celc simulate`: the paper's simulation study (CSV per sweep, plots, table).
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fmt/format.h>
@@ -68,9 +69,13 @@ void printSweepTable(const Sweep& sweep, const std::vector<SweepCell>& cells,
 
 // The uncertainty study: per setting and method the share of ok trials with
 // phi <= 2 sigma_deg (target 0.85-0.99), the median sigma, and how many ok
-// trials claim sigma < 10 deg. OUTDIR/sigma.csv holds the same.
+// trials claim sigma < 10 deg. OUTDIR/sigma.csv holds the same;
+// OUTDIR/sigma_trials.csv one row per ok trial and method (phi [rad],
+// sigma_deg, the window's D translation_px, sigma_rule), for
+// scripts/sigma_bins.py.
 void runSigmaStudy(const SimulateArgs& a, const SimulateConfig& cfg, const fs::path& out) {
   std::string csv = "sweep,level,method,trials,n_ok,covered_2sigma,share_2sigma,sigma_median_deg,ok_sigma_below_10deg\n";
+  std::string trials_csv = "sweep,level,method,status,phi,sigma_deg,translation_px,sigma_rule\n";
   std::cout << "\nUncertainty calibration: share of ok trials with phi <= 2 sigma_deg (ok trials; median "
                "sigma_deg; ok trials with sigma_deg < 10)\n\n| setting | level";
   for (Method m : cfg.methods) std::cout << " | " << toString(m);
@@ -89,11 +94,17 @@ void runSigmaStudy(const SimulateArgs& a, const SimulateConfig& cfg, const fs::p
                   << "; " << c.confident_10deg << ")";
         csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", c.sweep, c.level, toString(c.method), c.trials, c.n_ok,
                            c.covered_2sigma, share, c.sigma_median_deg, c.confident_10deg);
+        for (const SweepCell::SigmaSample& s : c.samples)
+          trials_csv += fmt::format("{},{},{},ok,{:.9g},{:.6g},{},{}\n", c.sweep, c.level, toString(c.method), s.phi,
+                                    s.sigma_deg,
+                                    std::isfinite(s.translation_px) ? fmt::format("{:.2f}", s.translation_px) : "",
+                                    s.sigma_rule);
       }
       std::cout << " |\n";
     }
   }
   writeFileAtomically((out / "sigma.csv").string(), csv);
+  writeFileAtomically((out / "sigma_trials.csv").string(), trials_csv);
   std::cout << std::flush;
 }
 

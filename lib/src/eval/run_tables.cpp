@@ -20,17 +20,22 @@ std::string windowsCsvHeaderV1() {
 
 std::string windowsCsvHeaderV2() { return windowsCsvHeaderV1() + ",reason,sigma_deg,parallax,n_lines,wx,wy,wz"; }
 std::string windowsCsvHeaderV3() { return windowsCsvHeaderV2() + ",translation_px"; }
-std::string windowsCsvHeader() {
+std::string windowsCsvHeaderV4() {
   return windowsCsvHeaderV3() + ",purity,impure_clusters,edges,edges_complete,coverage,noise_admitted,oracle_phi";
 }
+std::string windowsCsvHeader() { return windowsCsvHeaderV4() + ",sigma_fisher_deg,sigma_budget_deg,sigma_rule"; }
 
 std::string padWindowsCsvLine(const std::string& line) {
   std::string l = line;
   if (!l.empty() && l.back() == '\r') l.pop_back();
   const auto commas = std::count(l.begin(), l.end(), ',');
-  if (l.empty() || (commas != 15 && commas != 22 && commas != 23)) return line;
+  if (l.empty() || (commas != 15 && commas != 22 && commas != 23 && commas != 30)) return line;
   const std::string truth = ",,,,,,,";  // the seven truth columns
-  return l + (commas == 15 ? ",,,,,,,," + truth : commas == 22 ? "," + truth : truth);
+  const std::string parts = ",,,";      // sigma_deg's three parts
+  return l + (commas == 15   ? ",,,,,,,," + truth + parts
+              : commas == 22 ? "," + truth + parts
+              : commas == 23 ? truth + parts
+                             : parts);
 }
 
 namespace {
@@ -73,8 +78,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     if (!l.empty() && l.back() == '\r') l.pop_back();
     const std::string where = path + ":" + std::to_string(no);
     if (no == 1) {
-      if (l != windowsCsvHeader() && l != windowsCsvHeaderV3() && l != windowsCsvHeaderV2() &&
-          l != windowsCsvHeaderV1())
+      if (l != windowsCsvHeader() && l != windowsCsvHeaderV4() && l != windowsCsvHeaderV3() &&
+          l != windowsCsvHeaderV2() && l != windowsCsvHeaderV1())
         throw std::runtime_error(where + ": not a celc windows.csv header");
       continue;
     }
@@ -82,8 +87,8 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     const bool last = i + 1 == lines.size();
     const auto f = splitList(l, ',');
     try {
-      if (f.size() != 16 && f.size() != 23 && f.size() != 24 && f.size() != 31)
-        throw std::runtime_error(where + ": expected 16, 23, 24 or 31 columns, got " + std::to_string(f.size()));
+      if (f.size() != 16 && f.size() != 23 && f.size() != 24 && f.size() != 31 && f.size() != 34)
+        throw std::runtime_error(where + ": expected 16, 23, 24, 31 or 34 columns, got " + std::to_string(f.size()));
       WindowsCsvRow r;
       r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
       r.t_start = toDouble(f[1], where, "t_start");
@@ -114,7 +119,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
           r.omega = Vec3(toDouble(f[20], where, "wx"), toDouble(f[21], where, "wy"), toDouble(f[22], where, "wz"));
       }
       if (f.size() >= 24 && !f[23].empty()) r.translation_px = toDouble(f[23], where, "translation_px");
-      if (f.size() == 31 && !f[26].empty()) {
+      if (f.size() >= 31 && !f[26].empty()) {
         r.has_truth = true;
         if (!f[24].empty()) r.purity = toDouble(f[24], where, "purity");
         r.impure_clusters = static_cast<int>(toDouble(f[25], where, "impure_clusters"));
@@ -123,6 +128,11 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         if (!f[28].empty()) r.coverage = toDouble(f[28], where, "coverage");
         if (!f[29].empty()) r.noise_admitted = toDouble(f[29], where, "noise_admitted");
         if (!f[30].empty()) r.oracle_phi = toDouble(f[30], where, "oracle_phi");
+      }
+      if (f.size() == 34) {
+        if (!f[31].empty()) r.sigma_fisher_deg = toDouble(f[31], where, "sigma_fisher_deg");
+        if (!f[32].empty()) r.sigma_budget_deg = toDouble(f[32], where, "sigma_budget_deg");
+        r.sigma_rule = f[33];
       }
       rows.push_back(r);
     } catch (const std::runtime_error&) {

@@ -193,9 +193,13 @@ Vec3 MotionModel::meanOmega(double t0, double t1) const {
 }
 
 MotionModel MotionModel::withOmegaOffset(const Vec3& delta) const {
-  if (kind_ == MotionModelKind::ConstantTwist) return constantTwist(omega_ + delta, t_ref_);
+  return withRateTransform(Mat3::Identity(), delta);
+}
+
+MotionModel MotionModel::withRateTransform(const Mat3& A, const Vec3& delta) const {
+  if (kind_ == MotionModelKind::ConstantTwist) return constantTwist(A * omega_ + delta, t_ref_);
   std::vector<Vec3> rates = rates_;
-  for (auto& r : rates) r += delta;
+  for (auto& r : rates) r = A * r + delta;
   return gyroIntegrated(times_, rates, t_ref_, frame_);
 }
 

@@ -79,6 +79,12 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     } else {
       o << ",,,,,,";
     }
+    // sigma_deg's parts: sigma_fisher_deg,sigma_budget_deg,sigma_rule.
+    o << ",";
+    if (r.ok() && !std::isnan(r.sigma_fisher_deg)) o << std::setprecision(4) << r.sigma_fisher_deg;
+    o << ",";
+    if (r.ok() && !std::isnan(r.sigma_budget_deg)) o << std::setprecision(4) << r.sigma_budget_deg;
+    o << "," << (r.ok() ? r.sigma_rule : std::string());
     lines.push_back(o.str());
   }
   return lines;

@@ -8,6 +8,7 @@
 
 #include "celc/eval/statistics.hpp"
 #include "celc/pipeline/study_engine.hpp"
+#include "celc/pipeline/window_policy.hpp"
 
 namespace celc {
 namespace {
@@ -22,6 +23,14 @@ std::vector<double> range(double from, double to, double step) {
 void meanStd(const std::vector<double>& x, double& m, double& stdev) {
   m = mean(x);
   stdev = sampleStd(x);
+}
+
+/// The solver options with the scene's own gyro error, a constant rate
+/// error of omega_noise per axis, added in quadrature to sigma_deg's budget.
+SolverOptions withSceneBudget(SolverOptions solver, const LineSceneOptions& scene) {
+  UncertaintyOptions& u = solver.uncertainty;
+  u.gyro_bias_rad_s = std::hypot(u.gyro_bias_rad_s, scene.omega_noise);
+  return solver;
 }
 
 }  // namespace
@@ -104,8 +113,10 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
         sweep.apply(scene, sweep.levels[level]);
         const LineSceneTrial tr = generateLineScene(scene, rng);
         const SampleSeeds seeds{rng(), config.solver.refine.seed};
-        const auto res = solveMethods(tr.observations, tr.given_motion, config.methods, config.solver, seeds);
+        const auto res =
+            solveMethods(tr.observations, tr.given_motion, config.methods, withSceneBudget(config.solver, scene), seeds);
         TrialOutcome out;
+        out.translation_px = lineTranslationPx(tr.observations, tr.given_motion, 0.0, scene.duration);
         if (tr.true_direction.norm() > 0.5) {
           out.methods = scoreResults(res, tr.true_direction);
         } else if (sweep.score_without_truth) {
@@ -123,8 +134,12 @@ std::vector<SweepCell> runSweep(const Sweep& sweep, const SimulateConfig& config
     for (int m = 0; m < n_methods; ++m) {
       SweepCell c;
       std::vector<double> sig;
-      for (const MethodOutcome& o : outcomes.methodOutcomes(static_cast<size_t>(level), m)) {
+      for (int t = 0; t < n_trials; ++t) {
+        const TrialOutcome& trial = outcomes.trial(static_cast<size_t>(level), t);
+        if (static_cast<size_t>(m) >= trial.methods.size()) continue;
+        const MethodOutcome& o = trial.methods[static_cast<size_t>(m)];
         if (!o.ok) continue;
+        c.samples.push_back({o.phi, o.sigma_deg, trial.translation_px, o.sigma_rule});
         sig.push_back(o.sigma_deg);
         if (o.phi <= 2.0 * o.sigma_deg * M_PI / 180.0) ++c.covered_2sigma;
         if (o.sigma_deg < 10.0) ++c.confident_10deg;

@@ -29,6 +29,7 @@ std::vector<MethodOutcome> scoreResults(const std::vector<SolverResult>& results
     o.phi_sign_agnostic = e.phi_sign_agnostic;
     o.time_us = r.time_us;
     o.sigma_deg = r.sigma_deg;
+    o.sigma_rule = r.sigma_rule;
   }
   return out;
 }

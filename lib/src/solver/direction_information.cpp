@@ -33,7 +33,8 @@ M pinvSymmetric(const M& A) {
 
 }  // namespace
 
-DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events)
+DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events,
+                               const BearingChange* bearing_change)
     : focal_px_(obs.focal_px) {
   detail::borrowThreadVector<DirectionTerms>(terms_);
   std::size_t total = 0;
@@ -49,7 +50,9 @@ DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel&
       if (!std::isfinite(c.times[k]) || !c.bearings[k].allFinite()) continue;
       Mat3 Rk, Pk;
       motion.pose(c.times[k], Rk, Pk);
-      terms_.push_back(makeEventTerm(fr, Rk, Pk, c.bearings[k]));
+      Vec3 f = c.bearings[k];
+      if (bearing_change) f.head<2>() = bearing_change->scale * f.head<2>() + bearing_change->offset;
+      terms_.push_back(makeEventTerm(fr, Rk, Pk, f));
     }
     begin_.push_back(terms_.size());
     m1_.push_back(fr.m1.normalized());
@@ -102,6 +105,49 @@ DirectionInformation DirectionTerms::information(const Vec3& direction, bool kee
   }
   out.ok = true;
   return out;
+}
+
+Eigen::Vector2d DirectionTerms::shift(const Vec3& direction, const DirectionTerms& changed) const {
+  const Eigen::Vector2d invalid = Eigen::Vector2d::Constant(NAN);
+  if (changed.begin_ != begin_ || !direction.allFinite() || !(direction.norm() > 0.0) || !(focal_px_ > 0.0))
+    return invalid;
+  const Vec3 v = direction.normalized();
+  const Mat32 Bv = tangentBasis(v);
+  Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  for (size_t c = 0; c < m1_.size(); ++c) {
+    const Vec3& m1 = m1_[c];
+    const Vec3& m3 = m3_[c];
+    const Mat32 B1 = tangentBasis(m1), B3 = tangentBasis(m3);
+    Eigen::Matrix2d Ivv = Eigen::Matrix2d::Zero();
+    Mat24 Ivl = Mat24::Zero();
+    Mat4 Ill = Mat4::Zero();
+    Eigen::Vector2d av = Eigen::Vector2d::Zero();
+    Eigen::Vector4d al = Eigen::Vector4d::Zero();
+    for (size_t k = begin_[c]; k < begin_[c + 1]; ++k) {
+      Vec3 gv, g1, g3;
+      const double d = eventDistance(terms_[k], v, m1, m3, focal_px_, &gv, &g1, &g3);
+      const double d_changed = eventDistance(changed.terms_[k], v, m1, m3, focal_px_, nullptr, nullptr, nullptr);
+      if (!std::isfinite(d) || !std::isfinite(d_changed) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite())
+        continue;
+      const Eigen::Vector2d jv = Bv.transpose() * gv;
+      Eigen::Vector4d jl;
+      jl << B1.transpose() * g1, B3.transpose() * g3;
+      const double g = d_changed - d;
+      Ivv += jv * jv.transpose();
+      Ivl += jv * jl.transpose();
+      Ill += jl * jl.transpose();
+      av += jv * g;
+      al += jl * g;
+    }
+    const Mat4 Ill_pinv = pinvSymmetric(Ill);
+    S += Ivv - Ivl * Ill_pinv * Ivl.transpose();
+    b += av - Ivl * Ill_pinv * al;
+  }
+  S = 0.5 * (S + S.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+  if (!(es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(1), 1e-300))) return invalid;
+  return -S.inverse() * b;
 }
 
 double DirectionTerms::sigmaDeg(const Vec3& direction, double scale) const {

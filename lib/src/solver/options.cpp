@@ -74,6 +74,12 @@ std::string UncertaintyOptions::validate() const {
       e += "uncertainty.scale_* must be finite and >= 0; ";
       break;
     }
+  if (!(gyro_bias_rad_s >= 0.0 && gyro_bias_rad_s <= 1.0)) e += "uncertainty.gyro_bias_rad_s must be in [0, 1]; ";
+  if (!(gyro_scale >= 0.0 && gyro_scale <= 0.5)) e += "uncertainty.gyro_scale must be in [0, 0.5]; ";
+  if (!(imu_rotation_deg >= 0.0 && imu_rotation_deg <= 30.0)) e += "uncertainty.imu_rotation_deg must be in [0, 30]; ";
+  if (!(principal_point_px >= 0.0 && principal_point_px <= 100.0))
+    e += "uncertainty.principal_point_px must be in [0, 100]; ";
+  if (!(focal_share >= 0.0 && focal_share <= 0.5)) e += "uncertainty.focal_share must be in [0, 0.5]; ";
   return e;
 }
 

@@ -136,6 +136,8 @@ void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"agreement", "", "sigma_deg at least the angle to a celc / celc_opt / celc_ml estimate of the window that "
                             "disagrees beyond 2 sigma"},
           o.agreement);
+  v.field({"agreement_celc_ml", "", "the agreement rule raises celc_ml's sigma_deg too (off: celc_ml only witnesses)"},
+          o.agreement_celc_ml);
   v.field({"witness_rows", "rows",
            "with agreement: one more witness, celc on a second random subset of this many rows (0 = none)"},
           o.witness_rows);
@@ -149,6 +151,15 @@ void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"scale_celc_ml", "-", "... for celc_ml"}, o.scale_celc_ml);
   v.field({"scale_ce3lc", "-", "... for ce3lc"}, o.scale_ce3lc);
   v.field({"scale_npt", "-", "... for npt"}, o.scale_npt);
+  v.field({"gyro_bias_rad_s", "rad/s",
+           "budget: 1-sigma gyroscope bias per axis, propagated to sigma_deg (0 = left out; docs/accuracy.md)"},
+          o.gyro_bias_rad_s);
+  v.field({"gyro_scale", "-", "budget: 1-sigma gyroscope scale error per axis"}, o.gyro_scale);
+  v.field({"imu_rotation_deg", "deg", "budget: 1-sigma IMU-camera rotation error about each axis"},
+          o.imu_rotation_deg);
+  v.field({"principal_point_px", "px", "budget: 1-sigma principal point error per image axis"},
+          o.principal_point_px);
+  v.field({"focal_share", "-", "budget: 1-sigma relative focal length error"}, o.focal_share);
 }
 
 void describe(FieldVisitor& v, SolverOptions& o) {
@@ -156,7 +167,7 @@ void describe(FieldVisitor& v, SolverOptions& o) {
   v.section({"refine", "", "Ceres refinement (celc_opt, celc_ml)"}, [&](FieldVisitor& s) { describe(s, o.refine); });
   v.section({"npt", "", "N-point linear solver (Gao et al. 2024)"}, [&](FieldVisitor& s) { describe(s, o.npt); });
   v.section({"ml", "", "celc_ml: joint refinement of v and the lines"}, [&](FieldVisitor& s) { describe(s, o.ml); });
-  v.section({"uncertainty", "", "sigma_deg per estimate (Fisher information at the estimate)"},
+  v.section({"uncertainty", "", "sigma_deg per estimate (Fisher information at the estimate and a model-error budget)"},
             [&](FieldVisitor& s) { describe(s, o.uncertainty); });
   v.field({"check_parallax", "", "degenerate (no parallax) windows are detected once per window"},
           o.check_parallax);

@@ -8,6 +8,7 @@
 
 #include "ce3lc.hpp"
 #include "celc/solver/direction_information.hpp"
+#include "celc/solver/error_budget.hpp"
 #include "celc/solver/npt.hpp"
 #include "celc/solver/solver.hpp"
 #include "celc_linear.hpp"
@@ -28,16 +29,21 @@ constexpr std::uint64_t kWitnessSeed = 0x9e3779b97f4a7c15ULL;
 
 /// sigma_i at least the largest angle to a disagreeing witness
 /// (UncertaintyOptions::agreement). `witnesses` holds estimates with their
-/// Fisher sigma_deg; `self` is i's own witness index or -1.
+/// sigma parts; `self` is i's own witness index or -1. The test compares the
+/// Fisher parts alone: the budget's errors move every estimate alike.
 void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResult>& witnesses) {
   const double sigma = r.sigma_deg;
   double raised = sigma;
   for (size_t j = 0; j < witnesses.size(); ++j) {
     if (static_cast<int>(j) == self) continue;
     const double angle_deg = angleBetweenSignAgnostic(r.v, witnesses[j].v) * 180.0 / M_PI;
-    if (angle_deg > 2.0 * std::hypot(sigma, witnesses[j].sigma_deg)) raised = std::max(raised, angle_deg);
+    if (angle_deg > 2.0 * std::hypot(r.sigma_fisher_deg, witnesses[j].sigma_fisher_deg))
+      raised = std::max(raised, angle_deg);
   }
-  r.sigma_deg = raised;
+  if (raised > sigma) {
+    r.sigma_deg = raised;
+    r.sigma_rule = "disagreement";
+  }
 }
 
 /// LinearOptions::answer_when_observable: a linear method's ambiguous
@@ -234,8 +240,23 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
   auto floorBehind = [&]() {
     for (size_t i = 0; i < out.size(); ++i)
-      if (behind[i]) out[i].sigma_deg = std::max(out[i].sigma_deg, kRandomDirectionRmsDeg);
+      if (behind[i] && out[i].sigma_deg < kRandomDirectionRmsDeg) {
+        out[i].sigma_deg = kRandomDirectionRmsDeg;
+        out[i].sigma_rule = "behind_camera";
+      }
     return out;
+  };
+  // The model-error budget, formed once for every direction asked about.
+  std::optional<ErrorBudget> budget;
+  auto budgetDeg = [&](const Vec3& v) {
+    if (!budget) budget.emplace(obs, motion, u);
+    return budget->sources() == 0 ? 0.0 : budget->sigmaDeg(terms(), v);
+  };
+  // The Fisher value times `scale` and the budget in quadrature.
+  auto sigmaOf = [&](SolverResult& r, double scale) {
+    r.sigma_fisher_deg = terms().sigmaDeg(r.v, scale);
+    r.sigma_budget_deg = budgetDeg(r.v);
+    r.sigma_deg = std::isnan(r.sigma_budget_deg) ? INFINITY : std::hypot(r.sigma_fisher_deg, r.sigma_budget_deg);
   };
   // What every method shares (the window's verdict), and each estimate's
   // uncertainty at its own direction.
@@ -253,7 +274,11 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
     }
-    r.sigma_deg = std::max(terms().sigmaDeg(r.v, scale), sigma_floor_deg[i]);
+    sigmaOf(r, scale);
+    if (sigma_floor_deg[i] > r.sigma_deg) {
+      r.sigma_deg = sigma_floor_deg[i];
+      r.sigma_rule = "ambiguous_nullspace";
+    }
   }
   if (!u.enabled || !u.agreement) return floorBehind();
   // The witnesses: the ok estimates of the celc family with their Fisher
@@ -272,7 +297,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
   }
   if (!celc_asked && have_linear && linear.ok()) {
     SolverResult w = linear;
-    w.sigma_deg = terms().sigmaDeg(w.v, u.scale_celc);
+    sigmaOf(w, u.scale_celc);
     if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
   }
   if (u.witness_rows > 0 && have_linear) {
@@ -282,12 +307,13 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     subset.max_rows = u.witness_rows;
     SolverResult w = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
     if (w.ok()) {
-      w.sigma_deg = terms().sigmaDeg(w.v, u.scale_celc);
+      sigmaOf(w, u.scale_celc);
       if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
     }
   }
   for (size_t i = 0; i < out.size(); ++i)
-    if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], witness_of[i], witnesses);
+    if (out[i].ok() && std::isfinite(out[i].sigma_deg) && (methods[i] != Method::CelcMl || u.agreement_celc_ml))
+      raiseToDisagreement(out[i], witness_of[i], witnesses);
   return floorBehind();
 }
 

@@ -16,7 +16,14 @@ namespace celc {
 /// `celc simulate` configuration: the scene, the solvers and the study.
 struct SimulateConfig {
   LineSceneOptions scene;
-  SolverOptions solver;
+  /// The library's solver defaults with an empty model-error budget: the
+  /// simulated calibration is exact, and each trial's own gyro error
+  /// (scene.omega_noise) is added to gyro_bias_rad_s (runSweep).
+  SolverOptions solver = [] {
+    SolverOptions s;
+    s.uncertainty.clearBudget();
+    return s;
+  }();
   std::vector<Method> methods = allMethods();
   int trials = 500;
   std::uint64_t seed = 1;

@@ -16,16 +16,19 @@ namespace celc {
 /// The header of windows.csv: the 16 columns of the first format, then the
 /// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px,
 /// then the truth columns purity,impure_clusters,edges,edges_complete,
-/// coverage,noise_admitted,oracle_phi (docs/running.md).
+/// coverage,noise_admitted,oracle_phi, then sigma_deg's parts
+/// sigma_fisher_deg,sigma_budget_deg,sigma_rule (docs/running.md).
 std::string windowsCsvHeader();
+/// The header of files written without sigma_deg's parts (still read).
+std::string windowsCsvHeaderV4();
 /// The header of files written without the truth columns (still read).
 std::string windowsCsvHeaderV3();
 /// The header of files written before translation_px (still read).
 std::string windowsCsvHeaderV2();
 /// The header of files written before the quality columns (still read).
 std::string windowsCsvHeaderV1();
-/// A row of an earlier format (16, 23 or 24 columns) padded with empty
-/// quality and truth columns; other lines are returned as they are.
+/// A row of an earlier format (16, 23, 24 or 31 columns) padded with empty
+/// quality, truth and sigma-part columns; other lines are returned as they are.
 std::string padWindowsCsvLine(const std::string& line);
 
 struct WindowsCsvRow {
@@ -40,6 +43,9 @@ struct WindowsCsvRow {
   // Quality columns (empty in files of the first format).
   std::string reason;           ///< degeneracy or failure reason; empty when ok
   double sigma_deg = NAN;       ///< standard deviation of the direction [deg]; NaN: none
+  double sigma_fisher_deg = NAN;  ///< its Fisher part (times the method's factor) [deg]
+  double sigma_budget_deg = NAN;  ///< its model-error budget part [deg]
+  std::string sigma_rule;         ///< the rule that raised it, empty when none
   double parallax = NAN;        ///< the window's parallax ratio [-]; NaN: none
   int n_lines = -1;             ///< usable clusters; -1: none
   bool has_omega = false;

@@ -94,6 +94,9 @@ class MotionModel {
   /// The same model with a different constant rate (ConstantTwist) or with all
   /// rate samples shifted by delta (GyroIntegrated): used to perturb the gyroscope.
   MotionModel withOmegaOffset(const Vec3& delta) const;
+  /// The same model with every rate w replaced by A w + delta (a gyroscope's
+  /// scale, misalignment and bias errors; solver/error_budget.hpp).
+  MotionModel withRateTransform(const Mat3& A, const Vec3& delta) const;
 
  private:
   MotionModelKind kind_ = MotionModelKind::ConstantTwist;

@@ -55,6 +55,13 @@ struct SweepCell {
   int covered_2sigma = 0;
   int confident_10deg = 0;
   double sigma_median_deg = NAN;  ///< median sigma_deg of the ok trials
+  /// Per ok trial: phi [rad], sigma_deg, the trial's D [px] and the rule that
+  /// raised sigma_deg (the sigma study's per-trial table).
+  struct SigmaSample {
+    double phi = 0.0, sigma_deg = NAN, translation_px = NAN;
+    std::string sigma_rule;
+  };
+  std::vector<SigmaSample> samples;
 };
 
 /// Runs every level of a sweep with `threads` workers (0 = all cores).

@@ -36,6 +36,7 @@ struct MethodOutcome {
   double phi_sign_agnostic = 0.0;  ///< min(phi, pi - phi) [rad]
   double time_us = 0.0;            ///< solver time of the method
   double sigma_deg = NAN;          ///< the estimate's standard deviation [deg] (SolverResult)
+  std::string sigma_rule;          ///< the rule that raised sigma_deg (SolverResult)
 };
 
 /// One trial: an outcome per method (in the study's method order; missing
@@ -44,6 +45,7 @@ struct MethodOutcome {
 struct TrialOutcome {
   std::vector<MethodOutcome> methods;
   double reference = NAN;
+  double translation_px = NAN;  ///< the window's D (pipeline/window_policy.hpp) [px], where measured
 };
 
 /// Scores every result against the true unit direction: ok results get

@@ -49,10 +49,19 @@ DirectionInformation directionInformation(const WindowObservations& obs, const M
 /// direction: each usable cluster's frame and its events' terms (one pose of
 /// the motion model per event), built once for the several directions a
 /// window's estimates ask about.
+/// A change of every bearing (x, y, 1) to (scale x + offset_x, scale y + offset_y, 1):
+/// a calibration error (principal point offset / focal, focal share).
+struct BearingChange {
+  double scale = 1.0;
+  Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+};
+
 class DirectionTerms {
  public:
-  /// `max_events` as for directionInformation.
-  DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events = 0);
+  /// `max_events` as for directionInformation; `bearing_change` applied to
+  /// every event's bearing (null: none).
+  DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events = 0,
+                 const BearingChange* bearing_change = nullptr);
   ~DirectionTerms();
   DirectionTerms(const DirectionTerms&) = delete;
   DirectionTerms& operator=(const DirectionTerms&) = delete;
@@ -61,6 +70,13 @@ class DirectionTerms {
   DirectionInformation information(const Vec3& direction, bool keep_residuals = false) const;
   /// directionSigmaDeg(obs, motion, direction, scale, max_events).
   double sigmaDeg(const Vec3& direction, double scale) const;
+  /// The first-order shift of the maximum-likelihood direction [rad, tangent
+  /// basis of `direction`] when the measurements change from these terms to
+  /// `changed`'s (the same window and max_events, another motion model or
+  /// bearing change), the lines re-estimated: with g_k the change of event
+  /// k's residual at the fixed estimate, shift = -S^-1 sum_c (J_v,c^T g_c -
+  /// I_vl,c I_ll,c^+ J_l,c^T g_c). NaN when S is singular or the events differ.
+  Eigen::Vector2d shift(const Vec3& direction, const DirectionTerms& changed) const;
 
  private:
   /// Cluster c's events: terms_[begin_[c], begin_[c + 1]); its plane

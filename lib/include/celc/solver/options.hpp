@@ -236,6 +236,8 @@ struct MlOptions {
 /// (direction_information.hpp), times a per-method factor. The factors
 /// calibrate the Fisher value (the ML bound) to each method's actual spread,
 /// so that about 9 in 10 windows have phi <= 2 sigma (docs/accuracy.md).
+/// The budget terms add what the Fisher value cannot see of a gyroscope's and
+/// a calibration's errors: sigma_deg = sqrt((factor sigma_F)^2 + sigma_B^2).
 ///
 /// The Fisher value sees the noise, not a model that fails (a rotation that
 /// is not constant, clusters that mix edges, a wrong basin): with
@@ -250,6 +252,11 @@ struct MlOptions {
 struct UncertaintyOptions {
   bool enabled = true;          ///< compute sigma_deg (off: NaN)
   bool agreement = true;        ///< raise sigma_deg to the angle to a disagreeing witness
+  /// The agreement rule raises celc_ml's sigma_deg too. Off: celc_ml
+  /// witnesses for the others but keeps its own sigma_deg (its basins are
+  /// screened; on rendered windows the rule widened it without covering more,
+  /// docs/decisions.md).
+  bool agreement_celc_ml = false;
   /// > 0 (with agreement): one more witness, the linear celc estimate on a
   /// second random subset of this many rows [rows]. Where the linear cost is
   /// flat (model errors: impure clusters, an accelerating camera) such
@@ -268,6 +275,16 @@ struct UncertaintyOptions {
   double scale_celc_ml = 1.0;   ///< [-] for celc_ml (the ML estimate: the Fisher value itself)
   double scale_ce3lc = 8.0;     ///< [-] for ce3lc (not calibrated: heavy-tailed errors)
   double scale_npt = 30.0;      ///< [-] for npt (not calibrated: heavy-tailed errors)
+  /// The model-error budget (solver/error_budget.hpp): 1-sigma sizes of the
+  /// errors the estimate takes as exact, propagated to the direction and
+  /// added in quadrature to the Fisher value. 0 leaves a source out.
+  double gyro_bias_rad_s = 0.01;    ///< [rad/s] per axis, a constant rate offset
+  double gyro_scale = 0.01;         ///< [-] per axis, a rate scale error
+  double imu_rotation_deg = 1.0;    ///< [deg] about each axis, the IMU-camera rotation
+  double principal_point_px = 3.0;  ///< [px] per image axis
+  double focal_share = 0.01;        ///< [-] relative focal length error
+  /// Every budget size 0: inputs known to be exact (simulated windows).
+  void clearBudget() { gyro_bias_rad_s = gyro_scale = imu_rotation_deg = principal_point_px = focal_share = 0.0; }
   std::string validate() const;  ///< empty when valid
 };
 

@@ -36,6 +36,15 @@ struct SolverResult {
   /// SolverOptions::uncertainty): set by solveMethods for ok results; +inf when
   /// the direction is unobservable at the estimate, NaN when not computed.
   double sigma_deg = NAN;
+  /// sigma_deg's parts [deg]: the Fisher value times the method's factor, and
+  /// the model-error budget (solver/error_budget.hpp); NaN when not computed.
+  double sigma_fisher_deg = NAN;
+  double sigma_budget_deg = NAN;
+  /// The rule that raised sigma_deg above hypot(sigma_fisher_deg,
+  /// sigma_budget_deg), empty when none: "disagreement" (another estimate of
+  /// the window disagrees), "behind_camera" (the clusters' cheirality votes
+  /// disagree), "ambiguous_nullspace" (the linear rows' own spread).
+  std::string sigma_rule;
   /// The window's measured parallax, shared by every method (solveMethods):
   /// the median over the clusters with >= 8 events of the ratio of the robust
   /// scales of the rotation-compensated events about one static line and about
