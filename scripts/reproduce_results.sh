@@ -7,7 +7,7 @@
 #   peers       celc simulate --study peers (500 trials, seed 1): peers.md, peers_*.png
 #   scenes      scripts/scene_table.sh: scenes.md, shipped_scenes.md (8 min)
 #   sample      celc run data/sample_seq: sample.md, docs/images/sample_*.png
-#   sigma       scripts/sigma_calibration.sh: sigma_calibration.md, sigma_calibration_sim.md (5 min)
+#   sigma       scripts/sigma_calibration.sh: sigma_calibration.md, _sim.md, _bins.md, images/sigma_reliability.png (12 min)
 #   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
 #   rotation    scripts/rotation_trust.sh: rotation_trust.md (pure rotation, calibration errors; 2 min)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
@@ -68,18 +68,12 @@ for name in "${names[@]}"; do
       cp "$work/sample/error.png" docs/images/sample_error.png
       ;;
     sigma)
-      scripts/sigma_calibration.sh "$work/sigma" > "$work/sigma.txt"
-      n=$($py -c "import sys; sys.path.insert(0, 'scripts'); import results_tables as r; \
-print(len(r.tables(open('$work/sigma.txt').read().splitlines())))")
-      $tables table $((n - 1)) < "$work/sigma.txt" | put sigma_calibration.md sigma "scripts/sigma_calibration.sh"
-      $py - "$work/sigma.txt" "$n" <<'PY' | put sigma_calibration_sim.md sigma "scripts/sigma_calibration.sh"
-import sys
-sys.path.insert(0, "scripts")
-import results_tables as r
-lines = open(sys.argv[1]).read().splitlines()
-spans = r.tables(lines)[: int(sys.argv[2]) - 1]
-print("\n\n".join("\n".join(lines[s:e]) for s, e in spans))
-PY
+      scripts/sigma_calibration.sh "$work/sigma" > /dev/null
+      put sigma_calibration_sim.md sigma "scripts/sigma_calibration.sh" < "$work/sigma/sim.md"
+      { echo "Coverage of sigma_deg by D:"; echo; cat "$work/sigma/compact.md"; } |
+        put sigma_calibration.md sigma "scripts/sigma_calibration.sh"
+      put sigma_calibration_bins.md sigma "scripts/sigma_calibration.sh" < "$work/sigma/bins.md"
+      cp "$work/sigma/reliability_rendered__input_errors.png" docs/images/sigma_reliability.png
       ;;
     parallax)
       scripts/parallax_study.sh "$work/scenes" > "$work/parallax.txt"

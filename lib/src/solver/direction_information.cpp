@@ -31,6 +31,9 @@ M pinvSymmetric(const M& A) {
   return es.eigenvectors() * D * es.eigenvectors().transpose();
 }
 
+/// DirectionTerms::shift leaves out events beyond this many robust scales.
+constexpr double kShiftInlierScales = 3.0;
+
 }  // namespace
 
 DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events,
@@ -113,6 +116,18 @@ Eigen::Vector2d DirectionTerms::shift(const Vec3& direction, const DirectionTerm
     return invalid;
   const Vec3 v = direction.normalized();
   const Mat32 Bv = tangentBasis(v);
+  // Events beyond kShiftInlierScales robust scales of their line at the
+  // estimate are left out, as the robust stages leave them: near a line with
+  // no image direction a residual's change is not first order.
+  std::vector<double> residuals;
+  residuals.reserve(terms_.size());
+  for (size_t c = 0; c < m1_.size(); ++c)
+    for (size_t k = begin_[c]; k < begin_[c + 1]; ++k) {
+      const double d = eventDistance(terms_[k], v, m1_[c], m3_[c], focal_px_, nullptr, nullptr, nullptr);
+      if (std::isfinite(d)) residuals.push_back(d);
+    }
+  if (residuals.empty()) return invalid;
+  const double limit = kShiftInlierScales * 1.4826 * detail::medianAbs(residuals);
   Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
   Eigen::Vector2d b = Eigen::Vector2d::Zero();
   for (size_t c = 0; c < m1_.size(); ++c) {
@@ -130,6 +145,7 @@ Eigen::Vector2d DirectionTerms::shift(const Vec3& direction, const DirectionTerm
       const double d_changed = eventDistance(changed.terms_[k], v, m1, m3, focal_px_, nullptr, nullptr, nullptr);
       if (!std::isfinite(d) || !std::isfinite(d_changed) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite())
         continue;
+      if (limit > 0.0 && std::abs(d) > limit) continue;
       const Eigen::Vector2d jv = Bv.transpose() * gv;
       Eigen::Vector4d jl;
       jl << B1.transpose() * g1, B3.transpose() * g3;

@@ -136,8 +136,10 @@ void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"agreement", "", "sigma_deg at least the angle to a celc / celc_opt / celc_ml estimate of the window that "
                             "disagrees beyond 2 sigma"},
           o.agreement);
-  v.field({"agreement_celc_ml", "", "the agreement rule raises celc_ml's sigma_deg too (off: celc_ml only witnesses)"},
-          o.agreement_celc_ml);
+  v.field({"linear_witness_refined", "",
+           "with agreement: a linear estimate (celc, the witness_rows subset) also raises celc_opt's and celc_ml's "
+           "sigma_deg (off: only celc_opt and celc_ml witness for each other)"},
+          o.linear_witness_refined);
   v.field({"witness_rows", "rows",
            "with agreement: one more witness, celc on a second random subset of this many rows (0 = none)"},
           o.witness_rows);

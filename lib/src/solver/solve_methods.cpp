@@ -29,13 +29,15 @@ constexpr std::uint64_t kWitnessSeed = 0x9e3779b97f4a7c15ULL;
 
 /// sigma_i at least the largest angle to a disagreeing witness
 /// (UncertaintyOptions::agreement). `witnesses` holds estimates with their
-/// sigma parts; `self` is i's own witness index or -1. The test compares the
+/// sigma parts, `counts` whether each may raise r; `self` is r's own witness
+/// index or -1. The test compares the
 /// Fisher parts alone: the budget's errors move every estimate alike.
-void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResult>& witnesses) {
+void raiseToDisagreement(SolverResult& r, int self, const std::vector<SolverResult>& witnesses,
+                         const std::vector<bool>& counts) {
   const double sigma = r.sigma_deg;
   double raised = sigma;
   for (size_t j = 0; j < witnesses.size(); ++j) {
-    if (static_cast<int>(j) == self) continue;
+    if (static_cast<int>(j) == self || !counts[j]) continue;
     const double angle_deg = angleBetweenSignAgnostic(r.v, witnesses[j].v) * 180.0 / M_PI;
     if (angle_deg > 2.0 * std::hypot(r.sigma_fisher_deg, witnesses[j].sigma_fisher_deg))
       raised = std::max(raised, angle_deg);
@@ -284,6 +286,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
   // The witnesses: the ok estimates of the celc family with their Fisher
   // sigma, and the linear celc estimate when celc itself was not asked for.
   std::vector<SolverResult> witnesses;
+  std::vector<bool> witness_linear;
   std::vector<int> witness_of(out.size(), -1);
   bool celc_asked = false;
   for (size_t i = 0; i < out.size(); ++i) {
@@ -294,11 +297,15 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       continue;
     witness_of[i] = static_cast<int>(witnesses.size());
     witnesses.push_back(out[i]);
+    witness_linear.push_back(m == Method::Celc);
   }
   if (!celc_asked && have_linear && linear.ok()) {
     SolverResult w = linear;
     sigmaOf(w, u.scale_celc);
-    if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
+    if (std::isfinite(w.sigma_deg)) {
+      witnesses.push_back(w);
+      witness_linear.push_back(true);
+    }
   }
   if (u.witness_rows > 0 && have_linear) {
     // The linear estimate again on another random subset of rows (a seed
@@ -308,12 +315,20 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     SolverResult w = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
     if (w.ok()) {
       sigmaOf(w, u.scale_celc);
-      if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
+      if (std::isfinite(w.sigma_deg)) {
+        witnesses.push_back(w);
+        witness_linear.push_back(true);
+      }
     }
   }
-  for (size_t i = 0; i < out.size(); ++i)
-    if (out[i].ok() && std::isfinite(out[i].sigma_deg) && (methods[i] != Method::CelcMl || u.agreement_celc_ml))
-      raiseToDisagreement(out[i], witness_of[i], witnesses);
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (!out[i].ok() || !std::isfinite(out[i].sigma_deg)) continue;
+    const bool refined = methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl;
+    std::vector<bool> counts(witnesses.size(), true);
+    if (refined && !u.linear_witness_refined)
+      for (size_t j = 0; j < witnesses.size(); ++j) counts[j] = !witness_linear[j];
+    raiseToDisagreement(out[i], witness_of[i], witnesses, counts);
+  }
   return floorBehind();
 }
 

@@ -75,7 +75,9 @@ class DirectionTerms {
   /// `changed`'s (the same window and max_events, another motion model or
   /// bearing change), the lines re-estimated: with g_k the change of event
   /// k's residual at the fixed estimate, shift = -S^-1 sum_c (J_v,c^T g_c -
-  /// I_vl,c I_ll,c^+ J_l,c^T g_c). NaN when S is singular or the events differ.
+  /// I_vl,c I_ll,c^+ J_l,c^T g_c), over the events within 3 robust scales
+  /// (1.4826 median |d|) of their line at the estimate. NaN when S is
+  /// singular or the events differ.
   Eigen::Vector2d shift(const Vec3& direction, const DirectionTerms& changed) const;
 
  private:

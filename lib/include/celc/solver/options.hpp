@@ -252,11 +252,11 @@ struct MlOptions {
 struct UncertaintyOptions {
   bool enabled = true;          ///< compute sigma_deg (off: NaN)
   bool agreement = true;        ///< raise sigma_deg to the angle to a disagreeing witness
-  /// The agreement rule raises celc_ml's sigma_deg too. Off: celc_ml
-  /// witnesses for the others but keeps its own sigma_deg (its basins are
-  /// screened; on rendered windows the rule widened it without covering more,
-  /// docs/decisions.md).
-  bool agreement_celc_ml = false;
+  /// A linear witness (celc's estimate, the witness_rows subset) raises
+  /// celc_opt's and celc_ml's sigma_deg too. Off: only the refined estimates
+  /// witness for each other; they start from the linear estimate, and moving
+  /// away from it is their refinement's work (docs/decisions.md).
+  bool linear_witness_refined = false;
   /// > 0 (with agreement): one more witness, the linear celc estimate on a
   /// second random subset of this many rows [rows]. Where the linear cost is
   /// flat (model errors: impure clusters, an accelerating camera) such
