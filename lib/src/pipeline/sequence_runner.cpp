@@ -435,7 +435,9 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   EventWindow window;
   ParallaxWindowJoiner joiner(source, cfg.parallax, cfg.windows.partial_min_share,
                               [&](double t0, double t1, const std::vector<Event>& events) {
+                                const auto t_probe = Clock::now();
                                 const double d = m.probeTranslation(t0, t1, events);
+                                stats.seconds_probing += secondsSince(t_probe);
                                 spdlog::debug("parallax window at {:.3f} s: {:.3f} s, {} events: D = {:.1f} px", t0,
                                               t1 - t0, events.size(), d);
                                 return d;
@@ -507,6 +509,12 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   stats.reader_warnings = m.reader->warnings().total();
   stats.tail = parallax ? joiner.tail() : source.tail();
   stats.seconds_total = secondsSince(start);
+  const StageTimes& st = stats.stage_seconds;
+  spdlog::debug("stage seconds: reading {:.3f} (of which parallax probes {:.3f}), clustering {:.3f}, "
+                "undistortion+lines {:.3f}, solvers {:.3f}, ground truth {:.3f}, truth labels {:.3f}; "
+                "{} events in {:.3f} s",
+                stats.seconds_reading, stats.seconds_probing, st.cluster, st.lines, st.solve, st.groundtruth,
+                st.truth, stats.events_processed, stats.seconds_total);
   return stats;
 }
 

@@ -95,6 +95,7 @@ struct RunStats {
   std::uint64_t windows_read = 0, windows_processed = 0;
   std::uint64_t events_read = 0, events_processed = 0;
   double seconds_total = 0.0, seconds_reading = 0.0;
+  double seconds_probing = 0.0;  ///< of seconds_reading: the parallax policy's probes (clustering subsets)
   StageTimes stage_seconds;  ///< summed over windows
   std::uint64_t reader_warnings = 0;
   std::uint64_t clusters_line_fit_failed = 0;  ///< summed WindowRecord::n_line_fit_failed
