@@ -131,9 +131,11 @@ class SequenceRunner {
   /// for the last window, cut by the end of the data); nullopt for the other
   /// policies. With the parallax policy a window whose D (the probe's, else
   /// the whole window's) is below windows.no_parallax_px is degenerate
-  /// (no_parallax) for every method.
+  /// (no_parallax) for every method. cluster_threads > 0: the threads of the
+  /// window's clustering instead of cluster.threads (the clusters do not
+  /// depend on it; run() gives a window the workers that have nothing left to do).
   WindowRecord processWindow(std::uint64_t index, double t0, double t1, const std::vector<Event>& events,
-                             std::optional<double> probe_px = std::nullopt) const;
+                             std::optional<double> probe_px = std::nullopt, int cluster_threads = 0) const;
 
   /// Also write every clustered window for `celc solve` (window_dump.hpp)
   /// into context.dir; context.calib, gyro_integrated and seed are filled
