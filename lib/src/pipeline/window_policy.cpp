@@ -154,7 +154,7 @@ void ParallaxWindowJoiner::join(int steps) {
   for (int i = joined_steps_; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
   if (n > source_.options().max_events)
     throw source_.tooManyEvents(pending_.front().t0, pending_[static_cast<std::size_t>(steps - 1)].t1);
-  reserveWithHeadroom(joined_, n);
+  reserveLarge(joined_, n);
   for (int i = joined_steps_; i < steps; ++i) {
     const auto& e = pending_[static_cast<std::size_t>(i)].events;
     joined_.insert(joined_.end(), e.begin(), e.end());
