@@ -56,31 +56,53 @@ WindowSource::WindowSource(EventReader& reader, const WindowOptions& options) : 
   if (!err.empty()) throw std::invalid_argument("window options: " + err);
 }
 
-bool WindowSource::pull() {
+bool WindowSource::pull(std::size_t max) {
   if (eof_) return false;
   if (!started_) {
     started_ = true;
     if (std::isfinite(o_.t_start)) reader_.seekTime(o_.t_start);
   }
   while (true) {
-    if (!reader_.next(batch_, o_.read_batch)) {
+    if (!reader_.next(batch_, std::max<std::size_t>(1, max))) {
       eof_ = true;
       return false;
     }
-    bool any = false;
-    for (const Event& e : batch_) {
-      if (e.t < o_.t_start) continue;
-      if (e.t >= o_.t_end) {
-        eof_ = true;  // time-ordered input: nothing further is in range
-        past_end_ = true;
-        break;
-      }
-      buf_.push_back(e);
-      any = true;
+    // The batch up to the first event at or after t_end (time-ordered
+    // input: nothing further is in range), without the events before
+    // t_start; in one copy where none is before t_start.
+    auto last = batch_.begin();
+    std::size_t early = 0;
+    for (; last != batch_.end() && last->t < o_.t_end; ++last) early += last->t < o_.t_start;
+    if (last != batch_.end()) {
+      eof_ = true;
+      past_end_ = true;
     }
-    peak_ = std::max(peak_, buf_.size());
+    const std::size_t kept = std::size_t(last - batch_.begin()) - early;
+    const bool any = kept > 0;
+    if (any) {
+      if (buffered() == 0) buf_.clear(), head_ = 0;
+      reserveWithHeadroom(buf_, buf_.size() + kept);
+      if (early == 0) {
+        buf_.insert(buf_.end(), batch_.begin(), last);
+      } else {
+        for (auto e = batch_.begin(); e != last; ++e)
+          if (e->t >= o_.t_start) buf_.push_back(*e);
+      }
+    }
+    peak_ = std::max(peak_, buffered());
     if (any) return true;
     if (eof_) return false;
+  }
+}
+
+void WindowSource::dropFront(std::size_t n) {
+  head_ += std::min(n, buffered());
+  if (head_ == buf_.size()) {
+    buf_.clear();
+    head_ = 0;
+  } else if (head_ > buffered()) {
+    buf_.erase(buf_.begin(), buf_.begin() + std::ptrdiff_t(head_));
+    head_ = 0;
   }
 }
 
@@ -113,22 +135,31 @@ bool WindowSource::next(EventWindow& w) {
   w.index = index_;
   if (o_.events_per_window > 0) {
     const std::size_t n = o_.events_per_window;
-    while (buf_.size() < n && pull()) {
+    if (buf_.capacity() < n) reserveLarge(buf_, n);
+    // Reads no further than the window needs: without overlap the buffer
+    // then holds exactly the window and is handed over without a copy.
+    while (buffered() < n && pull(std::min(o_.read_batch, n - buffered()))) {
     }
-    if (buf_.size() < n) {  // the end: a partial window, or nothing new
-      const std::size_t fresh = buf_.size() - std::min(covered_front_, buf_.size());
+    if (buffered() < n) {  // the end: a partial window, or nothing new
+      const std::size_t fresh = buffered() - std::min(covered_front_, buffered());
       if (fresh == 0) return false;  // tail_ keeps what became of the last partial window
-      tail_ = {fresh, double(buf_.size()) / double(n), false};
+      tail_ = {fresh, double(buffered()) / double(n), false};
       if (!(o_.keep_partial || tail_.share >= o_.partial_min_share)) return false;
       tail_.emitted = true;
     }
-    const std::size_t take = std::min(n, buf_.size());
-    w.events.assign(buf_.begin(), buf_.begin() + std::ptrdiff_t(take));
+    const std::size_t take = std::min(n, buffered());
+    const std::size_t step = std::max<std::size_t>(1, std::size_t(std::floor((1.0 - o_.overlap) * double(n))));
+    const std::size_t erased = std::min(step, buffered());
+    if (head_ == 0 && take == buf_.size() && erased == take) {
+      w.events.swap(buf_);  // the whole buffer is this window and no later one
+      buf_.clear();
+    } else {
+      reserveLarge(w.events, take);
+      w.events.assign(begin(), begin() + std::ptrdiff_t(take));
+      dropFront(erased);
+    }
     w.t0 = w.events.front().t;
     w.t1 = w.events.back().t;
-    const std::size_t step = std::max<std::size_t>(1, std::size_t(std::floor((1.0 - o_.overlap) * double(n))));
-    const std::size_t erased = std::min(step, buf_.size());
-    buf_.erase(buf_.begin(), buf_.begin() + std::ptrdiff_t(erased));
     covered_front_ = take - erased;
     ++index_;
     return true;
@@ -136,12 +167,12 @@ bool WindowSource::next(EventWindow& w) {
   // by duration
   const double S = o_.seconds_per_window;
   const double step = (1.0 - o_.overlap) * S;
-  if (index_ == 0 && buf_.empty()) {
-    if (!pull()) return false;
+  if (index_ == 0 && buffered() == 0) {
+    if (!pull(o_.read_batch)) return false;
   }
-  if (index_ == 0) next_t0_ = std::isfinite(o_.t_start) ? o_.t_start : buf_.front().t;
-  if (buf_.empty()) pull();
-  if (!buf_.empty()) skipGap(buf_.front().t, S, step);
+  if (index_ == 0) next_t0_ = std::isfinite(o_.t_start) ? o_.t_start : begin()->t;
+  if (buffered() == 0) pull(o_.read_batch);
+  if (buffered() > 0) skipGap(begin()->t, S, step);
   // t0 from the origin and the step count (no accumulated rounding). Without
   // overlap t1 is the next window's t0 computed the same way: t0 + S may
   // round below it, and an event between the two would be in neither window.
@@ -152,38 +183,46 @@ bool WindowSource::next(EventWindow& w) {
                   std::to_string(S) + " s (t0 + S == t0 in double precision)");
   // make sure the buffer reaches t1 (or the end); the buffer holds the
   // window's events and at most one batch beyond
-  while ((buf_.empty() || buf_.back().t < t1) && pull()) {
-    if (buf_.size() > o_.max_events + o_.read_batch) throw tooManyEvents(t0, t1);
+  while ((buffered() == 0 || (end() - 1)->t < t1) && pull(o_.read_batch)) {
+    if (buffered() > o_.max_events + o_.read_batch) throw tooManyEvents(t0, t1);
   }
   // complete when events reach t1, or the stream passed t_end and t1 <= t_end
-  const bool complete = (!buf_.empty() && buf_.back().t >= t1) || (past_end_ && t1 <= o_.t_end);
+  const bool complete = (buffered() > 0 && (end() - 1)->t >= t1) || (past_end_ && t1 <= o_.t_end);
   if (!complete) {  // the end: a partial window, or nothing new
-    const auto fresh = std::count_if(buf_.begin(), buf_.end(),
-                                     [&](const Event& e) { return e.t >= t0 && e.t >= covered_until_; });
-    const double span = buf_.empty() ? 0.0 : std::max(0.0, buf_.back().t - t0);
+    const auto fresh =
+        std::count_if(begin(), end(), [&](const Event& e) { return e.t >= t0 && e.t >= covered_until_; });
+    const double span = buffered() == 0 ? 0.0 : std::max(0.0, (end() - 1)->t - t0);
     if (fresh == 0) return false;  // tail_ keeps what became of the last partial window
     tail_ = {std::size_t(fresh), std::min(1.0, span / S), false};
     if (!(o_.keep_partial || tail_.share >= o_.partial_min_share)) return false;
     tail_.emitted = true;
   }
-  // Counted first: grown push by push, a window's vector was copied and its
-  // new pages faulted in about log2(n) times.
+  // The window's events are one run of the time-ordered buffer (times at or
+  // above t0, below t1; events before t0 are the previous windows' overlap),
+  // copied once into memory of the exact size.
+  const Event* first = begin();
+  while (first != end() && first->t < t0) ++first;
+  const Event* last = first;
+  while (last != end() && last->t < t1) ++last;
+  // Times going back within the reader's tolerance can leave an event below
+  // t0 after the run's start: counted and left out, as one by one.
   std::size_t count = 0;
-  for (const Event& e : buf_) {
-    if (e.t >= t1) break;
-    count += e.t >= t0;
-  }
+  for (const Event* e = first; e != last; ++e) count += e->t >= t0;
   if (count > o_.max_events) throw tooManyEvents(t0, t1);
   reserveLarge(w.events, count);
-  for (const Event& e : buf_) {
-    if (e.t >= t1) break;
-    if (e.t >= t0) w.events.push_back(e);
+  if (count == std::size_t(last - first)) {
+    w.events.assign(first, last);
+  } else {
+    for (const Event* e = first; e != last; ++e)
+      if (e->t >= t0) w.events.push_back(*e);
   }
   w.t0 = t0;
   w.t1 = t1;
   covered_until_ = t1;
   const double following = next_t0_ + double(step_index_ + 1) * step;
-  while (!buf_.empty() && buf_.front().t < following) buf_.pop_front();
+  std::size_t drop = 0;
+  for (const Event* e = begin(); e != end() && e->t < following; ++e) ++drop;
+  dropFront(drop);
   ++step_index_;
   ++index_;
   return true;

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <cmath>
@@ -110,7 +111,7 @@ struct SequenceRunner::Impl {
   /// Every k-th event is k times sparser in (x, y, c t), and the clustering's
   /// density checks can then find no cluster: a probe without a D is repeated
   /// with a 4 times denser subset, down to every event.
-  double probeTranslation(double t0, double t1, const std::vector<Event>& events) const {
+  double probeTranslation(double t0, double t1, const std::vector<Event>& events, int cluster_threads) const {
     MotionModel motion = MotionModel::constantTwist(Vec3::Zero(), t0);
     Vec3 omega;
     std::string status;
@@ -122,6 +123,7 @@ struct SequenceRunner::Impl {
     // default); D is a median over clusters and needs no purity.
     ClusterOptions cluster = config.cluster;
     cluster.c_speed_factor = std::min(1.0, cluster.c_speed_factor);
+    if (cluster_threads > 0) cluster.threads = cluster_threads;
     for (;;) {
       std::vector<Event> probe;
       probe.reserve(events.size() / keep_every + 1);
@@ -295,9 +297,12 @@ void SequenceRunner::dumpWindows(WindowDumpContext context) {
 }
 
 WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, double t1,
-                                           const std::vector<Event>& events, std::optional<double> probe_px) const {
+                                           const std::vector<Event>& events, std::optional<double> probe_px,
+                                           int cluster_threads) const {
   const Impl& m = *impl_;
   const RunConfig& cfg = m.config;
+  ClusterOptions cluster_options = cfg.cluster;
+  if (cluster_threads > 0) cluster_options.threads = cluster_threads;
   WindowRecord rec;
   // Every method gets a row; an early exit leaves them without an estimate.
   for (Method method : cfg.methods) {
@@ -333,9 +338,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // Clustering in pixel space-time.
   start = Clock::now();
-  ClusterResult clusters = clusterEvents(events, cfg.cluster);
+  ClusterResult clusters = clusterEvents(events, cluster_options);
   splitByMovingLines(events, clusters, [&](const Vec2& p) { return m.bearing(p); }, m.calib.camera.focal(), &motion,
-                     cfg.cluster);
+                     cluster_options);
   rec.times.cluster = secondsSince(start);
   if (m.dump) {
     const GyroWindow gw = cfg.omega_source == OmegaSource::Gyro && !m.gyro.empty() ? m.gyro.window(t0, t1)
@@ -433,9 +438,27 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   }
   WindowSource source(*m.reader, source_options);
   EventWindow window;
+  // The cores stay busy where the windows alone would leave them idle: a
+  // probe while no window is worked on or waiting (the first window's), and
+  // the last window to start once every window is read, cluster with every
+  // worker's thread. The clusters do not depend on the thread count.
+  const int workers = resolveThreadCount(threads);
+  const int all_threads = std::max(workers, cfg.cluster.threads);
+  std::atomic<int> busy{0};           // windows being worked on
+  std::atomic<int> waiting{0};        // windows read and not yet started
+  std::atomic<bool> all_read{false};  // the producer has read its last window
+  struct Busy {
+    std::atomic<int>& n;
+    explicit Busy(std::atomic<int>& count) : n(count) { ++n; }
+    ~Busy() { --n; }
+  };
   ParallaxWindowJoiner joiner(source, cfg.parallax, cfg.windows.partial_min_share,
                               [&](double t0, double t1, const std::vector<Event>& events) {
-                                const double d = m.probeTranslation(t0, t1, events);
+                                const auto t_probe = Clock::now();
+                                const int probe_threads =
+                                    workers > 1 && busy.load() == 0 && waiting.load() == 0 ? all_threads : 0;
+                                const double d = m.probeTranslation(t0, t1, events, probe_threads);
+                                stats.seconds_probing += secondsSince(t_probe);
                                 spdlog::debug("parallax window at {:.3f} s: {:.3f} s, {} events: D = {:.1f} px", t0,
                                               t1 - t0, events.size(), d);
                                 return d;
@@ -474,7 +497,10 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
           const auto t_read = Clock::now();
           const bool more = nextWindow(window);
           stats.seconds_reading += secondsSince(t_read);
-          if (!more) return false;
+          if (!more) {
+            all_read = true;
+            return false;
+          }
           stats.windows_read++;
           stats.events_read += window.events.size();
           checkWindowRate(stats.windows_read, window);
@@ -488,10 +514,15 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
           job.events = std::move(window.events);
           job.probe_px = parallax ? std::optional<double>(joiner.translationPx()) : std::nullopt;
           window.events = {};
+          ++waiting;
           return true;
         }
       },
-      [&](Job& job) { return processWindow(job.index, job.t0, job.t1, job.events, job.probe_px); },
+      [&](Job& job) {
+        const Busy working(busy);
+        const bool last = --waiting == 0 && all_read.load();
+        return processWindow(job.index, job.t0, job.t1, job.events, job.probe_px, workers > 1 && last ? all_threads : 0);
+      },
       [&](WindowRecord& rec) {  // in window order, on this thread
         stats.windows_processed++;
         stats.events_processed += rec.n_events;
@@ -507,6 +538,12 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   stats.reader_warnings = m.reader->warnings().total();
   stats.tail = parallax ? joiner.tail() : source.tail();
   stats.seconds_total = secondsSince(start);
+  const StageTimes& st = stats.stage_seconds;
+  spdlog::debug("stage seconds: reading {:.3f} (of which parallax probes {:.3f}), clustering {:.3f}, "
+                "undistortion+lines {:.3f}, solvers {:.3f}, ground truth {:.3f}, truth labels {:.3f}; "
+                "{} events in {:.3f} s",
+                stats.seconds_reading, stats.seconds_probing, st.cluster, st.lines, st.solve, st.groundtruth,
+                st.truth, stats.events_processed, stats.seconds_total);
   return stats;
 }
 

@@ -142,19 +142,24 @@ int ParallaxWindowJoiner::tailToJoin(int steps, int longest) {
   return have < steps + look ? have - steps : 0;  // the run of data ends within it
 }
 
-void ParallaxWindowJoiner::join(int steps, EventWindow& window) const {
-  window.events.clear();
-  std::size_t n = 0;
-  for (int i = 0; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
+void ParallaxWindowJoiner::join(int steps) {
+  if (steps < joined_steps_) {
+    std::size_t n = 0;
+    for (int i = 0; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
+    joined_.resize(n);
+    joined_steps_ = steps;
+    return;
+  }
+  std::size_t n = joined_.size();
+  for (int i = joined_steps_; i < steps; ++i) n += pending_[static_cast<std::size_t>(i)].events.size();
   if (n > source_.options().max_events)
     throw source_.tooManyEvents(pending_.front().t0, pending_[static_cast<std::size_t>(steps - 1)].t1);
-  reserveLarge(window.events, n);
-  for (int i = 0; i < steps; ++i) {
+  reserveLarge(joined_, n);
+  for (int i = joined_steps_; i < steps; ++i) {
     const auto& e = pending_[static_cast<std::size_t>(i)].events;
-    window.events.insert(window.events.end(), e.begin(), e.end());
+    joined_.insert(joined_.end(), e.begin(), e.end());
   }
-  window.t0 = pending_.front().t0;
-  window.t1 = pending_[static_cast<std::size_t>(steps - 1)].t1;
+  joined_steps_ = steps;
 }
 
 bool ParallaxWindowJoiner::next(EventWindow& window) {
@@ -185,8 +190,8 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
     if (seen != tried.end()) {
       translation_px_ = seen->second;
     } else {
-      join(steps, window);
-      translation_px_ = probe_(window.t0, window.t1, window.events);
+      join(steps);
+      translation_px_ = probe_(pending_.front().t0, pending_[static_cast<std::size_t>(steps - 1)].t1, joined_);
       tried.emplace_back(steps, translation_px_);
     }
     if (may_shrink && translation_px_ >= 2.0 * o_.target_px) {
@@ -214,7 +219,12 @@ bool ParallaxWindowJoiner::next(EventWindow& window) {
   }
   last_steps_ = std::isfinite(translation_px_) || measured ? steps : min_steps;
   steps += tailToJoin(steps, longest);
-  join(steps, window);
+  join(steps);
+  window.events.clear();
+  window.events.swap(joined_);  // handed over without a copy
+  joined_steps_ = 0;
+  window.t0 = pending_.front().t0;
+  window.t1 = pending_[static_cast<std::size_t>(steps - 1)].t1;
   const bool at_end = source_done_ && static_cast<int>(pending_.size()) == steps;
   if (at_end && steps < min_steps) {  // the end of the data cut the window short
     std::size_t events = window.events.size();

@@ -16,7 +16,6 @@
 /// so one far timestamp never makes it produce windows without bound.
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <limits>
 #include <string>
 #include <vector>
@@ -94,12 +93,21 @@ class WindowSource {
   const std::vector<std::string>& reports() const { return reports_; }
 
  private:
-  bool pull();  ///< appends one batch within the time range; false at the end
+  /// Appends one batch (at most `max` events) within the time range; false at the end.
+  bool pull(std::size_t max);
   /// By duration: moves the time grid past a long gap before the event at t_next.
   void skipGap(double t_next, double S, double step);
+  /// The buffered events: buf_[head_, buf_.size()).
+  std::size_t buffered() const { return buf_.size() - head_; }
+  const Event* begin() const { return buf_.data() + head_; }
+  const Event* end() const { return buf_.data() + buf_.size(); }
+  /// Drops the first n buffered events (moved out of the buffer's front only
+  /// when they are more than the rest: each event moves at most once).
+  void dropFront(std::size_t n);
   EventReader& reader_;
   WindowOptions o_;
-  std::deque<Event> buf_;
+  std::vector<Event> buf_;  ///< the read events, from head_ on; one contiguous block, no per-event copies
+  std::size_t head_ = 0;
   std::vector<Event> batch_;
   bool eof_ = false;
   bool past_end_ = false;  ///< an event at or after t_end was seen

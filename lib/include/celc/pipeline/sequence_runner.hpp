@@ -95,6 +95,7 @@ struct RunStats {
   std::uint64_t windows_read = 0, windows_processed = 0;
   std::uint64_t events_read = 0, events_processed = 0;
   double seconds_total = 0.0, seconds_reading = 0.0;
+  double seconds_probing = 0.0;  ///< of seconds_reading: the parallax policy's probes (clustering subsets)
   StageTimes stage_seconds;  ///< summed over windows
   std::uint64_t reader_warnings = 0;
   std::uint64_t clusters_line_fit_failed = 0;  ///< summed WindowRecord::n_line_fit_failed
@@ -130,9 +131,11 @@ class SequenceRunner {
   /// for the last window, cut by the end of the data); nullopt for the other
   /// policies. With the parallax policy a window whose D (the probe's, else
   /// the whole window's) is below windows.no_parallax_px is degenerate
-  /// (no_parallax) for every method.
+  /// (no_parallax) for every method. cluster_threads > 0: the threads of the
+  /// window's clustering instead of cluster.threads (the clusters do not
+  /// depend on it; run() gives a window the workers that have nothing left to do).
   WindowRecord processWindow(std::uint64_t index, double t0, double t1, const std::vector<Event>& events,
-                             std::optional<double> probe_px = std::nullopt) const;
+                             std::optional<double> probe_px = std::nullopt, int cluster_threads = 0) const;
 
   /// Also write every clustered window for `celc solve` (window_dump.hpp)
   /// into context.dir; context.calib, gyro_integrated and seed are filled

@@ -121,13 +121,18 @@ class ParallaxWindowJoiner {
   /// show target_px itself (D linear in the length) and the joined window
   /// stays within `longest` steps; else 0.
   int tailToJoin(int steps, int longest);
-  void join(int steps, EventWindow& window) const;
+  /// joined_ becomes the first `steps` pending steps' events: a longer try
+  /// appends the steps it adds, a shorter one cuts the vector (each event is
+  /// copied once per window, however many lengths the probes try).
+  void join(int steps);
   WindowSource& source_;
   ParallaxWindowOptions o_;
   double partial_min_share_;
   Probe probe_;
   Turn turn_;
   std::deque<EventWindow> pending_;
+  std::vector<Event> joined_;  ///< the events of pending_'s first joined_steps_ steps
+  int joined_steps_ = 0;
   bool source_done_ = false;
   std::uint64_t index_ = 0;
   WindowTail tail_;
