@@ -133,7 +133,7 @@ TEST(Uncertainty, DisagreeingEstimatesRaiseSigma) {
 // rad/s off, celc_ml's error is the predicted shift within 10% (+0.01 deg;
 // the rest is second order in the rate error). Its last refinement under
 // Cauchy's loss is off: noise-free, the loss's scale would be the rate
-// error's own residuals, and the answer no longer least squares'.
+// error's own residuals, and the answer not least squares'.
 TEST(Uncertainty, BudgetShiftPredictsTheErrorOfAWrongGyroRate) {
   std::mt19937_64 rng(4242);
   SolverOptions opt;
