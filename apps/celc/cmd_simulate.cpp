@@ -247,7 +247,7 @@ void registerSimulate(CLI::App& app) {
   cmd->add_option("--threads", a->threads, "worker threads (0 = all cores, at most 1024)")
       ->capture_default_str();
   cmd->add_option("--methods", a->methods,
-                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "study.methods"));
+                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt,celc_acc (or all): " + fieldHelp(schema, "study.methods"));
   cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
   cmd->add_flag("--no-plots", a->no_plots, "skip the PNG plots");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

@@ -10,6 +10,7 @@
 #include "celc/solver/direction_information.hpp"
 #include "celc/solver/npt.hpp"
 #include "celc/solver/solver.hpp"
+#include "celc_acc.hpp"
 #include "celc_linear.hpp"
 #include "celc_ml.hpp"
 #include "constraint_rows.hpp"
@@ -196,6 +197,9 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         out.push_back(detail::solveCe3lc(obs, motion, options.linear, frames, false));
         break;
       case Method::Npt: out.push_back(getNpt()); break;
+      case Method::CelcAcc:
+        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), options.linear, frames, seeds.linear_rows));
+        break;
       case Method::CelcMl: {
         const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
         out.push_back(detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr,
@@ -243,6 +247,10 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     SolverResult& r = out[i];
     r.parallax = window.parallax;
     r.n_lines = window.n_lines;
+    if (methods[i] == Method::CelcAcc) {  // its own spread (celc_acc.hpp): the bound assumes a constant v
+      if (!r.ok() || !u.enabled) r.sigma_deg = NAN;
+      continue;
+    }
     r.sigma_deg = NAN;
     if (!r.ok() || !u.enabled) continue;
     double scale = 1.0;
@@ -252,6 +260,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::CelcMl: scale = u.scale_celc_ml; break;
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
+      case Method::CelcAcc: break;
     }
     r.sigma_deg = std::max(terms().sigmaDeg(r.v, scale), sigma_floor_deg[i]);
   }

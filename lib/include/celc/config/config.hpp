@@ -17,7 +17,7 @@ namespace celc {
 struct SimulateConfig {
   LineSceneOptions scene;
   SolverOptions solver;
-  std::vector<Method> methods = allMethods();
+  std::vector<Method> methods = defaultMethods();
   int trials = 500;
   std::uint64_t seed = 1;
   std::string validate() const;  ///< empty when valid

@@ -43,6 +43,11 @@ struct SolverResult {
   /// min_parallax_ratio). NaN when the test did not run.
   double parallax = NAN;
   int n_lines = 0;                ///< usable clusters of the window (shared by every method)
+  /// celc_acc only: the constant acceleration over the speed, a / |v| [1/s],
+  /// reference frame (NaN for the other methods), and whether the window
+  /// shows it (an F-test of the cost with and without it, p = 0.001).
+  Vec3 acceleration = Vec3::Constant(NAN);
+  bool acceleration_seen = false;
   bool ok() const { return status == SolveStatus::Ok; }
 };
 

@@ -1,0 +1,238 @@
+// CELC with a constant acceleration (celc_acc.hpp).
+#include "celc_acc.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "linear_method.hpp"
+#include "robust_nullspace.hpp"
+#include "sampling.hpp"
+#include "sign_test.hpp"
+#include "stopwatch.hpp"
+#include "window_checks.hpp"
+
+namespace celc::detail {
+
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat26 = Eigen::Matrix<double, 2, 6>;
+
+/// One event's row: residual r = a^T x / |N x| [normalised units].
+struct AccRow {
+  Vec6 a;
+  Mat26 N;
+};
+
+constexpr int kMaxIterations = 50;        // IRLS steps at most
+constexpr double kFTestCritical = 5.42;  // F(3, inf) at p = 0.001: chi2(3) 16.27 / 3
+
+/// x = (v, a) minimising the weighted sum of w_i (a_i^T x)^2 with |v| = 1.
+bool weightedSolve(const std::vector<AccRow>& rows, const std::vector<double>& w, bool with_acceleration, Vec6& x,
+                   Mat3* schur_out) {
+  Mat6 m = Mat6::Zero();
+  for (std::size_t i = 0; i < rows.size(); ++i) m.noalias() += w[i] * rows[i].a * rows[i].a.transpose();
+  const Mat3 mvv = m.topLeftCorner<3, 3>(), mva = m.topRightCorner<3, 3>(), maa = m.bottomRightCorner<3, 3>();
+  Mat3 schur = mvv, k = Mat3::Zero();
+  if (with_acceleration) {
+    const double ridge = 1e-12 * std::max(maa.trace(), 1e-300);
+    k = (maa + ridge * Mat3::Identity()).ldlt().solve(mva.transpose());  // a = -k v
+    schur = mvv - mva * k;
+  }
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (schur + schur.transpose()));
+  if (es.info() != Eigen::Success) return false;
+  const Vec3 v = es.eigenvectors().col(0);
+  x.head<3>() = v;
+  x.tail<3>() = with_acceleration ? Vec3(-k * v) : Vec3::Zero();
+  if (schur_out) *schur_out = schur;
+  return x.allFinite();
+}
+
+/// Geometric residuals of the rows at x.
+std::vector<double> residuals(const std::vector<AccRow>& rows, const Vec6& x) {
+  std::vector<double> r(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double n = (rows[i].N * x).norm();
+    r[i] = n > 1e-300 ? rows[i].a.dot(x) / n : 0.0;
+  }
+  return r;
+}
+
+double robustScale(const std::vector<double>& r) {
+  std::vector<double> a(r.size());
+  for (std::size_t i = 0; i < r.size(); ++i) a[i] = std::abs(r[i]);
+  if (a.empty()) return 0.0;
+  auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
+  std::nth_element(a.begin(), mid, a.end());
+  return 1.4826 * *mid;
+}
+
+/// Huber's cost of the residuals at scale `scale` (threshold k scales).
+double huberCost(const std::vector<double>& r, double scale, double k) {
+  const double c = k * scale;
+  double sum = 0.0;
+  for (double e : r) sum += std::abs(e) <= c ? 0.5 * e * e : c * (std::abs(e) - 0.5 * c);
+  return sum;
+}
+
+struct Fit {
+  Vec6 x = Vec6::Zero();
+  Mat3 schur = Mat3::Zero();
+  double scale = 0.0, cost = 0.0;
+  int iterations = 0;
+  bool ok = false;
+};
+
+/// IRLS from x0: weights Huber(r / scale) / |N x|^2 at a fixed scale (the
+/// same for the fits with and without a, so that their costs compare); the
+/// end point is the lowest Huber cost met.
+Fit irls(const std::vector<AccRow>& rows, Vec6 x, bool with_acceleration, const LinearOptions& opt, double scale) {
+  Fit fit;
+  fit.x = x;
+  fit.scale = scale;
+  fit.cost = huberCost(residuals(rows, x), scale, opt.huber_k);
+  std::vector<double> w(rows.size());
+  for (int it = 0; it < kMaxIterations; ++it) {
+    const std::vector<double> r = residuals(rows, x);
+    const double c = opt.huber_k * scale;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const double n2 = (rows[i].N * x).squaredNorm();
+      const double huber = std::abs(r[i]) <= c ? 1.0 : c / std::abs(r[i]);
+      w[i] = n2 > 1e-300 ? huber / n2 : 0.0;
+    }
+    Vec6 next;
+    Mat3 schur;
+    if (!weightedSolve(rows, w, with_acceleration, next, &schur)) break;
+    if (next.head<3>().dot(x.head<3>()) < 0.0) next = -next;
+    const double moved = std::acos(std::clamp(next.head<3>().dot(x.head<3>()), -1.0, 1.0));
+    x = next;
+    fit.iterations = it + 1;
+    // Each step's weights are the last one's: keep the lowest robust cost seen.
+    const double cost = huberCost(residuals(rows, x), scale, opt.huber_k);
+    if (cost < fit.cost || fit.iterations == 1) {
+      if (cost < fit.cost || fit.schur.isZero()) fit.schur = schur;
+      if (cost < fit.cost) fit.x = x, fit.cost = cost;
+    }
+    if (moved < 1e-3 * opt.tolerance) break;
+  }
+  fit.ok = true;
+  return fit;
+}
+
+}  // namespace
+
+SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
+                          const LinearOptions& opt, const WindowFrames& frames, std::uint64_t row_seed) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (rejectInput(obs, motion, opt, result)) return result;
+  if (!celc.ok()) {
+    result = celc;
+    result.message = "celc_acc starts from celc, which did not answer: " + celc.message;
+    return result;
+  }
+  const std::vector<int> usable = usableClusters(obs, opt.min_cluster_events);
+  std::vector<size_t> sizes;
+  for (int c : usable) sizes.push_back(obs.clusters[c].size());
+  const std::vector<size_t> quota = rowQuota(sizes, static_cast<size_t>(opt.max_rows), opt.balance_clusters);
+  const double t_ref = motion.referenceTime();
+  auto q = [&](double t) { return 0.5 * (t - t_ref) * (t - t_ref); };
+  std::vector<AccRow> rows;
+  for (size_t ci = 0; ci < usable.size(); ++ci) {
+    const ClusterObservation& cl = obs.clusters[usable[ci]];
+    const ClusterFrame& frame = frames[usable[ci]];
+    const double qs = q(cl.l1.t), qe = q(cl.l3.t);
+    for (size_t k : sampleIndices(cl.size(), quota[ci], row_seed + ci)) {
+      if (!cl.bearings[k].allFinite() || !std::isfinite(cl.times[k])) continue;
+      Mat3 rk, pk;
+      motion.pose(cl.times[k], rk, pk);
+      const Mat3 b_v = transferMatrix(frame, pk);
+      const double qk = q(cl.times[k]);
+      const Mat3 b_a = (qe - qk) * frame.m1 * frame.m3.transpose() - (qs - qk) * frame.m3 * frame.m1.transpose();
+      const Vec3 fp = rk * cl.bearings[k];
+      AccRow row;
+      row.a << b_v.transpose() * fp, b_a.transpose() * fp;
+      const Eigen::Matrix<double, 2, 3> rt = rk.transpose().topRows<2>();
+      row.N << rt * b_v, rt * b_a;
+      if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
+    }
+  }
+  result.rows_used = static_cast<int>(rows.size());
+  if (rows.size() < 12) {
+    result = failure(SolveStatus::Degenerate, Degeneracy::TooFewClusters,
+                     std::to_string(rows.size()) + " rows, fewer than celc_acc's 12");
+    result.time_us = microsecondsSince(start);
+    return result;
+  }
+  Vec6 x0 = Vec6::Zero();
+  x0.head<3>() = celc.v.normalized();
+  const double scale0 = std::max(robustScale(residuals(rows, x0)), 1e-12);
+  const Fit constant = irls(rows, x0, false, opt, scale0);
+  // The accelerating fit from the constant one and from the best directions
+  // of a hemisphere lattice (an acceleration can move v's basin far from
+  // where a constant-velocity solver puts it): the lowest Huber cost wins.
+  Fit accelerating = irls(rows, constant.ok ? constant.x : x0, true, opt, scale0);
+  if (opt.grid_directions > 0 && opt.grid_starts > 0) {
+    std::vector<std::pair<double, Vec3>> scored;
+    for (const Vec3& d : hemisphereDirections(opt.grid_directions)) {
+      Vec6 xd = Vec6::Zero();
+      xd.head<3>() = d;
+      scored.emplace_back(huberCost(residuals(rows, xd), scale0, opt.huber_k), d);
+    }
+    const std::size_t n_starts = std::min<std::size_t>(scored.size(), static_cast<std::size_t>(opt.grid_starts));
+    std::partial_sort(scored.begin(), scored.begin() + static_cast<std::ptrdiff_t>(n_starts), scored.end(),
+                      [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t k = 0; k < n_starts; ++k) {
+      Vec6 xd = Vec6::Zero();
+      xd.head<3>() = scored[k].second;
+      const Fit f = irls(rows, irls(rows, xd, false, opt, scale0).x, true, opt, scale0);
+      if (f.ok && f.cost < accelerating.cost) accelerating = f;
+    }
+  }
+  if (!accelerating.ok || !constant.ok) {
+    result = failure(SolveStatus::Failed, Degeneracy::None, "celc_acc: the weighted system could not be solved");
+    result.time_us = microsecondsSince(start);
+    return result;
+  }
+  // F-test: the cost reduction per added unknown against the cost per degree
+  // of freedom (Huber's cost is close to half the sum of squares for inliers).
+  const double dof = std::max(1.0, static_cast<double>(rows.size()) - 5.0);
+  const double f = ((constant.cost - accelerating.cost) / 3.0) / std::max(accelerating.cost / dof, 1e-300);
+  // Where the window does not show an acceleration, the constant-velocity
+  // fit is the answer (fewer unknowns, less noise) and the message says so.
+  result.acceleration_seen = f > kFTestCritical;
+  const Fit& chosen = result.acceleration_seen ? accelerating : constant;
+  Vec6 x = chosen.x;
+  SignDecision sign;
+  if (opt.resolve_sign) {
+    sign = resolveSign(obs, motion, x.head<3>().normalized(), frames);
+    x *= static_cast<double>(sign.sign);
+  }
+  const double speed = x.head<3>().norm();
+  result.status = SolveStatus::Ok;
+  result.v = x.head<3>() / speed;
+  result.acceleration = accelerating.x.tail<3>() * (accelerating.x.head<3>().dot(result.v) < 0.0 ? -1.0 : 1.0) /
+                        accelerating.x.head<3>().norm();
+  if (!result.acceleration_seen)
+    result.message = "no acceleration seen (F = " + std::to_string(f) + " < " + std::to_string(kFTestCritical) +
+                     "): the constant-velocity fit";
+  result.iterations = constant.iterations + accelerating.iterations;
+  result.rows_used = static_cast<int>(rows.size());
+  result.residual_px = robustScale(residuals(rows, x)) * obs.focal_px;
+  // The direction's spread: the residual scale over the curvature of the
+  // Schur complement (rows normalised by |N x|), along its two larger axes.
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (chosen.schur + chosen.schur.transpose()));
+  const Vec3 ev = es.eigenvalues();
+  const double s2 = std::pow(robustScale(residuals(rows, x)), 2);
+  result.sigma_deg = ev(1) > 0.0 && ev(2) > 0.0 ? std::sqrt(s2 / ev(1) + s2 / ev(2)) * 180.0 / M_PI : INFINITY;
+  result.sigma_min = std::sqrt(std::max(0.0, ev(0)));
+  result.sigma_second = std::sqrt(std::max(0.0, ev(1)));
+  result.sign_margin = sign.margin * sign.sign;
+  result.time_us = microsecondsSince(start) + celc.time_us;
+  return result;
+}
+
+}  // namespace celc::detail
