@@ -4,8 +4,10 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
+#include "joint_refine.hpp"
 #include "linear_method.hpp"
 #include "robust_nullspace.hpp"
 #include "sampling.hpp"
@@ -27,8 +29,7 @@ struct AccRow {
   Mat26 N;
 };
 
-constexpr int kMaxIterations = 50;        // IRLS steps at most
-constexpr double kFTestCritical = 5.42;  // F(3, inf) at p = 0.001: chi2(3) 16.27 / 3
+constexpr int kMaxIterations = 50;  // IRLS steps at most
 
 /// x = (v, a) minimising the weighted sum of w_i (a_i^T x)^2 with |v| = 1.
 bool weightedSolve(const std::vector<AccRow>& rows, const std::vector<double>& w, bool with_acceleration, Vec6& x,
@@ -122,18 +123,11 @@ Fit irls(const std::vector<AccRow>& rows, Vec6 x, bool with_acceleration, const 
   return fit;
 }
 
-}  // namespace
 
-SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
-                          const LinearOptions& opt, const WindowFrames& frames, std::uint64_t row_seed) {
-  const auto start = Clock::now();
-  SolverResult result;
-  if (rejectInput(obs, motion, opt, result)) return result;
-  if (!celc.ok()) {
-    result = celc;
-    result.message = "celc_acc starts from celc, which did not answer: " + celc.message;
-    return result;
-  }
+/// The linear stage: (v, a) of the accelerating IRLS (|v| = 1, v's sign
+/// CELC's), or false when the rows cannot fix it.
+bool linearAcceleration(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
+                        const LinearOptions& opt, const WindowFrames& frames, std::uint64_t row_seed, Vec6& out) {
   const std::vector<int> usable = usableClusters(obs, opt.min_cluster_events);
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
@@ -160,13 +154,7 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
       if (row.a.allFinite() && row.N.allFinite()) rows.push_back(row);
     }
   }
-  result.rows_used = static_cast<int>(rows.size());
-  if (rows.size() < 12) {
-    result = failure(SolveStatus::Degenerate, Degeneracy::TooFewClusters,
-                     std::to_string(rows.size()) + " rows, fewer than celc_acc's 12");
-    result.time_us = microsecondsSince(start);
-    return result;
-  }
+  if (rows.size() < 12 || !celc.ok()) return false;
   Vec6 x0 = Vec6::Zero();
   x0.head<3>() = celc.v.normalized();
   const double scale0 = std::max(robustScale(residuals(rows, x0)), 1e-12);
@@ -192,46 +180,123 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
       if (f.ok && f.cost < accelerating.cost) accelerating = f;
     }
   }
-  if (!accelerating.ok || !constant.ok) {
-    result = failure(SolveStatus::Failed, Degeneracy::None, "celc_acc: the weighted system could not be solved");
-    result.time_us = microsecondsSince(start);
-    return result;
+  if (!accelerating.ok || !accelerating.x.allFinite() || !(accelerating.x.head<3>().norm() > 0.0)) return false;
+  out = accelerating.x / accelerating.x.head<3>().norm();
+  if (out.head<3>().dot(celc.v) < 0.0) out = -out;
+  return true;
+}
+
+}  // namespace
+
+SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
+                          const SolverResult& ml, const SolverOptions& options, const WindowFrames& frames,
+                          std::uint64_t row_seed, std::uint64_t event_seed) {
+  const auto start = Clock::now();
+  SolverResult result;
+  if (rejectInput(obs, motion, options.linear, result)) return result;
+  const AccOptions& acc = options.acc;
+  // celc's time is inside celc_ml's (its start).
+  const double before_us = ml.time_us;
+  // The constant-velocity answer (celc_ml's), with the reason it stands.
+  auto constantVelocity = [&](Degeneracy reason, const std::string& why) {
+    SolverResult r = ml;
+    if (r.ok()) {
+      r.degeneracy = reason;
+      r.message = why + ": celc_ml's constant-velocity answer";
+    }
+    r.time_us = before_us + microsecondsSince(start);
+    return r;
+  };
+  if (!ml.ok()) return constantVelocity(Degeneracy::None, "");
+  const int lines = static_cast<int>(frames.clusters().size());
+  if (lines < acc.min_lines)
+    return constantVelocity(Degeneracy::AccelerationUnobservable,
+                            std::to_string(lines) + " lines, fewer than the " + std::to_string(acc.min_lines) +
+                                " that fix an acceleration");
+  JointProblem problem(obs, motion, frames, options.ml.max_events, options.refine.balance_clusters, event_seed,
+                       options.refine.huber_px, true);
+  if (problem.events() < 12 || static_cast<int>(problem.clusters()) < acc.min_lines)
+    return constantVelocity(Degeneracy::AccelerationUnobservable,
+                            std::to_string(problem.events()) + " events on " + std::to_string(problem.clusters()) +
+                                " lines, too few to fix an acceleration");
+  const int iterations = options.refine.max_iterations;
+  const double tolerance = options.refine.function_tolerance;
+  // The constant-velocity minimum of this problem (celc_ml's answer refined
+  // on its events), which sets the Huber threshold as celc_ml's first end
+  // point does (MlOptions::huber_scale) and is the test's C_0.
+  JointProblem::Result constant = problem.refineConstantVelocity(problem.start(ml.v), iterations, tolerance);
+  if (!constant.ok) return constantVelocity(Degeneracy::None, "the constant-velocity refinement failed");
+  if (options.ml.huber_scale > 0.0) {
+    const double scaled = options.ml.huber_scale * problem.robustScale(constant.state);
+    if (scaled > options.refine.huber_px) {
+      problem.setHuber(scaled);
+      JointProblem::Result again = problem.refineConstantVelocity(constant.state, iterations, tolerance);
+      if (again.ok) constant = std::move(again);
+      else constant.cost = problem.cost(constant.state);
+    }
   }
-  // F-test: the cost reduction per added unknown against the cost per degree
-  // of freedom (Huber's cost is close to half the sum of squares for inliers).
-  const double dof = std::max(1.0, static_cast<double>(rows.size()) - 5.0);
-  const double f = ((constant.cost - accelerating.cost) / 3.0) / std::max(accelerating.cost / dof, 1e-300);
-  // Where the window does not show an acceleration, the constant-velocity
-  // fit is the answer (fewer unknowns, less noise) and the message says so.
-  result.acceleration_seen = f > kFTestCritical;
-  const Fit& chosen = result.acceleration_seen ? accelerating : constant;
-  Vec6 x = chosen.x;
-  SignDecision sign;
-  if (opt.resolve_sign) {
-    sign = resolveSign(obs, motion, x.head<3>().normalized(), frames);
-    x *= static_cast<double>(sign.sign);
+  // The accelerating starts: celc_ml's end point with a = 0 and the linear
+  // (v, a) with the fitted lines; the lower cost wins.
+  JointProblem::Result best = problem.refine(constant.state, iterations, tolerance);
+  Vec6 linear;
+  if (linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear)) {
+    JointProblem::Result r = problem.refine(problem.start(linear.head<3>(), linear.tail<3>()), iterations, tolerance);
+    if (r.ok && (!best.ok || r.cost < best.cost)) best = std::move(r);
   }
-  const double speed = x.head<3>().norm();
+  if (!best.ok) return constantVelocity(Degeneracy::None, "the accelerating refinement failed");
+  // Observability: a's covariance with the lines and v eliminated.
+  const double scale = problem.robustScale(best.state);
+  const Eigen::MatrixXd info = problem.information(best.state);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
+  double sigma_a = INFINITY;
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(5, 5, NAN);
+  if (es.info() == Eigen::Success && es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(4), 1e-300)) {
+    cov = scale * scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
+          es.eigenvectors().transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3> ea(Mat3(cov.bottomRightCorner<3, 3>()));
+    sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
+  }
+  double reach = 0.0;  // the longest |t - t_ref| [s]
+  for (int c : frames.clusters())
+    for (double t : obs.clusters[c].times)
+      if (std::isfinite(t)) reach = std::max(reach, std::abs(t - motion.referenceTime()));
+  const double lr = 2.0 * (constant.cost - best.cost) / std::max(scale * scale, 1e-300);
+  char text[240];
+  if (!(sigma_a * reach <= acc.max_sigma)) {
+    std::snprintf(text, sizeof text,
+                  "acceleration not observable: its std times the window's reach, %.3g, above %g", sigma_a * reach,
+                  acc.max_sigma);
+    SolverResult r = constantVelocity(Degeneracy::AccelerationUnobservable, text);
+    r.acceleration = best.state.a;
+    return r;
+  }
+  if (!(lr > acc.test_chi2)) {
+    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
+    SolverResult r = constantVelocity(Degeneracy::None, text);
+    r.acceleration = best.state.a;
+    return r;
+  }
   result.status = SolveStatus::Ok;
-  result.v = x.head<3>() / speed;
-  result.acceleration = accelerating.x.tail<3>() * (accelerating.x.head<3>().dot(result.v) < 0.0 ? -1.0 : 1.0) /
-                        accelerating.x.head<3>().norm();
-  if (!result.acceleration_seen)
-    result.message = "no acceleration seen (F = " + std::to_string(f) + " < " + std::to_string(kFTestCritical) +
-                     "): the constant-velocity fit";
-  result.iterations = constant.iterations + accelerating.iterations;
-  result.rows_used = static_cast<int>(rows.size());
-  result.residual_px = robustScale(residuals(rows, x)) * obs.focal_px;
-  // The direction's spread: the residual scale over the curvature of the
-  // Schur complement (rows normalised by |N x|), along its two larger axes.
-  const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (chosen.schur + chosen.schur.transpose()));
-  const Vec3 ev = es.eigenvalues();
-  const double s2 = std::pow(robustScale(residuals(rows, x)), 2);
-  result.sigma_deg = ev(1) > 0.0 && ev(2) > 0.0 ? std::sqrt(s2 / ev(1) + s2 / ev(2)) * 180.0 / M_PI : INFINITY;
-  result.sigma_min = std::sqrt(std::max(0.0, ev(0)));
-  result.sigma_second = std::sqrt(std::max(0.0, ev(1)));
+  result.acceleration_seen = true;
+  result.v = best.state.v;
+  result.acceleration = best.state.a;
+  SignDecision sign;
+  if (options.linear.resolve_sign) {
+    sign = resolveSign(obs, motion, result.v, frames);
+    result.v *= static_cast<double>(sign.sign);
+    result.acceleration *= static_cast<double>(sign.sign);
+  }
   result.sign_margin = sign.margin * sign.sign;
-  result.time_us = microsecondsSince(start) + celc.time_us;
+  result.iterations = constant.iterations + best.iterations;
+  result.rows_used = best.events;
+  result.residual_px = scale;
+  // The direction's spread: v's tangent block of the covariance.
+  result.sigma_deg = std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
+  if (!std::isfinite(result.sigma_deg)) result.sigma_deg = INFINITY;
+  std::snprintf(text, sizeof text, "acceleration seen (likelihood ratio %.3g), |a|/|v| = %.3g 1/s", lr,
+                result.acceleration.norm());
+  result.message = text;
+  result.time_us = before_us + microsecondsSince(start);
   return result;
 }
 

@@ -12,13 +12,27 @@
 // x = (v, a) up to its normaliser: one 6-vector row per event, the same
 // rows as CELC's for a = 0. v and a share one unknown scale; |v| = 1 fixes it.
 //
-// The estimate: IRLS with Huber weights (options.huber_k robust scales, the
-// scale from the MAD) on the geometric residuals, each step the weighted
-// least squares with a eliminated (a = -M_aa^-1 M_av v, v the smallest
-// eigenvector of the 3x3 Schur complement), started from CELC's estimate
-// with a = 0; v's sign is CELC's (resolved by cheirality). Whether the
-// acceleration is seen is an F-test of the cost with a against the cost of
-// the best a = 0 (3 added unknowns, p = 0.001).
+// The linear estimate: IRLS with Huber weights (options.huber_k robust
+// scales, the scale from the MAD) on the geometric residuals, each step the
+// weighted least squares with a eliminated (a = -M_aa^-1 M_av v, v the
+// smallest eigenvector of the 3x3 Schur complement), started from CELC's
+// estimate with a = 0.
+//
+// The linear answer alone is weak: the lines l1 / l3 are fitted under a
+// motion linear in time, and v and a reach the lines at the same (second)
+// order in time. The answer is the joint maximum-likelihood refinement of
+// v, a and every cluster's lines (JointProblem with an acceleration: the
+// lines' image motion under the constant acceleration), started from the
+// linear (v, a) and from celc_ml's v with a = 0; the lower robust cost wins.
+// Then two checks, each falling back to celc_ml's answer where it fails:
+//   observable: at least acc.min_lines lines, and a's standard deviation
+//     (Fisher information with the lines and v eliminated, the residuals'
+//     robust scale) times the longest |t - t_ref| at most acc.max_sigma;
+//     else Degeneracy::AccelerationUnobservable, status ok, and the message
+//     says why;
+//   seen: the likelihood ratio 2 (C_0 - C_a) / s^2 of the costs at the best
+//     constant-velocity and accelerating states (same events, same loss)
+//     above acc.test_chi2.
 #include <cstdint>
 
 #include "celc/solver/solver.hpp"
@@ -27,11 +41,15 @@
 namespace celc::detail {
 
 /// celc_acc on the window's frames: `celc` is CELC's linear result (the
-/// start and the sign); rows drawn with row_seed as CELC draws them.
+/// linear stage's start and sign), `ml` celc_ml's (the second start and the
+/// constant-velocity answer); rows drawn with row_seed as CELC draws them,
+/// the joint problem's events with event_seed as celc_ml draws them.
 /// SolverResult::acceleration is a / |v| [1/s] (reference frame) and
-/// acceleration_seen the F-test's verdict; sigma_deg is set from the
-/// weighted system (the residual scale over the Schur complement's curvature).
+/// acceleration_seen the test's verdict; sigma_deg is set where the
+/// acceleration is seen (the Fisher information with the lines and a
+/// eliminated). Its time includes celc's and celc_ml's.
 SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
-                          const LinearOptions& options, const WindowFrames& frames, std::uint64_t row_seed);
+                          const SolverResult& ml, const SolverOptions& options, const WindowFrames& frames,
+                          std::uint64_t row_seed, std::uint64_t event_seed);
 
 }  // namespace celc::detail

@@ -190,6 +190,17 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
     return npt;
   };
+  SolverResult ml;
+  bool have_ml = false;
+  auto getMl = [&]() -> const SolverResult& {
+    if (!have_ml) {
+      const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
+      ml = detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr, options, frames,
+                               seeds.refine_events);
+      have_ml = true;
+    }
+    return ml;
+  };
   for (Method m : methods) {
     switch (m) {
       case Method::Celc: out.push_back(getLinear()); break;
@@ -198,14 +209,10 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         break;
       case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcAcc:
-        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), options.linear, frames, seeds.linear_rows));
+        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), getMl(), options, frames, seeds.linear_rows,
+                                           seeds.refine_events));
         break;
-      case Method::CelcMl: {
-        const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
-        out.push_back(detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr,
-                                          options, frames, seeds.refine_events));
-        break;
-      }
+      case Method::CelcMl: out.push_back(getMl()); break;
       case Method::CelcOpt: {
         const SolverResult& init = getLinear();
         out.push_back(celcOptCanStart(init) ? solveCelcOpt(obs, motion, init, options, frames, seeds) : init);
@@ -247,7 +254,10 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     SolverResult& r = out[i];
     r.parallax = window.parallax;
     r.n_lines = window.n_lines;
-    if (methods[i] == Method::CelcAcc) {  // its own spread (celc_acc.hpp): the bound assumes a constant v
+    // celc_acc's accelerating answer has its own spread (celc_acc.hpp): the
+    // bound assumes a constant v. Its constant-velocity answer is celc_ml's.
+    const bool own_sigma = methods[i] == Method::CelcAcc && r.acceleration_seen;
+    if (own_sigma) {
       if (!r.ok() || !u.enabled) r.sigma_deg = NAN;
       continue;
     }
@@ -260,7 +270,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::CelcMl: scale = u.scale_celc_ml; break;
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
-      case Method::CelcAcc: break;
+      case Method::CelcAcc: scale = u.scale_celc_ml; break;
     }
     r.sigma_deg = std::max(terms().sigmaDeg(r.v, scale), sigma_floor_deg[i]);
   }
@@ -295,8 +305,11 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       if (std::isfinite(w.sigma_deg)) witnesses.push_back(w);
     }
   }
+  // The witnesses assume a constant velocity: celc_acc's accelerating answer
+  // is not held to them.
   for (size_t i = 0; i < out.size(); ++i)
-    if (out[i].ok() && std::isfinite(out[i].sigma_deg)) raiseToDisagreement(out[i], witness_of[i], witnesses);
+    if (out[i].ok() && std::isfinite(out[i].sigma_deg) && !(methods[i] == Method::CelcAcc && out[i].acceleration_seen))
+      raiseToDisagreement(out[i], witness_of[i], witnesses);
   return floorBehind();
 }
 
