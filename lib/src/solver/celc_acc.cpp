@@ -29,7 +29,13 @@ struct AccRow {
   Mat26 N;
 };
 
-constexpr int kMaxIterations = 50;  // IRLS steps at most
+// IRLS steps at most: the linear (v, a) is a start of the joint
+// refinement, which needs its basin, not its minimum.
+constexpr int kMaxIterations = 5;
+// Rows of the linear stage at most (a start: 5 unknowns).
+constexpr std::size_t kMaxRows = 400;
+// The joint refinement's starts merge within this [deg] (celc_ml's kMergeDeg).
+constexpr double kMergeDeg = 1.0;
 
 /// x = (v, a) minimising the weighted sum of w_i (a_i^T x)^2 with |v| = 1.
 bool weightedSolve(const std::vector<AccRow>& rows, const std::vector<double>& w, bool with_acceleration, Vec6& x,
@@ -131,7 +137,8 @@ bool linearAcceleration(const WindowObservations& obs, const MotionModel& motion
   const std::vector<int> usable = usableClusters(obs, opt.min_cluster_events);
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
-  const std::vector<size_t> quota = rowQuota(sizes, static_cast<size_t>(opt.max_rows), opt.balance_clusters);
+  const size_t max_rows = opt.max_rows > 0 ? std::min(static_cast<std::size_t>(opt.max_rows), kMaxRows) : kMaxRows;
+  const std::vector<size_t> quota = rowQuota(sizes, max_rows, opt.balance_clusters);
   const double t_ref = motion.referenceTime();
   auto q = [&](double t) { return 0.5 * (t - t_ref) * (t - t_ref); };
   std::vector<AccRow> rows;
@@ -158,28 +165,9 @@ bool linearAcceleration(const WindowObservations& obs, const MotionModel& motion
   Vec6 x0 = Vec6::Zero();
   x0.head<3>() = celc.v.normalized();
   const double scale0 = std::max(robustScale(residuals(rows, x0)), 1e-12);
-  const Fit constant = irls(rows, x0, false, opt, scale0);
-  // The accelerating fit from the constant one and from the best directions
-  // of a hemisphere lattice (an acceleration can move v's basin far from
-  // where a constant-velocity solver puts it): the lowest Huber cost wins.
-  Fit accelerating = irls(rows, constant.ok ? constant.x : x0, true, opt, scale0);
-  if (opt.grid_directions > 0 && opt.grid_starts > 0) {
-    std::vector<std::pair<double, Vec3>> scored;
-    for (const Vec3& d : hemisphereDirections(opt.grid_directions)) {
-      Vec6 xd = Vec6::Zero();
-      xd.head<3>() = d;
-      scored.emplace_back(huberCost(residuals(rows, xd), scale0, opt.huber_k), d);
-    }
-    const std::size_t n_starts = std::min<std::size_t>(scored.size(), static_cast<std::size_t>(opt.grid_starts));
-    std::partial_sort(scored.begin(), scored.begin() + static_cast<std::ptrdiff_t>(n_starts), scored.end(),
-                      [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (std::size_t k = 0; k < n_starts; ++k) {
-      Vec6 xd = Vec6::Zero();
-      xd.head<3>() = scored[k].second;
-      const Fit f = irls(rows, irls(rows, xd, false, opt, scale0).x, true, opt, scale0);
-      if (f.ok && f.cost < accelerating.cost) accelerating = f;
-    }
-  }
+  // From celc's v with a = 0 (the joint refinement's other start, celc_ml's
+  // answer, has searched the sphere for v's basin already).
+  const Fit accelerating = irls(rows, x0, true, opt, scale0);
   if (!accelerating.ok || !accelerating.x.allFinite() || !(accelerating.x.head<3>().norm() > 0.0)) return false;
   out = accelerating.x / accelerating.x.head<3>().norm();
   if (out.head<3>().dot(celc.v) < 0.0) out = -out;
@@ -189,8 +177,8 @@ bool linearAcceleration(const WindowObservations& obs, const MotionModel& motion
 }  // namespace
 
 SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
-                          const SolverResult& ml, const SolverOptions& options, const WindowFrames& frames,
-                          std::uint64_t row_seed, std::uint64_t event_seed) {
+                          const SolverResult& ml, const MlEnd& ml_end, const SolverOptions& options,
+                          const WindowFrames& frames, std::uint64_t row_seed, std::uint64_t event_seed) {
   const auto start = Clock::now();
   SolverResult result;
   if (rejectInput(obs, motion, options.linear, result)) return result;
@@ -221,46 +209,73 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
                                 " lines, too few to fix an acceleration");
   const int iterations = options.refine.max_iterations;
   const double tolerance = options.refine.function_tolerance;
-  // The constant-velocity minimum of this problem (celc_ml's answer refined
-  // on its events), which sets the Huber threshold as celc_ml's first end
-  // point does (MlOptions::huber_scale) and is the test's C_0.
-  JointProblem::Result constant = problem.refineConstantVelocity(problem.start(ml.v), iterations, tolerance);
-  if (!constant.ok) return constantVelocity(Degeneracy::None, "the constant-velocity refinement failed");
-  if (options.ml.huber_scale > 0.0) {
-    const double scaled = options.ml.huber_scale * problem.robustScale(constant.state);
-    if (scaled > options.refine.huber_px) {
-      problem.setHuber(scaled);
-      JointProblem::Result again = problem.refineConstantVelocity(constant.state, iterations, tolerance);
-      if (again.ok) constant = std::move(again);
-      else constant.cost = problem.cost(constant.state);
+  // The starts: celc_ml's answer with a = 0 and its lines (with its Huber
+  // threshold: the same events); the linear (v, a) with the fitted lines;
+  // celc_ml's answer with the fitted lines. Each is refined
+  // ml.start_iterations iterations (a start that comes within kMergeDeg of
+  // an earlier end point, in v and in every line, stops: it would end
+  // there), and the lowest cost continues to convergence. Without celc_ml's
+  // threshold, the first end point sets it as celc_ml's does
+  // (MlOptions::huber_scale).
+  std::vector<JointProblem::State> starts;
+  const bool handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
+  if (handed) {
+    JointProblem::State s = problem.start(ml.v);
+    s.m1 = ml_end.m1;
+    s.m3 = ml_end.m3;
+    starts.push_back(std::move(s));
+    problem.setHuber(ml_end.huber_px);
+  }
+  Vec6 linear;
+  if (linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear))
+    starts.push_back(problem.start(linear.head<3>(), linear.tail<3>()));
+  starts.push_back(problem.start(ml.v));
+  const int screen_iterations =
+      options.ml.start_iterations > 0 ? std::min(options.ml.start_iterations, iterations) : iterations;
+  JointProblem::Result best;
+  std::vector<JointProblem::State> ends;
+  bool threshold_set = handed;
+  for (const JointProblem::State& s : starts) {
+    JointProblem::Result r = problem.refine(s, screen_iterations, tolerance, 1, ends, kMergeDeg * M_PI / 180.0);
+    if (!r.ok || r.merged) continue;
+    if (!threshold_set && options.ml.huber_scale > 0.0) {
+      threshold_set = true;
+      const double scaled = options.ml.huber_scale * problem.robustScale(r.state);
+      if (scaled > options.refine.huber_px) {
+        problem.setHuber(scaled);
+        r = problem.refine(r.state, screen_iterations, tolerance);
+        if (!r.ok) continue;
+      }
+    }
+    ends.push_back(r.state);
+    if (!best.ok || r.cost < best.cost) best = std::move(r);
+  }
+  if (best.ok && best.iterations >= screen_iterations && screen_iterations < iterations) {
+    JointProblem::Result rest = problem.refine(best.state, iterations, tolerance);
+    if (rest.ok) {
+      rest.iterations += best.iterations;
+      best = std::move(rest);
     }
   }
-  // The accelerating starts: celc_ml's end point with a = 0 and the linear
-  // (v, a) with the fitted lines; the lower cost wins.
-  JointProblem::Result best = problem.refine(constant.state, iterations, tolerance);
-  Vec6 linear;
-  if (linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear)) {
-    JointProblem::Result r = problem.refine(problem.start(linear.head<3>(), linear.tail<3>()), iterations, tolerance);
-    if (r.ok && (!best.ok || r.cost < best.cost)) best = std::move(r);
-  }
-  if (!best.ok) return constantVelocity(Degeneracy::None, "the accelerating refinement failed");
-  // Observability: a's covariance with the lines and v eliminated.
+  // a's covariance with the lines and v eliminated, the residuals' robust
+  // scale as the noise's.
   const double scale = problem.robustScale(best.state);
   const Eigen::MatrixXd info = problem.information(best.state);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
-  double sigma_a = INFINITY;
+  double sigma_a = INFINITY, wald = 0.0;
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(5, 5, NAN);
   if (es.info() == Eigen::Success && es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(4), 1e-300)) {
     cov = scale * scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
           es.eigenvectors().transpose();
-    const Eigen::SelfAdjointEigenSolver<Mat3> ea(Mat3(cov.bottomRightCorner<3, 3>()));
+    const Mat3 cov_a = cov.bottomRightCorner<3, 3>();
+    const Eigen::SelfAdjointEigenSolver<Mat3> ea(cov_a);
     sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
+    if (ea.eigenvalues()(0) > 0.0) wald = best.state.a.dot(cov_a.ldlt().solve(best.state.a));
   }
   double reach = 0.0;  // the longest |t - t_ref| [s]
   for (int c : frames.clusters())
     for (double t : obs.clusters[c].times)
       if (std::isfinite(t)) reach = std::max(reach, std::abs(t - motion.referenceTime()));
-  const double lr = 2.0 * (constant.cost - best.cost) / std::max(scale * scale, 1e-300);
   char text[240];
   if (!(sigma_a * reach <= acc.max_sigma)) {
     std::snprintf(text, sizeof text,
@@ -270,8 +285,8 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
     r.acceleration = best.state.a;
     return r;
   }
-  if (!(lr > acc.test_chi2)) {
-    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
+  if (!(wald > acc.test_chi2)) {
+    std::snprintf(text, sizeof text, "no acceleration seen (Wald statistic %.3g <= %g)", wald, acc.test_chi2);
     SolverResult r = constantVelocity(Degeneracy::None, text);
     r.acceleration = best.state.a;
     return r;
@@ -282,18 +297,18 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   result.acceleration = best.state.a;
   SignDecision sign;
   if (options.linear.resolve_sign) {
-    sign = resolveSign(obs, motion, result.v, frames);
+    sign = resolveSign(obs, motion, result.v, &result.acceleration, frames);
     result.v *= static_cast<double>(sign.sign);
     result.acceleration *= static_cast<double>(sign.sign);
   }
   result.sign_margin = sign.margin * sign.sign;
-  result.iterations = constant.iterations + best.iterations;
+  result.iterations = best.iterations;
   result.rows_used = best.events;
   result.residual_px = scale;
   // The direction's spread: v's tangent block of the covariance.
   result.sigma_deg = std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
   if (!std::isfinite(result.sigma_deg)) result.sigma_deg = INFINITY;
-  std::snprintf(text, sizeof text, "acceleration seen (likelihood ratio %.3g), |a|/|v| = %.3g 1/s", lr,
+  std::snprintf(text, sizeof text, "acceleration seen (Wald statistic %.3g), |a|/|v| = %.3g 1/s", wald,
                 result.acceleration.norm());
   result.message = text;
   result.time_us = before_us + microsecondsSince(start);

@@ -36,20 +36,22 @@
 #include <cstdint>
 
 #include "celc/solver/solver.hpp"
+#include "celc_ml.hpp"
 #include "constraint_rows.hpp"
 
 namespace celc::detail {
 
 /// celc_acc on the window's frames: `celc` is CELC's linear result (the
 /// linear stage's start and sign), `ml` celc_ml's (the second start and the
-/// constant-velocity answer); rows drawn with row_seed as CELC draws them,
+/// constant-velocity answer) with its lines and Huber threshold `ml_end`
+/// (when valid: the start's lines and the joint problem's loss); rows drawn with row_seed as CELC draws them,
 /// the joint problem's events with event_seed as celc_ml draws them.
 /// SolverResult::acceleration is a / |v| [1/s] (reference frame) and
 /// acceleration_seen the test's verdict; sigma_deg is set where the
 /// acceleration is seen (the Fisher information with the lines and a
 /// eliminated). Its time includes celc's and celc_ml's.
 SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
-                          const SolverResult& ml, const SolverOptions& options, const WindowFrames& frames,
-                          std::uint64_t row_seed, std::uint64_t event_seed);
+                          const SolverResult& ml, const MlEnd& ml_end, const SolverOptions& options,
+                          const WindowFrames& frames, std::uint64_t row_seed, std::uint64_t event_seed);
 
 }  // namespace celc::detail

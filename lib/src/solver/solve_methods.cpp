@@ -191,12 +191,13 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     return npt;
   };
   SolverResult ml;
+  detail::MlEnd ml_end;  // celc_ml's lines, celc_acc's start
   bool have_ml = false;
   auto getMl = [&]() -> const SolverResult& {
     if (!have_ml) {
       const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
       ml = detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr, options, frames,
-                               seeds.refine_events);
+                               seeds.refine_events, &ml_end);
       have_ml = true;
     }
     return ml;
@@ -209,7 +210,8 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         break;
       case Method::Npt: out.push_back(getNpt()); break;
       case Method::CelcAcc:
-        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), getMl(), options, frames, seeds.linear_rows,
+        getMl();
+        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), ml, ml_end, options, frames, seeds.linear_rows,
                                            seeds.refine_events));
         break;
       case Method::CelcMl: out.push_back(getMl()); break;
