@@ -34,6 +34,11 @@ struct AccRow {
 constexpr int kMaxIterations = 5;
 // Rows of the linear stage at most (a start: 5 unknowns).
 constexpr std::size_t kMaxRows = 400;
+// The joint refinement stops where a step lowers the cost by less than this
+// share (or refine.function_tolerance, if larger): with N events that is
+// N 1e-7 likelihood units, far below what moves the estimate; the valley of
+// v and a is long and Levenberg-Marquardt crawls along it.
+constexpr double kFunctionTolerance = 1e-7;
 // The joint refinement's starts merge within this [deg] (celc_ml's kMergeDeg).
 constexpr double kMergeDeg = 1.0;
 
@@ -208,7 +213,7 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
                             std::to_string(problem.events()) + " events on " + std::to_string(problem.clusters()) +
                                 " lines, too few to fix an acceleration");
   const int iterations = options.refine.max_iterations;
-  const double tolerance = options.refine.function_tolerance;
+  const double tolerance = std::max(options.refine.function_tolerance, kFunctionTolerance);
   // The starts: celc_ml's answer with a = 0 and its lines (with its Huber
   // threshold: the same events); the linear (v, a) with the fitted lines;
   // celc_ml's answer with the fitted lines. Each is refined
@@ -219,17 +224,17 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   // (MlOptions::huber_scale).
   std::vector<JointProblem::State> starts;
   const bool handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
+  JointProblem::State from_ml = problem.start(ml.v);
   if (handed) {
-    JointProblem::State s = problem.start(ml.v);
-    s.m1 = ml_end.m1;
-    s.m3 = ml_end.m3;
-    starts.push_back(std::move(s));
+    from_ml.m1 = ml_end.m1;
+    from_ml.m3 = ml_end.m3;
+    starts.push_back(from_ml);
     problem.setHuber(ml_end.huber_px);
   }
   Vec6 linear;
   if (linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear))
     starts.push_back(problem.start(linear.head<3>(), linear.tail<3>()));
-  starts.push_back(problem.start(ml.v));
+  if (!handed) starts.push_back(problem.start(ml.v));
   const int screen_iterations =
       options.ml.start_iterations > 0 ? std::min(options.ml.start_iterations, iterations) : iterations;
   JointProblem::Result best;
@@ -257,12 +262,16 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
       best = std::move(rest);
     }
   }
+  // The test's C_0: celc_ml's answer refined on this problem under the
+  // constant-velocity model (the answer without a; from celc_ml's lines a
+  // few iterations).
+  const JointProblem::Result constant = problem.refineConstantVelocity(from_ml, iterations, tolerance);
   // a's covariance with the lines and v eliminated, the residuals' robust
   // scale as the noise's.
   const double scale = problem.robustScale(best.state);
   const Eigen::MatrixXd info = problem.information(best.state);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
-  double sigma_a = INFINITY, wald = 0.0;
+  double sigma_a = INFINITY;
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(5, 5, NAN);
   if (es.info() == Eigen::Success && es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(4), 1e-300)) {
     cov = scale * scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
@@ -270,7 +279,6 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
     const Mat3 cov_a = cov.bottomRightCorner<3, 3>();
     const Eigen::SelfAdjointEigenSolver<Mat3> ea(cov_a);
     sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
-    if (ea.eigenvalues()(0) > 0.0) wald = best.state.a.dot(cov_a.ldlt().solve(best.state.a));
   }
   double reach = 0.0;  // the longest |t - t_ref| [s]
   for (int c : frames.clusters())
@@ -285,8 +293,9 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
     r.acceleration = best.state.a;
     return r;
   }
-  if (!(wald > acc.test_chi2)) {
-    std::snprintf(text, sizeof text, "no acceleration seen (Wald statistic %.3g <= %g)", wald, acc.test_chi2);
+  const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / std::max(scale * scale, 1e-300) : INFINITY;
+  if (!(lr > acc.test_chi2)) {
+    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
     SolverResult r = constantVelocity(Degeneracy::None, text);
     r.acceleration = best.state.a;
     return r;
@@ -308,7 +317,7 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   // The direction's spread: v's tangent block of the covariance.
   result.sigma_deg = std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
   if (!std::isfinite(result.sigma_deg)) result.sigma_deg = INFINITY;
-  std::snprintf(text, sizeof text, "acceleration seen (Wald statistic %.3g), |a|/|v| = %.3g 1/s", wald,
+  std::snprintf(text, sizeof text, "acceleration seen (likelihood ratio %.3g), |a|/|v| = %.3g 1/s", lr,
                 result.acceleration.norm());
   result.message = text;
   result.time_us = before_us + microsecondsSince(start);

@@ -23,16 +23,17 @@
 // order in time. The answer is the joint maximum-likelihood refinement of
 // v, a and every cluster's lines (JointProblem with an acceleration: the
 // lines' image motion under the constant acceleration), started from the
-// linear (v, a) and from celc_ml's v with a = 0; the lower robust cost wins.
+// linear (v, a) and from celc_ml's v with a = 0 (its lines, and the fitted
+// ones); the lowest robust cost wins.
 // Then two checks, each falling back to celc_ml's answer where it fails:
 //   observable: at least acc.min_lines lines, and a's standard deviation
 //     (Fisher information with the lines and v eliminated, the residuals'
 //     robust scale) times the longest |t - t_ref| at most acc.max_sigma;
 //     else Degeneracy::AccelerationUnobservable, status ok, and the message
 //     says why;
-//   seen: the likelihood ratio 2 (C_0 - C_a) / s^2 of the costs at the best
-//     constant-velocity and accelerating states (same events, same loss)
-//     above acc.test_chi2.
+//   seen: the likelihood ratio 2 (C_0 - C_a) / s^2 above acc.test_chi2, C_a
+//     the accelerating end point's cost, C_0 that of celc_ml's answer
+//     refined on the same events under the same loss with a = 0.
 #include <cstdint>
 
 #include "celc/solver/solver.hpp"
