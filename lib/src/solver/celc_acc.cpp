@@ -220,13 +220,13 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   const int iterations = options.refine.max_iterations;
   const double tolerance = std::max(options.refine.function_tolerance, kFunctionTolerance);
   // The starts: celc_ml's answer with a = 0 and its lines (with its Huber
-  // threshold: the same events); the linear (v, a) with the fitted lines;
-  // celc_ml's answer with the fitted lines. Each is refined
+  // threshold: the same events), or, where celc_ml hands over none, with the
+  // fitted lines; the linear (v, a) with the fitted lines. Each is refined
   // ml.start_iterations iterations (a start that comes within kMergeDeg of
   // an earlier end point, in v and in every line, stops: it would end
-  // there), and the lowest cost continues to convergence. Without celc_ml's
-  // threshold, the first end point sets it as celc_ml's does
-  // (MlOptions::huber_scale).
+  // there), and the lowest cost continues (kContinueIterations at most).
+  // Without celc_ml's threshold, the first end point sets it as celc_ml's
+  // does (MlOptions::huber_scale).
   std::vector<JointProblem::State> starts;
   const bool handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
   JointProblem::State from_ml = problem.start(ml.v);
@@ -267,6 +267,9 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
       best = std::move(rest);
     }
   }
+  if (!best.ok) return constantVelocity(Degeneracy::None, "the accelerating refinement failed");
+  // a with the sign of celc_ml's v, for the constant-velocity answers.
+  const Vec3 a_along_ml = best.state.v.dot(ml.v) < 0.0 ? Vec3(-best.state.a) : best.state.a;
   // The test's C_0: celc_ml's answer refined on this problem under the
   // constant-velocity model (the answer without a; from celc_ml's lines a
   // few iterations).
@@ -295,14 +298,14 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
                   "acceleration not observable: its std times the window's reach, %.3g, above %g", sigma_a * reach,
                   acc.max_sigma);
     SolverResult r = constantVelocity(Degeneracy::AccelerationUnobservable, text);
-    r.acceleration = best.state.a;
+    r.acceleration = a_along_ml;
     return r;
   }
   const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / std::max(scale * scale, 1e-300) : INFINITY;
   if (!(lr > acc.test_chi2)) {
     std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
     SolverResult r = constantVelocity(Degeneracy::None, text);
-    r.acceleration = best.state.a;
+    r.acceleration = a_along_ml;
     return r;
   }
   result.status = SolveStatus::Ok;
