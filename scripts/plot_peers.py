@@ -25,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {"celc": ("C0", "CELC"), "celc_opt": ("C1", "CELC+opt"),
          "celc_ml": ("C2", "CELC+ML (lines refined)"), "ce3lc": ("C3", "CE3LC"),
-         "npt": ("C4", "N-point (CVPR'24)")}
+         "npt": ("C4", "N-point (CVPR'24)"), "celc_acc": ("C5", "CELC+ML, constant acceleration")}
 
 
 def num(x):

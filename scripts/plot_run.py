@@ -30,7 +30,7 @@ import sys
 
 STYLE = {"celc": ("C0", "CELC"), "celc_opt": ("C1", "CELC+opt"),
          "celc_ml": ("C2", "CELC+ML (lines refined)"), "ce3lc": ("C3", "CE3LC"),
-         "npt": ("C4", "N-point (CVPR'24)")}
+         "npt": ("C4", "N-point (CVPR'24)"), "celc_acc": ("C5", "CELC+ML, constant acceleration")}
 PHI_FLOOR_DEG = 1e-3  # phi below this [deg] is drawn at it (log axis)
 
 

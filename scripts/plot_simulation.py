@@ -23,10 +23,11 @@ LABELS = {
     "speed": "speed [m/s]",
     "interval": "time interval [s]",
     "lines": "number of lines",
+    "acceleration": "rho = |a| Z / (2 V^2)",
 }
 STYLE = {"celc": ("C0", "CELC"), "celc_opt": ("C1", "CELC+opt"),
          "celc_ml": ("C2", "CELC+ML (lines refined)"), "ce3lc": ("C3", "CE3LC"),
-         "npt": ("C4", "N-point (CVPR'24)")}
+         "npt": ("C4", "N-point (CVPR'24)"), "celc_acc": ("C5", "CELC+ML, constant acceleration")}
 
 
 def read(path):

@@ -12,6 +12,7 @@
 #   rotation    scripts/rotation_trust.sh: rotation_trust.md (pure rotation, calibration errors; 2 min)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
+#   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
 #   summary     the README's results table from simulation, peers and scenes: summary.md;
 #               then the tables the pages of docs/ include (<!-- include results/NAME.md -->)
@@ -29,7 +30,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds acceleration studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -97,6 +98,10 @@ for name in "${names[@]}"; do
         $tables table 1 < "$work/speed3.txt"; echo; $tables table 0 < "$work/speed1.txt"; echo;
         $tables table 0 < "$work/speed3.txt"; } |
         put clusters_speeds.md speeds "scripts/cluster_table.sh --seed 50000 --count 8 --speed V,V --rate 0.3,3, V = 1 and 3"
+      ;;
+    acceleration)
+      scripts/acceleration_sweep.sh 200 "$work/acceleration" > "$work/acceleration.txt"
+      $tables table 0 < "$work/acceleration.txt" | put acceleration_sweep.md acceleration "scripts/acceleration_sweep.sh 200"
       ;;
     studies)
       for s in acceleration rate_offset solve_path; do

@@ -222,7 +222,7 @@ TEST(ConfigSchema, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(apply("solver:\n  linear:\n    huber_k: .nan\n"), "b.yaml:3: key 'solver.linear.huber_k': expected a number, got '.nan'");
   EXPECT_EQ(apply("solver:\n  linear:\n    max_rows: 1e99\n"), "b.yaml:3: key 'solver.linear.max_rows': expected an integer (32 bit), got '1e99'");
   EXPECT_EQ(apply("motion:\n  fixed_omega: [1, 2]\n"), "b.yaml:2: key 'motion.fixed_omega': expected a list of 3 numbers, found 2");
-  EXPECT_EQ(apply("methods: [celc, magic]\n"), "b.yaml:1: key 'methods': expected one of celc, celc_opt, celc_ml, ce3lc, npt, got 'magic'");
+  EXPECT_EQ(apply("methods: [celc, magic]\n"), "b.yaml:1: key 'methods': expected one of celc, celc_opt, celc_ml, ce3lc, npt, celc_acc, got 'magic'");
   EXPECT_EQ(apply("windows: 3\n"), "b.yaml:1: key 'windows': expected a map of keys, got '3'");
   EXPECT_EQ(apply("windows:\n  events: 1\nwindows:\n  events: 2\n"), "b.yaml:3: key 'windows': given twice (first at line 1)");
   EXPECT_EQ(apply("cluster:\n  seed: 1\n  seed: 2\n"), "b.yaml:3: key 'cluster.seed': given twice (first at line 2)");

@@ -3,6 +3,7 @@
 // beside the Cramér-Rao bound with its default options.
 #include <cstdio>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -270,6 +271,34 @@ TEST(JointProblem, ConvergesToTheTruthWithoutNoise) {
   const auto r = s.problem.refine(s.problem.start(s.start), 100, 1e-14);
   ASSERT_TRUE(r.ok);
   EXPECT_LT(angleBetweenSignAgnostic(r.state.v, s.tr.true_direction) * kDeg, 1e-4);
+}
+
+// With an acceleration (celc_acc) and a = 0 the problem is celc_ml's: the
+// same events, costs and end point; refineConstantVelocity keeps a at 0.
+// Started 10 deg off with a = 0, the accelerating refinement still ends at
+// the truth (noise-free, constant velocity) with a at 0.
+TEST(JointProblem, AccelerationAtZeroIsTheConstantVelocityProblem) {
+  const StartTenDegreesOff s;
+  ASSERT_TRUE(s.tr.ok);
+  const detail::JointProblem acc(s.tr.observations, s.tr.given_motion, s.frames, 0, false, 1, 1.5, true);
+  ASSERT_EQ(acc.events(), s.problem.events());
+  EXPECT_TRUE(acc.hasAcceleration());
+  const auto st = s.problem.start(s.start);
+  EXPECT_NEAR(acc.cost(acc.start(s.start)), s.problem.cost(st), 1e-9 * s.problem.cost(st));
+  const auto cv = acc.refineConstantVelocity(acc.start(s.start), 100, 1e-14);
+  const auto ref = s.problem.refine(st, 100, 1e-14);
+  ASSERT_TRUE(cv.ok && ref.ok);
+  EXPECT_EQ(cv.state.a, Vec3::Zero());
+  EXPECT_LT(angleBetween(cv.state.v, ref.state.v) * kDeg, 1e-6);
+  const auto free = acc.refine(acc.start(s.start), 100, 1e-14);
+  ASSERT_TRUE(free.ok);
+  EXPECT_LT(angleBetweenSignAgnostic(free.state.v, s.tr.true_direction) * kDeg, 1e-4);
+  EXPECT_LT(free.state.a.norm(), 1e-4);
+  // The information: 5 x 5, symmetric, positive definite at the truth.
+  const Eigen::MatrixXd info = acc.information(free.state);
+  ASSERT_EQ(info.rows(), 5);
+  EXPECT_LT((info - info.transpose()).norm(), 1e-9 * info.norm());
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(info).eigenvalues()(0), 0.0);
 }
 
 // A start that comes within merge_rad of an earlier end point (in v and in

@@ -67,6 +67,26 @@ void printSweepTable(const Sweep& sweep, const std::vector<SweepCell>& cells,
   }
 }
 
+// A sweep's medians: rows levels, columns methods, median phi [deg] and the
+// median solver time [ms] of the ok trials.
+void printMedianTable(const Sweep& sweep, const std::vector<SweepCell>& cells, const std::vector<Method>& methods) {
+  std::cout << "\nSweep " << sweep.name << ": median phi [deg] / median time [ms] (ok trials)\n\n| "
+            << sweep.parameter;
+  for (Method m : methods) std::cout << " | " << toString(m);
+  std::cout << " |\n|---";
+  for (size_t i = 0; i < methods.size(); ++i) std::cout << "|---";
+  std::cout << "|\n";
+  for (size_t i = 0; i < cells.size(); i += methods.size()) {
+    std::cout << "| " << fmt::format("{:g}", cells[i].level);
+    for (size_t m = 0; m < methods.size(); ++m) {
+      const auto& c = cells[i + m];
+      std::cout << " | " << fmt::format("{:.3f}", c.phi_median * 180.0 / M_PI) << " / "
+                << fmt::format("{:.1f}", c.time_median_us * 1e-3);
+    }
+    std::cout << " |\n";
+  }
+}
+
 // The uncertainty study: per setting and method the share of ok trials with
 // phi <= 2 sigma_deg (target 0.85-0.99), the median sigma, and how many ok
 // trials claim sigma < 10 deg. OUTDIR/sigma.csv holds the same;
@@ -218,6 +238,7 @@ void runSimulate(const SimulateArgs& a) {
     writeFileAtomically((out / (sweep->name + ".csv")).string(), csv);
     if (sweep->name == "default") printDefaultTable(cells);
     else printSweepTable(*sweep, cells, cfg.methods);
+    if (sweep->name == "acceleration") printMedianTable(*sweep, cells, cfg.methods);
   }
   std::cout << std::flush;
 
@@ -237,7 +258,8 @@ void registerSimulate(CLI::App& app) {
       "OUTDIR/<sweep>.png; prints the tables.");
   cmd->add_option("--sweep", a->sweep,
                   "all, default, event_noise, line_noise, omega_noise, speed, interval, lines "
-                  "(the paper's study), or peers (= --study peers)")
+                  "(the paper's study), acceleration (rho = |a| Z / (2 V^2) from 0 to 30; not in all; "
+                  "also prints median phi [deg] and time [ms]), or peers (= --study peers)")
       ->capture_default_str();
   cmd->add_option("--study", a->study,
                   "paper: the paper's sweeps; sigma: the calibration of sigma_deg (share of ok trials with "
@@ -258,7 +280,7 @@ void registerSimulate(CLI::App& app) {
   cmd->add_option("--threads", a->threads, "worker threads (0 = all cores, at most 1024)")
       ->capture_default_str();
   cmd->add_option("--methods", a->methods,
-                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "study.methods"));
+                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt,celc_acc (or all): " + fieldHelp(schema, "study.methods"));
   cmd->add_flag("--force", a->force, "overwrite the results in OUTDIR");
   cmd->add_flag("--no-plots", a->no_plots, "skip the PNG plots");
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");

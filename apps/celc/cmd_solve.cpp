@@ -174,7 +174,7 @@ void registerSolve(CLI::App& app) {
     RunConfig defaults;
     const Describe schema = [&](FieldVisitor& v) { describe(v, defaults); };
     cmd->add_option("--methods", a->methods,
-                    "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "methods"));
+                    "comma-separated celc,celc_opt,celc_ml,ce3lc,npt,celc_acc (or all): " + fieldHelp(schema, "methods"));
   }
   cmd->add_flag("-q,--quiet", a->quiet, "only warnings and errors on stderr");
   cmd->add_flag("-v,--verbose", a->verbose, "debug logging");

@@ -24,7 +24,7 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
   cmd->add_option("--window-seconds", o.window_seconds,
                   "windows of a fixed duration (windows.policy seconds): " + fieldHelp(schema, "windows.seconds"));
   cmd->add_option("--methods", o.methods,
-                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt: " + fieldHelp(schema, "methods"));
+                  "comma-separated celc,celc_opt,celc_ml,ce3lc,npt,celc_acc (or all): " + fieldHelp(schema, "methods"));
   cmd->add_option("--omega", o.omega,
                   "assume this constant angular velocity wx,wy,wz [rad/s, camera frame] instead of "
                   "the gyroscope (recordings without IMU)");

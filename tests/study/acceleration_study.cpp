@@ -1,7 +1,9 @@
-// What a constant-velocity solver makes of an accelerating camera: the peer
-// scene (sim/peer_scene.hpp) with a constant acceleration a in a random
-// direction, v the mean velocity over the window (the truth), solved by
-// solveMethods with `celc run`'s default solver options and the exact rotation.
+// What a constant-velocity solver makes of an accelerating camera, and what
+// celc_acc (which models the acceleration) makes of it: the peer scene
+// (sim/peer_scene.hpp) with a constant acceleration a in a random
+// direction, v the velocity at the window's middle (its mean over the
+// window, the truth), solved by solveMethods with `celc run`'s default
+// solver options and the exact rotation.
 //
 // Why the ratio rho = |a| Z / (2 V^2) (Z = 4 m, the depths' middle): the
 // direction of v reaches the image lines only at second order in time. Under
@@ -50,15 +52,18 @@ int main(int argc, char** argv) {
   const int status = study::parseStudyArgs(argc, argv, "celc_acceleration_study", trials, seed);
   if (status >= 0) return status;
   const RunConfig defaults;
+  // `celc run`'s methods and celc_acc, which models the acceleration.
+  std::vector<Method> methods = defaults.methods;
+  methods.push_back(Method::CelcAcc);
   std::vector<Cell> cells;
   for (double rho : {0.0, 0.03, 0.1, 0.3, 1.0}) {
     for (double T : {0.25, 0.5, 1.0}) cells.push_back({2.0, T, rho});  // one V: a the same, T varies
     cells.push_back({1.0, 0.5, rho});                                  // one T: rho the same, a and V vary
   }
   std::printf("| rho | V [m/s] | T [s] | a [m/s^2] | trials |");
-  for (Method m : defaults.methods) std::printf(" %s |", toString(m).c_str());
+  for (Method m : methods) std::printf(" %s |", toString(m).c_str());
   std::printf("\n|---|---|---|---|---|");
-  for (size_t i = 0; i < defaults.methods.size(); ++i) std::printf("---|");
+  for (size_t i = 0; i < methods.size(); ++i) std::printf("---|");
   std::printf("\n");
   for (const Cell& cell : cells) {
     PeerSceneOptions o;
@@ -67,13 +72,13 @@ int main(int argc, char** argv) {
     o.event_noise_px = 0.5;
     o.acceleration = cell.rho * 2.0 * cell.speed_m_s * cell.speed_m_s / kMidDepth;
     std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    std::vector<std::vector<double>> phi(defaults.methods.size());
+    std::vector<std::vector<double>> phi(methods.size());
     int generated = 0;
     for (int t = 0; t < trials; ++t) {
       const PeerSceneTrial tr = generatePeerScene(o, rng);
       if (!tr.ok) continue;
       ++generated;
-      const std::vector<SolverResult> res = solveMethods(tr.observations, tr.given_motion, defaults.methods,
+      const std::vector<SolverResult> res = solveMethods(tr.observations, tr.given_motion, methods,
                                                          defaults.solver, SampleSeeds{defaults.seed, defaults.seed});
       for (size_t m = 0; m < res.size(); ++m)
         phi[m].push_back(res[m].ok() ? angleBetween(tr.true_direction, res[m].v) * 180.0 / M_PI : 180.0);

@@ -54,6 +54,19 @@ const std::vector<Sweep>& paperSweeps() {
   return sweeps;
 }
 
+const std::vector<Sweep>& extraSweeps() {
+  static const std::vector<Sweep> sweeps{
+      // rho = |a| Z / (2 V^2), Z the middle of the scene's depths: an
+      // acceleration's share of what fixes v (docs/accuracy.md).
+      {"acceleration", "rho = |a| Z / (2 V^2) [-]", {0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 30.0},
+       [](LineSceneOptions& o, double rho) {
+         const double z = 0.5 * (o.z_range[0] + o.z_range[1]);
+         o.acceleration = rho * 2.0 * o.velocity.squaredNorm() / z;
+       }},
+  };
+  return sweeps;
+}
+
 const std::vector<Sweep>& sigmaSweeps() {
   static const std::vector<Sweep> sweeps{
       {"default", "default setting", {0.0}, [](LineSceneOptions&, double) {}},
@@ -84,10 +97,11 @@ const std::vector<Sweep>& sigmaSweeps() {
 
 const Sweep& findSweep(const std::string& name) {
   std::string names;
-  for (const auto& s : paperSweeps()) {
-    if (s.name == name) return s;
-    names += (names.empty() ? "" : ", ") + s.name;
-  }
+  for (const auto* list : {&paperSweeps(), &extraSweeps()})
+    for (const auto& s : *list) {
+      if (s.name == name) return s;
+      names += (names.empty() ? "" : ", ") + s.name;
+    }
   throw std::invalid_argument("unknown sweep '" + name + "' (expected all or one of: " + names + ")");
 }
 

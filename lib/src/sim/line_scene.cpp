@@ -20,6 +20,7 @@ std::string LineSceneOptions::validate() const {
     e << "ranges must be [min, max]; ";
   if (!(z_range[0] > 0.0)) e << "z_range must be in front of the camera (> 0); ";
   if (!(gyro_rate_hz > 0.0)) e << "gyro_rate_hz must be > 0; ";
+  if (!(acceleration >= 0.0) || !std::isfinite(acceleration)) e << "acceleration must be finite and >= 0; ";
   e << camera.validate();
   return e.str();
 }
@@ -59,11 +60,13 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
   trial.true_direction = speed > 0.0 ? Vec3(o.velocity / speed) : Vec3::Zero();
 
   const CameraModel& cam = o.camera;
-  auto pixelAt = [&](const Vec3& X, double t) {
+  Vec3& a = trial.true_acceleration;
+  auto inCamera = [&](const Vec3& X, double t) {
     const Mat3 R = trial.true_motion.rotation(t);
-    const Vec3 p = trial.true_motion.positionMatrix(t) * o.velocity;
-    return cam.project(R.transpose() * (X - p));
+    const Vec3 p = trial.true_motion.positionMatrix(t) * o.velocity + 0.5 * (t - ts) * (t - ts) * a;
+    return Vec3(R.transpose() * (X - p));
   };
+  auto pixelAt = [&](const Vec3& X, double t) { return cam.project(inCamera(X, t)); };
   auto bearingOf = [&](const Vec2& px) { return cam.bearing(px); };
   auto noisyLine = [&](const std::array<Vec3, 2>& seg, double t) {
     const Vec2 a = pixelAt(seg[0], t) + Vec2(ln_noise(rng), ln_noise(rng));
@@ -75,18 +78,41 @@ LineSceneTrial generateLineScene(const LineSceneOptions& o, std::mt19937_64& rng
   obs.focal_px = cam.focal();
   const int n_lines = o.fixed_segments.empty() ? o.n_lines : static_cast<int>(o.fixed_segments.size());
   obs.clusters.resize(static_cast<size_t>(n_lines));
-  for (int i = 0; i < n_lines; ++i) {
-    std::array<Vec3, 2> seg = o.fixed_segments.empty()
-                                  ? std::array<Vec3, 2>{Vec3(ux(rng), uy(rng), uz(rng)),
-                                                        Vec3(ux(rng), uy(rng), uz(rng))}
-                                  : o.fixed_segments[static_cast<size_t>(i)];
-    trial.segments.push_back(seg);
+  auto fitLines = [&](int i) {
+    const std::array<Vec3, 2>& seg = trial.segments[static_cast<size_t>(i)];
     auto& c = obs.clusters[static_cast<size_t>(i)];
     c.id = i;
     c.l1 = noisyLine(seg, ts);
     c.l2 = noisyLine(seg, tm);
     c.l3 = noisyLine(seg, te);
     c.has_l2 = true;
+  };
+  // Each segment, then its lines (without an acceleration, in turn: the
+  // draws of the paper's scene).
+  for (int i = 0; i < n_lines; ++i) {
+    std::array<Vec3, 2> seg = o.fixed_segments.empty()
+                                  ? std::array<Vec3, 2>{Vec3(ux(rng), uy(rng), uz(rng)),
+                                                        Vec3(ux(rng), uy(rng), uz(rng))}
+                                  : o.fixed_segments[static_cast<size_t>(i)];
+    trial.segments.push_back(seg);
+    if (!(o.acceleration > 0.0)) fitLines(i);
+  }
+  if (o.acceleration > 0.0) {
+    // The acceleration's direction, drawn again while it brings the camera
+    // within kMinDepth of a segment's endpoint; then the lines.
+    constexpr double kMinDepth = 0.5;  // [m]
+    std::normal_distribution<double> n01(0.0, 1.0);
+    for (int draw = 0; draw < 100; ++draw) {
+      Vec3 d(n01(rng), n01(rng), n01(rng));
+      if (!(d.norm() > 1e-9)) continue;
+      a = d.normalized() * o.acceleration;
+      bool front = true;
+      for (int k = 0; k <= 10 && front; ++k)
+        for (const auto& seg : trial.segments)
+          for (const Vec3& X : seg) front = front && inCamera(X, ts + (te - ts) * k / 10.0).z() >= kMinDepth;
+      if (front) break;
+    }
+    for (int i = 0; i < n_lines; ++i) fitLines(i);
   }
   // Side of each line's edge offset (drawn only when there is one, so that
   // the other draws do not depend on it).

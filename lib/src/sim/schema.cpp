@@ -15,6 +15,10 @@ void describe(FieldVisitor& v, LineSceneOptions& o) {
   v.field({"outlier_fraction", "-", "share of events replaced by uniform random ones"}, o.outlier_fraction);
   v.field({"edge_offset_px", "px", "events moved this far off their line, to a side drawn per line"},
           o.edge_offset_px);
+  v.field({"acceleration", "m/s^2",
+           "constant acceleration beyond the velocity (v is the velocity at the window's start), in a direction "
+           "drawn per trial"},
+          o.acceleration);
   v.field({"x_range", "m", "segment endpoints x (reference frame)"}, o.x_range);
   v.field({"y_range", "m", "segment endpoints y"}, o.y_range);
   v.field({"z_range", "m", "segment endpoints z (depth)"}, o.z_range);

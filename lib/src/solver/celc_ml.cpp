@@ -42,7 +42,8 @@ bool nptStartApplies(const WindowObservations& obs, const MotionModel& motion,
 SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motion,
                          const SolverResult& linear, const SolverResult* npt,
                          const SolverOptions& options, const WindowFrames& frames,
-                         std::uint64_t event_seed) {
+                         std::uint64_t event_seed, MlEnd* end) {
+  if (end) *end = MlEnd{};
   // The joint problem has several minima (docs/accuracy.md): every start is refined.
   struct Start {
     Vec3 v;
@@ -277,6 +278,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   }
   const MotionModel& used_motion = shifted_motion ? *shifted_motion : motion;
   const WindowFrames& used_frames = shifted_frames ? *shifted_frames : frames;
+  if (end && !shifted_motion) *end = MlEnd{best.state.m1, best.state.m3, active->lossScale(), true};
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.cost / std::max(1, best.events));
   // A last refinement under a redescending loss, from the winner (the basin

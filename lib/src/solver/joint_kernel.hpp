@@ -11,11 +11,13 @@
 namespace celc::detail {
 
 /// Event terms (EventTerm) as 27 columns: fp, the two rows of R_k^T, then De
-/// and Ds row by row; column j holds entry j of every event, then kPadding
-/// zeros.
+/// and Ds row by row; with an acceleration, two more: q_e - q_k and
+/// q_s - q_k, q(t) = (t - t_ref)^2 / 2 (celc_acc.hpp). Column j holds entry
+/// j of every event, then kPadding zeros.
 class JointColumns {
  public:
   static constexpr int kColumns = 27;
+  static constexpr int kAccelerationColumns = 29;
   /// The storage is the thread's spare columns, given back on destruction
   /// (thread_buffer.hpp).
   JointColumns();
@@ -23,18 +25,21 @@ class JointColumns {
   JointColumns(const JointColumns&) = delete;
   JointColumns& operator=(const JointColumns&) = delete;
   /// Every step-th event of each cluster c, terms[begin[c], begin[c + 1]);
-  /// strided_begin gets the clusters' ranges in the columns.
+  /// strided_begin gets the clusters' ranges in the columns. With `dq`
+  /// (per term: q_e - q_k, q_s - q_k), the acceleration's columns too.
   void assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
-              std::vector<size_t>& strided_begin);
+              std::vector<size_t>& strided_begin, const std::vector<Eigen::Vector2d>* dq = nullptr);
   /// Zero rows after the events, so that a pass may read a whole block of
   /// lanes past the last one.
   static constexpr size_t kPadding = 8;
   size_t size() const { return n_; }
   const double* data() const { return data_.data(); }
   size_t stride() const { return n_ + kPadding; }  ///< between columns [doubles]
+  bool hasAcceleration() const { return acceleration_; }
 
  private:
   size_t n_ = 0;
+  bool acceleration_ = false;
   std::vector<double> data_;
 };
 
@@ -60,14 +65,29 @@ JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t 
                               const Vec3& m1, const Vec3& m3, const double* Bv, const double* B1,
                               const double* B3, double focal, JointLossKind loss, double scale);
 
+/// The same sums with a constant acceleration a (columns with the
+/// acceleration's): the camera's position P(t) v + q(t) a, so that
+/// u.v -> u.v + (q_e - q_k) m3.a and s.v -> s.v + (q_s - q_k) m1.a in the
+/// event distance. The global block is g = (v's tangent, a): jg = slope
+/// (Bv^T dd/dv, dd/da), G = sum jg jg^T (upper triangle, row by row, 15),
+/// bg = sum jg r, W = sum jg jc^T (5 x 4, row by row); U and bc as above.
+struct JointAccelerationSums {
+  double G[15], bg[5], U[10], W[20], bc[4];
+};
+JointAccelerationSums jointAccelerationSums(const JointColumns& columns, size_t begin, size_t end,
+                                            const Vec3& v, const Vec3& a, const Vec3& m1, const Vec3& m3,
+                                            const double* Bv, const double* B1, const double* B3, double focal,
+                                            JointLossKind loss, double scale);
+
 /// sum of the Huber rho(d) = d^2 (|d| <= delta), 2 delta |d| - delta^2
-/// (beyond) over the same events; +inf when a distance is not finite.
+/// (beyond) over the same events; +inf when a distance is not finite. With
+/// `a` (columns with the acceleration's), the distances under it.
 double jointHuberCost(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
-                      const Vec3& m3, double focal, double delta);
+                      const Vec3& m3, double focal, double delta, const Vec3* a = nullptr);
 
 /// The event distances d [px] of the same events into out[0 .. end - begin),
-/// NaN where the transferred line has no image direction.
+/// NaN where the transferred line has no image direction; `a` as above.
 void jointDistances(const JointColumns& columns, size_t begin, size_t end, const Vec3& v, const Vec3& m1,
-                    const Vec3& m3, double focal, double* out);
+                    const Vec3& m3, double focal, double* out, const Vec3* a = nullptr);
 
 }  // namespace celc::detail

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "refine_costs.hpp"
 #include "sampling.hpp"
@@ -40,8 +41,10 @@ bool near(const JointProblem::State& a, const JointProblem::State& b, double min
 
 JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& motion,
                            const WindowFrames& frames, int max_events, bool balance_clusters,
-                           std::uint64_t event_seed, double huber_px)
-    : focal_(obs.focal_px), scale_(huber_px) {
+                           std::uint64_t event_seed, double huber_px, bool acceleration)
+    : acceleration_(acceleration), focal_(obs.focal_px), scale_(huber_px) {
+  const double t_ref = motion.referenceTime();
+  auto q = [t_ref](double t) { return 0.5 * (t - t_ref) * (t - t_ref); };
   const std::vector<int>& usable = frames.clusters();
   std::vector<size_t> sizes;
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
@@ -55,6 +58,7 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
     const ClusterObservation& cl = obs.clusters[usable[ci]];
     const ClusterFrame& frame = frames[usable[ci]];
     const size_t first = terms_.size();
+    const double qe = q(cl.l3.t), qs = q(cl.l1.t);
     for (size_t k : sampleIndices(cl.size(), quota[ci], event_seed + ci)) {
       const double t = cl.times[k];
       const Vec3& f = cl.bearings[k];
@@ -62,7 +66,9 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
       Mat3 Rk, Pk;
       motion.pose(t, Rk, Pk);
       const EventTerm e = makeEventTerm(frame, Rk, Pk, f);
-      if (e.fp.allFinite() && e.De.allFinite() && e.Ds.allFinite()) terms_.push_back(e);
+      if (!e.fp.allFinite() || !e.De.allFinite() || !e.Ds.allFinite()) continue;
+      terms_.push_back(e);
+      if (acceleration_) dq_.emplace_back(qe - q(t), qs - q(t));
     }
     if (terms_.size() == first) continue;
     begin_.push_back(terms_.size());
@@ -73,7 +79,7 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
 
 const JointColumns& JointProblem::columns(int stride) const {
   if (stride != column_stride_) {
-    columns_.assign(terms_, begin_, static_cast<size_t>(stride), column_begin_);
+    columns_.assign(terms_, begin_, static_cast<size_t>(stride), column_begin_, acceleration_ ? &dq_ : nullptr);
     column_stride_ = stride;
   }
   return columns_;
@@ -114,31 +120,43 @@ double JointProblem::weighted(double d, double* slope) const {
 }
 
 ResidualSpread JointProblem::spread(const State& s) const {
-  std::vector<double> d;
-  d.reserve(terms_.size());
-  for (size_t c = 0; c + 1 < begin_.size(); ++c)
-    for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
-      d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
+  if (!acceleration_) {
+    std::vector<double> d;
+    d.reserve(terms_.size());
+    for (size_t c = 0; c + 1 < begin_.size(); ++c)
+      for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
+        d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
+    return residualSpread(std::move(d));
+  }
+  const JointColumns& cols = columns(1);
+  std::vector<double> d(cols.size());
+  for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
+    jointDistances(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
+                   d.data() + column_begin_[c], &s.a);
   return residualSpread(std::move(d));
 }
 
 double JointProblem::robustScale(const State& s) const { return spread(s).scale; }
 
-JointProblem::State JointProblem::start(const Vec3& v) const { return {v.normalized(), m1_, m3_}; }
+JointProblem::State JointProblem::start(const Vec3& v, const Vec3& a) const {
+  const double n = v.norm();
+  return {v / n, m1_, m3_, acceleration_ ? Vec3(a / n) : Vec3::Zero()};
+}
 
 double JointProblem::cost(const State& s, int stride) const {
   double total = 0.0;
   if (loss_ == Loss::Huber) {
     const JointColumns& cols = columns(stride);
     for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
-      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_, scale_);
+      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_, scale_,
+                              acceleration_ ? &s.a : nullptr);
     return 0.5 * total;  // +inf when a distance is not finite
   }
   const JointColumns& cols = columns(stride);
   distances_.resize(cols.size());
   for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
     jointDistances(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
-                   distances_.data() + column_begin_[c]);
+                   distances_.data() + column_begin_[c], acceleration_ ? &s.a : nullptr);
   for (double d : distances_) {
     if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
     total += rho(d);
@@ -146,9 +164,87 @@ double JointProblem::cost(const State& s, int stride) const {
   return 0.5 * total;
 }
 
+template <int G>
+void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen::Matrix<double, G, G>& V,
+                             Eigen::Matrix<double, G, 1>& bv, std::vector<ClusterBlocks<G>>& blocks) const {
+  const JointLossKind loss = loss_ == Loss::Huber    ? JointLossKind::Huber
+                             : loss_ == Loss::Cauchy ? JointLossKind::Cauchy
+                                                     : JointLossKind::Tukey;
+  const JointColumns& cols = columns(stride);
+  V.setZero();
+  bv.setZero();
+  for (size_t c = 0; c + 1 < begin_.size(); ++c) {
+    ClusterBlocks<G>& k = blocks[c];
+    k.B1 = tangentBasis(s.m1[c]);
+    k.B3 = tangentBasis(s.m3[c]);
+    // An event whose distance is not finite adds nothing (not at s: its
+    // cost is finite).
+    const double *sum_v, *sum_bv, *sum_u, *sum_w, *sum_bc;
+    JointBlockSums b;
+    JointAccelerationSums ba;
+    if constexpr (G == 2) {
+      b = jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
+                         k.B1.data(), k.B3.data(), focal_, loss, scale_);
+      sum_v = b.V, sum_bv = b.bv, sum_u = b.U, sum_w = b.W, sum_bc = b.bc;
+    } else {
+      ba = jointAccelerationSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.a, s.m1[c], s.m3[c],
+                                 Bv.data(), k.B1.data(), k.B3.data(), focal_, loss, scale_);
+      sum_v = ba.G, sum_bv = ba.bg, sum_u = ba.U, sum_w = ba.W, sum_bc = ba.bc;
+    }
+    for (int i = 0, n = 0; i < G; ++i)
+      for (int j = i; j < G; ++j, ++n) {
+        V(i, j) += sum_v[n];
+        if (j != i) V(j, i) += sum_v[n];
+      }
+    for (int i = 0; i < G; ++i) bv(i) += sum_bv[i];
+    for (int i = 0, n = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j, ++n) k.U(i, j) = k.U(j, i) = sum_u[n];
+    for (int i = 0; i < G; ++i)
+      for (int j = 0; j < 4; ++j) k.W(i, j) = sum_w[4 * i + j];
+    k.bc = Vec4(sum_bc[0], sum_bc[1], sum_bc[2], sum_bc[3]);
+  }
+}
+
+Eigen::MatrixXd JointProblem::information(const State& s) const {
+  const Mat32 Bv = tangentBasis(s.v);
+  auto reduce = [&](auto g) -> Eigen::MatrixXd {
+    constexpr int G = decltype(g)::value;
+    std::vector<ClusterBlocks<G>> blocks(begin_.size() - 1);
+    Eigen::Matrix<double, G, G> V;
+    Eigen::Matrix<double, G, 1> bv;
+    linearise<G>(s, 1, Bv, V, bv, blocks);
+    // The lines eliminated: V - sum W U^-1 W^T (a line the events do not
+    // fix adds nothing, as the pseudo-inverse of solveSpd4 does).
+    for (ClusterBlocks<G>& k : blocks) {
+      k.X.template leftCols<G>() = k.W.transpose();
+      k.X.col(G).setZero();
+      solveSpd4(k.U, k.X);
+      V.noalias() -= k.X.template leftCols<G>().transpose() * k.W.transpose();
+    }
+    return 0.5 * (V + V.transpose());
+  };
+  return acceleration_ ? reduce(std::integral_constant<int, 5>{}) : reduce(std::integral_constant<int, 2>{});
+}
+
+JointProblem::Result JointProblem::refineConstantVelocity(State s, int max_iterations, double function_tolerance,
+                                                          int stride) const {
+  s.a.setZero();
+  return refineSteps<2>(std::move(s), max_iterations, function_tolerance, stride, {}, 0.0);
+}
+
 JointProblem::Result JointProblem::refine(State s, int max_iterations, double function_tolerance,
                                           int stride, const std::vector<State>& merge_into,
                                           double merge_rad) const {
+  return acceleration_ ? refineSteps<5>(std::move(s), max_iterations, function_tolerance, stride, merge_into, merge_rad)
+                       : refineSteps<2>(std::move(s), max_iterations, function_tolerance, stride, merge_into, merge_rad);
+}
+
+template <int G>
+JointProblem::Result JointProblem::refineSteps(State s, int max_iterations, double function_tolerance,
+                                               int stride, const std::vector<State>& merge_into,
+                                               double merge_rad) const {
+  using MatG = Eigen::Matrix<double, G, G>;
+  using VecG = Eigen::Matrix<double, G, 1>;
   const double merge_cos = std::cos(merge_rad);
   Result out;
   const size_t nc = begin_.size() - 1;
@@ -156,80 +252,53 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
     out.events += static_cast<int>((begin_[c + 1] - begin_[c] + stride - 1) / stride);
   double f = cost(s, stride);
   if (!std::isfinite(f) || out.events < 3) return out;
-  // Per cluster: the Gauss-Newton blocks at s, the tangent bases of its
-  // lines, and (per try) U_d^-1 [W^T | bc] with U_d the damped U.
-  struct ClusterBlocks {
-    Mat4 U;
-    Mat24 W;
-    Vec4 bc;
-    Mat32 B1, B3;
-    Eigen::Matrix<double, 4, 3> X;
-  };
-  std::vector<ClusterBlocks> blocks(nc);
+  std::vector<ClusterBlocks<G>> blocks(nc);
   double lambda = 1e-4;
   State trial = s;
   for (int it = 0; it < max_iterations; ++it) {
     out.iterations = it + 1;
     // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s (Huber),
     // or of r = sqrt(w(d_s)) d with the weights frozen at s (Cauchy: IRLS).
+    // The global block: v's tangent, then (G = 5) the acceleration.
     const Mat32 Bv = tangentBasis(s.v);
-    const JointColumns& cols = columns(stride);
-    Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d bv = Eigen::Vector2d::Zero();
-    for (size_t c = 0; c < nc; ++c) {
-      ClusterBlocks& k = blocks[c];
-      k.B1 = tangentBasis(s.m1[c]);
-      k.B3 = tangentBasis(s.m3[c]);
-      // An event whose distance is not finite adds nothing (not at s: its
-      // cost is finite).
-      const JointBlockSums b =
-          jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
-                         k.B1.data(), k.B3.data(), focal_,
-                         loss_ == Loss::Huber    ? JointLossKind::Huber
-                         : loss_ == Loss::Cauchy ? JointLossKind::Cauchy
-                                                 : JointLossKind::Tukey,
-                         scale_);
-      V(0, 0) += b.V[0], V(0, 1) += b.V[1], V(1, 0) += b.V[1], V(1, 1) += b.V[2];
-      bv += Eigen::Vector2d(b.bv[0], b.bv[1]);
-      for (int i = 0, n = 0; i < 4; ++i)
-        for (int j = i; j < 4; ++j, ++n) k.U(i, j) = k.U(j, i) = b.U[n];
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 4; ++j) k.W(i, j) = b.W[4 * i + j];
-      k.bc = Vec4(b.bc[0], b.bc[1], b.bc[2], b.bc[3]);
-    }
+    MatG V;
+    VecG bv;
+    linearise<G>(s, stride, Bv, V, bv, blocks);
     // Damped steps until one lowers the cost (lambda grows on failure).
     bool accepted = false;
     for (int tries = 0; tries < 12 && !accepted; ++tries) {
-      Eigen::Matrix2d S = V;
+      MatG S = V;
       S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
-      Eigen::Vector2d rhs = -bv;
+      VecG rhs = -bv;
       for (size_t c = 0; c < nc; ++c) {
-        ClusterBlocks& k = blocks[c];
+        ClusterBlocks<G>& k = blocks[c];
         Mat4 Ud = k.U;
         Ud.diagonal() += lambda * k.U.diagonal().cwiseMax(1e-12);
-        k.X.leftCols<2>() = k.W.transpose();
-        k.X.col(2) = k.bc;
+        k.X.template leftCols<G>() = k.W.transpose();
+        k.X.col(G) = k.bc;
         solveSpd4(Ud, k.X);
-        S.noalias() -= k.X.leftCols<2>().transpose() * k.W.transpose();
-        rhs.noalias() += k.X.leftCols<2>().transpose() * k.bc;
+        S.noalias() -= k.X.template leftCols<G>().transpose() * k.W.transpose();
+        rhs.noalias() += k.X.template leftCols<G>().transpose() * k.bc;
       }
-      const Eigen::Vector2d dv = S.ldlt().solve(rhs);
-      if (!dv.allFinite()) {
+      const VecG dg = S.ldlt().solve(rhs);
+      if (!dg.allFinite()) {
         lambda *= 10.0;
         continue;
       }
+      const Eigen::Vector2d dv = dg.template head<2>();
       trial.v = retract(s.v, Bv, dv);
+      if constexpr (G == 5) trial.a = s.a + dg.template tail<3>();
       for (size_t c = 0; c < nc; ++c) {
-        // dc = -U_d^-1 (bc + W^T dv), from the columns solved above.
-        const ClusterBlocks& k = blocks[c];
-        const Vec4 dc = -(k.X.col(2) + k.X.leftCols<2>() * dv);
+        // dc = -U_d^-1 (bc + W^T dg), from the columns solved above.
+        const ClusterBlocks<G>& k = blocks[c];
+        const Vec4 dc = -(k.X.col(G) + k.X.template leftCols<G>() * dg);
         if (!dc.allFinite()) {
           trial.m1[c] = s.m1[c];
           trial.m3[c] = s.m3[c];
           continue;
         }
-        trial.m1[c] = retract(s.m1[c], k.B1, dc.head<2>());
-        trial.m3[c] = retract(s.m3[c], k.B3, dc.tail<2>());
+        trial.m1[c] = retract(s.m1[c], k.B1, dc.template head<2>());
+        trial.m3[c] = retract(s.m3[c], k.B3, dc.template tail<2>());
       }
       const double ft = cost(trial, stride);
       if (ft < f) {
@@ -239,8 +308,10 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
         lambda = std::max(lambda / 3.0, 1e-12);
         accepted = true;
         // Converged: the cost or v no longer moves (v's step below
-        // kStepTolerance rad, as Ceres' parameter tolerance).
-        if (decrease < function_tolerance || dv.norm() < kStepTolerance) it = max_iterations;
+        // kStepTolerance rad, as Ceres' parameter tolerance; with an
+        // acceleration, a's step below it times |a| or 1).
+        const bool a_still = G == 2 || dg.template tail<G - 2>().norm() < kStepTolerance * std::max(1.0, s.a.norm());
+        if (decrease < function_tolerance || (dv.norm() < kStepTolerance && a_still)) it = max_iterations;
         for (const State& e : merge_into)
           if (merge_rad > 0.0 && near(e, s, merge_cos)) {
             out.merged = true;
@@ -254,7 +325,7 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
   }
   out.state = std::move(s);
   out.cost = f;
-  out.ok = std::isfinite(f) && out.state.v.allFinite();
+  out.ok = std::isfinite(f) && out.state.v.allFinite() && out.state.a.allFinite();
   return out;
 }
 

@@ -24,19 +24,26 @@ namespace celc::detail {
 /// (a seeded subset of max_events events, as refine.hpp draws it; 0 = all).
 class JointProblem {
  public:
+  /// With `acceleration`, the camera's position is P(t) v + q(t) a,
+  /// q(t) = (t - t_ref)^2 / 2 (celc_acc.hpp): a reference-frame acceleration
+  /// over the speed [1/s] joins v and the lines as unknowns.
   JointProblem(const WindowObservations& obs, const MotionModel& motion, const WindowFrames& frames,
-               int max_events, bool balance_clusters, std::uint64_t event_seed, double huber_px);
+               int max_events, bool balance_clusters, std::uint64_t event_seed, double huber_px,
+               bool acceleration = false);
   ~JointProblem();
   JointProblem(const JointProblem&) = delete;
   JointProblem& operator=(const JointProblem&) = delete;
 
-  /// A point of the problem: v and each cluster's plane normals (unit).
+  /// A point of the problem: v and each cluster's plane normals (unit), and
+  /// the acceleration a (zero, and left so, without one).
   struct State {
     Vec3 v;
     std::vector<Vec3> m1, m3;
+    Vec3 a = Vec3::Zero();
   };
-  /// v with the fitted lines of the frames.
-  State start(const Vec3& v) const;
+  /// v (and a) with the fitted lines of the frames.
+  State start(const Vec3& v, const Vec3& a = Vec3::Zero()) const;
+  bool hasAcceleration() const { return acceleration_; }
   /// Robust cost 1/2 sum rho(d^2) [px^2] over every stride-th event of each
   /// cluster; +inf when a distance is not finite.
   double cost(const State& s, int stride = 1) const;
@@ -49,13 +56,24 @@ class JointProblem {
     bool ok = false;
     bool merged = false;  ///< stopped early at one of merge_into
   };
-  /// Levenberg-Marquardt from s over every stride-th event, until the
+  /// Levenberg-Marquardt from s over every stride-th event (v, the lines,
+  /// and a with an acceleration), until the
   /// relative cost decrease is below function_tolerance or max_iterations,
   /// or (merged) until the state is within merge_rad [rad] of one of
   /// merge_into in v and in every line normal (sign-agnostic): from there
   /// it would follow that state's descent.
   Result refine(State s, int max_iterations, double function_tolerance, int stride = 1,
                 const std::vector<State>& merge_into = {}, double merge_rad = 0.0) const;
+
+  /// refine() with a held at zero (a problem with an acceleration, refined
+  /// under the constant-velocity model on the same events and loss).
+  Result refineConstantVelocity(State s, int max_iterations, double function_tolerance, int stride = 1) const;
+
+  /// The Gauss-Newton information of the global unknowns at s over every
+  /// event, with every cluster's lines eliminated (Schur complement) [1/px^2
+  /// per unit^2, the loss's weights at s]: 2 x 2 over v's tangent
+  /// (tangentBasis(s.v)), with an acceleration 5 x 5, then a.
+  Eigen::MatrixXd information(const State& s) const;
 
   /// Events in the problem.
   size_t events() const;
@@ -81,6 +99,28 @@ class JointProblem {
   double lossScale() const { return scale_; }  ///< the loss's threshold or scale [px]
 
  private:
+  /// Per cluster: the Gauss-Newton blocks at a state, the tangent bases of
+  /// its lines, and (per try) U_d^-1 [W^T | bc] with U_d the damped U.
+  template <int G>
+  struct ClusterBlocks {
+    Eigen::Matrix4d U;
+    Eigen::Matrix<double, G, 4> W;
+    Eigen::Vector4d bc;
+    Eigen::Matrix<double, 3, 2> B1, B3;
+    Eigen::Matrix<double, 4, G + 1> X;
+  };
+  /// The Gauss-Newton blocks at s over every stride-th event: the global
+  /// block (V, bv; v's tangent in the basis Bv, then a for G = 5) and each
+  /// cluster's.
+  template <int G>
+  void linearise(const State& s, int stride, const Eigen::Matrix<double, 3, 2>& Bv, Eigen::Matrix<double, G, G>& V,
+                 Eigen::Matrix<double, G, 1>& bv, std::vector<ClusterBlocks<G>>& blocks) const;
+  /// refine() with the global block of G unknowns: v's tangent (2), and a (5).
+  template <int G>
+  Result refineSteps(State s, int max_iterations, double function_tolerance, int stride,
+                     const std::vector<State>& merge_into, double merge_rad) const;
+  bool acceleration_ = false;
+  std::vector<Eigen::Vector2d> dq_;  // with an acceleration, per term: q_e - q_k, q_s - q_k
   /// The terms of cluster c: terms_[begin_[c], begin_[c + 1]). The buffer's
   /// memory is kept per thread across problems: allocating and releasing it
   /// per window made the kernel map and unmap its pages every time, which

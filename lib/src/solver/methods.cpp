@@ -15,13 +15,19 @@ std::string toString(Method method) {
     case Method::CelcMl: return "celc_ml";
     case Method::Ce3lc: return "ce3lc";
     case Method::Npt: return "npt";
+    case Method::CelcAcc: return "celc_acc";
   }
   return "unknown";
 }
 
+const std::vector<Method>& defaultMethods() {
+  static const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::CelcMl, Method::Ce3lc, Method::Npt};
+  return methods;
+}
+
 const std::vector<Method>& allMethods() {
   static const std::vector<Method> all{Method::Celc, Method::CelcOpt, Method::CelcMl,
-                                       Method::Ce3lc, Method::Npt};
+                                       Method::Ce3lc, Method::Npt, Method::CelcAcc};
   return all;
 }
 
@@ -29,7 +35,7 @@ Method parseMethod(const std::string& name) {
   for (Method m : allMethods())
     if (toString(m) == name) return m;
   throw std::invalid_argument("unknown method '" + name +
-                              "' (expected celc, celc_opt, celc_ml, ce3lc or npt)");
+                              "' (expected celc, celc_opt, celc_ml, ce3lc, npt or celc_acc)");
 }
 
 std::vector<Method> parseMethodList(const std::string& list) {

@@ -63,6 +63,14 @@ std::string MlOptions::validate() const {
   return e;
 }
 
+std::string AccOptions::validate() const {
+  std::string e;
+  if (min_lines < 2 || min_lines > 1000) e += "acc.min_lines must be in [2, 1000]; ";
+  if (!(max_sigma > 0.0)) e += "acc.max_sigma must be > 0; ";
+  if (!(test_chi2 >= 0.0) || !std::isfinite(test_chi2)) e += "acc.test_chi2 must be finite and >= 0; ";
+  return e;
+}
+
 std::string UncertaintyOptions::validate() const {
   std::string e;
   if (max_events < 0) e += "uncertainty.max_events must be >= 0; ";
@@ -84,7 +92,8 @@ std::string UncertaintyOptions::validate() const {
 }
 
 std::string SolverOptions::validate() const {
-  return linear.validate() + refine.validate() + npt.validate() + ml.validate() + uncertainty.validate();
+  return linear.validate() + refine.validate() + npt.validate() + ml.validate() + acc.validate() +
+         uncertainty.validate();
 }
 
 }  // namespace celc

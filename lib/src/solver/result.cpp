@@ -22,6 +22,7 @@ std::string toString(Degeneracy reason) {
     case Degeneracy::TooFewClusters: return "too_few_clusters";
     case Degeneracy::NoParallax: return "no_parallax";
     case Degeneracy::NullspaceNotUnique: return "nullspace_not_unique";
+    case Degeneracy::AccelerationUnobservable: return "acceleration_unobservable";
   }
   return "none";
 }

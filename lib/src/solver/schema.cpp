@@ -131,6 +131,19 @@ void describe(FieldVisitor& v, MlOptions& o) {
           o.rate_offset);
 }
 
+void describe(FieldVisitor& v, AccOptions& o) {
+  v.field({"min_lines", "lines", "fewer usable lines: the acceleration is not observable (celc_ml's answer)"},
+          o.min_lines);
+  v.field({"max_sigma", "-",
+           "the acceleration is observable when its std (over the speed) times the window's longest |t - t_ref| "
+           "is at most this"},
+          o.max_sigma);
+  v.field({"test_chi2", "-",
+           "the acceleration is seen when 2 (C_0 - C_a) / s^2 exceeds this (chi-square, 3 dof: 16.27 at p = 0.001); "
+           "else celc_ml's answer"},
+          o.test_chi2);
+}
+
 void describe(FieldVisitor& v, UncertaintyOptions& o) {
   v.field({"enabled", "", "report sigma_deg, the direction's standard deviation, per estimate"}, o.enabled);
   v.field({"agreement", "", "sigma_deg at least the angle to a celc / celc_opt / celc_ml estimate of the window that "
@@ -169,6 +182,8 @@ void describe(FieldVisitor& v, SolverOptions& o) {
   v.section({"refine", "", "Ceres refinement (celc_opt, celc_ml)"}, [&](FieldVisitor& s) { describe(s, o.refine); });
   v.section({"npt", "", "N-point linear solver (Gao et al. 2024)"}, [&](FieldVisitor& s) { describe(s, o.npt); });
   v.section({"ml", "", "celc_ml: joint refinement of v and the lines"}, [&](FieldVisitor& s) { describe(s, o.ml); });
+  v.section({"acc", "", "celc_acc: v, a constant acceleration and the lines, jointly"},
+            [&](FieldVisitor& s) { describe(s, o.acc); });
   v.section({"uncertainty", "", "sigma_deg per estimate (Fisher information at the estimate and a model-error budget)"},
             [&](FieldVisitor& s) { describe(s, o.uncertainty); });
   v.field({"check_parallax", "", "degenerate (no parallax) windows are detected once per window"},

@@ -25,9 +25,19 @@ struct SignVotes {
       : cl(&c), terms(frame, motion) {}
   // lambda of the event (t, f) from the cluster's terms; NaN when it sees
   // neither plane.
+  // With an acceleration a (celc_acc.hpp): p = P v + q a, q = (t - t_ref)^2 / 2.
+  const Vec3* a = nullptr;
+  double t_ref = 0.0;
   double depth(double t, const Vec3& f, const Vec3& v) const {
     const EventLineTerms e = terms.at(t);
-    const double a1 = e.g1.dot(f), a3 = e.g3.dot(f), d1 = e.s.dot(v), d3 = e.u.dot(v);
+    const double a1 = e.g1.dot(f), a3 = e.g3.dot(f);
+    double d1 = e.s.dot(v), d3 = e.u.dot(v);
+    if (a) {
+      auto q = [this](double x) { return 0.5 * (x - t_ref) * (x - t_ref); };
+      const ClusterFrame& fr = terms.frame();
+      d1 += (q(cl->l1.t) - q(t)) * fr.m1.dot(*a);
+      d3 += (q(cl->l3.t) - q(t)) * fr.m3.dot(*a);
+    }
     const double den = a1 * a1 + a3 * a3;
     if (!(den > 1e-24)) return NAN;
     return (a1 * d1 + a3 * d3) / den;
@@ -48,6 +58,11 @@ struct SignVotes {
 
 SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v,
                          const WindowFrames& frames) {
+  return resolveSign(obs, motion, v, nullptr, frames);
+}
+
+SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v, const Vec3* a,
+                         const WindowFrames& frames) {
   // Depth of event k along its ray from the camera at t_k, where the ray meets
   // the planes of l1 and l3 (least squares over both planes):
   //   lambda = sum_i (m_i.f')(m_i.(p_i - p_k)) / sum_i (m_i.f')^2,  f' = R_k f_k, p = P v,
@@ -60,6 +75,8 @@ SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motio
   clusters.reserve(frames.clusters().size());
   for (int c : frames.clusters()) {
     SignVotes& s = clusters.emplace_back(obs.clusters[c], frames[c], motion);
+    s.a = a;
+    s.t_ref = motion.referenceTime();
     s.stride = std::max<size_t>(1, s.cl->size() / kSignVotesPerCluster);
     s.count(v, false);
   }

@@ -24,5 +24,9 @@ constexpr size_t kSignCentroidEvents = 16;
 /// resolveSign with the window's frames (frames of obs under motion).
 SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v,
                          const WindowFrames& frames);
+/// The same with a constant acceleration a (celc_acc.hpp; null: none): the
+/// camera's position P(t) v + q(t) a, the depths odd in (v, a) together.
+SignDecision resolveSign(const WindowObservations& obs, const MotionModel& motion, const Vec3& v, const Vec3* a,
+                         const WindowFrames& frames);
 
 }  // namespace celc::detail

@@ -11,6 +11,7 @@
 #include "celc/solver/error_budget.hpp"
 #include "celc/solver/npt.hpp"
 #include "celc/solver/solver.hpp"
+#include "celc_acc.hpp"
 #include "celc_linear.hpp"
 #include "celc_ml.hpp"
 #include "constraint_rows.hpp"
@@ -197,6 +198,18 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     }
     return npt;
   };
+  SolverResult ml;
+  detail::MlEnd ml_end;  // celc_ml's lines, celc_acc's start
+  bool have_ml = false;
+  auto getMl = [&]() -> const SolverResult& {
+    if (!have_ml) {
+      const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
+      ml = detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr, options, frames,
+                               seeds.refine_events, &ml_end);
+      have_ml = true;
+    }
+    return ml;
+  };
   for (Method m : methods) {
     switch (m) {
       case Method::Celc: out.push_back(getLinear()); break;
@@ -204,12 +217,12 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
         out.push_back(detail::solveCe3lc(obs, motion, options.linear, frames, false));
         break;
       case Method::Npt: out.push_back(getNpt()); break;
-      case Method::CelcMl: {
-        const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
-        out.push_back(detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr,
-                                          options, frames, seeds.refine_events));
+      case Method::CelcAcc:
+        getMl();
+        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), ml, ml_end, options, frames, seeds.linear_rows,
+                                           seeds.refine_events));
         break;
-      }
+      case Method::CelcMl: out.push_back(getMl()); break;
       case Method::CelcOpt: {
         const SolverResult& init = getLinear();
         out.push_back(celcOptCanStart(init) ? solveCelcOpt(obs, motion, init, options, frames, seeds) : init);
@@ -266,6 +279,13 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     SolverResult& r = out[i];
     r.parallax = window.parallax;
     r.n_lines = window.n_lines;
+    // celc_acc's accelerating answer has its own spread (celc_acc.hpp): the
+    // bound assumes a constant v. Its constant-velocity answer is celc_ml's.
+    const bool own_sigma = methods[i] == Method::CelcAcc && r.acceleration_seen;
+    if (own_sigma) {
+      if (!r.ok() || !u.enabled) r.sigma_deg = NAN;
+      continue;
+    }
     r.sigma_deg = NAN;
     if (!r.ok() || !u.enabled) continue;
     double scale = 1.0;
@@ -275,6 +295,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       case Method::CelcMl: scale = u.scale_celc_ml; break;
       case Method::Ce3lc: scale = u.scale_ce3lc; break;
       case Method::Npt: scale = u.scale_npt; break;
+      case Method::CelcAcc: scale = u.scale_celc_ml; break;
     }
     sigmaOf(r, scale);
     if (sigma_floor_deg[i] > r.sigma_deg) {
@@ -321,9 +342,13 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
       }
     }
   }
+  // The witnesses assume a constant velocity: celc_acc's accelerating answer
+  // is not held to them.
   for (size_t i = 0; i < out.size(); ++i) {
     if (!out[i].ok() || !std::isfinite(out[i].sigma_deg)) continue;
-    const bool refined = methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl;
+    if (methods[i] == Method::CelcAcc && out[i].acceleration_seen) continue;
+    const bool refined =
+        methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl || methods[i] == Method::CelcAcc;
     std::vector<bool> counts(witnesses.size(), true);
     if (refined && !u.linear_witness_refined)
       for (size_t j = 0; j < witnesses.size(); ++j) counts[j] = !witness_linear[j];

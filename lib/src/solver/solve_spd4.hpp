@@ -10,7 +10,8 @@ namespace celc::detail {
 /// triangle is read), by A = L D L^T without pivoting; where a pivot is not
 /// positive (an indefinite A, or rounding on a near-singular one) by Eigen's
 /// pivoted LDL^T instead, which treats a zero pivot as a pseudo-inverse does.
-inline void solveSpd4(const Eigen::Matrix4d& A, Eigen::Matrix<double, 4, 3>& X) {
+template <int Cols>
+inline void solveSpd4(const Eigen::Matrix4d& A, Eigen::Matrix<double, 4, Cols>& X) {
   double L[4][4], D[4], inv[4];
   for (int j = 0; j < 4; ++j) {
     double d = A(j, j);

@@ -64,7 +64,7 @@ struct PeerCellResult {
 struct PeerStudyConfig {
   PeerSceneOptions scene;         ///< base scene (the cells override their factors)
   SolverOptions solver;
-  std::vector<Method> methods = allMethods();
+  std::vector<Method> methods = defaultMethods();
   int trials = 200;
   std::uint64_t seed = 1;
   std::string validate() const;

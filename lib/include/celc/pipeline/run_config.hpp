@@ -107,7 +107,7 @@ struct RunConfig {
     s.uncertainty.cheiral_min = 0.9;
     return s;
   }();
-  std::vector<Method> methods = allMethods();
+  std::vector<Method> methods = defaultMethods();
   GtVelocityOptions groundtruth;
   std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)
   std::string validate() const;

@@ -31,7 +31,13 @@ struct Sweep {
 /// The paper's sweeps: event_noise, line_noise, omega_noise, speed, interval,
 /// lines; plus `default`, the default setting as a single level.
 const std::vector<Sweep>& paperSweeps();
-/// Looks a sweep up by name; throws std::invalid_argument listing the names.
+/// Sweeps beyond the paper's, run only when named (not in `all`):
+/// `acceleration`, the paper's default scene with a constant acceleration
+/// of rho = |a| Z / (2 V^2) = 0 .. 30 (Z the middle of its depths) in a
+/// direction drawn per trial (LineSceneOptions::acceleration).
+const std::vector<Sweep>& extraSweeps();
+/// Looks a sweep up by name (the paper's and the extra ones); throws
+/// std::invalid_argument listing the names.
 const Sweep& findSweep(const std::string& name);
 /// The settings of the uncertainty study (`celc simulate --study sigma`):
 /// the default and a few levels of each paper sweep, plus `pure_rotation`

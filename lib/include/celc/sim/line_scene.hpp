@@ -45,6 +45,12 @@ struct LineSceneOptions {
   MotionModelKind motion = MotionModelKind::ConstantTwist;
   Vec3 omega_wobble{0.5, -0.3, 0.4};  ///< [rad/s], GyroIntegrated only
   double gyro_rate_hz = 1000.0;       ///< [Hz], GyroIntegrated only
+  /// |a| [m/s^2]: a constant reference-frame acceleration beyond the motion
+  /// model's velocity, p(t) = P(t) v + (t - t_s)^2 / 2 a, so that v is the
+  /// velocity at t_s. Its direction is drawn per trial, uniform on the sphere
+  /// and drawn again (up to 100 times) while a segment's endpoint comes
+  /// closer than 0.5 m in depth during the window; nothing is drawn at 0.
+  double acceleration = 0.0;
   /// When not empty: these segments (reference frame [m]) instead of random ones.
   std::vector<std::array<Vec3, 2>> fixed_segments;
   std::string validate() const;
@@ -59,6 +65,7 @@ struct LineSceneTrial {
   MotionModel true_motion = MotionModel::constantTwist(Vec3::Zero(), 0.0);
   MotionModel given_motion = MotionModel::constantTwist(Vec3::Zero(), 0.0);  ///< with gyro noise
   Vec3 true_direction = Vec3::Zero();       ///< unit v (zero when the speed is zero)
+  Vec3 true_acceleration = Vec3::Zero();    ///< a [m/s^2], reference frame
   std::vector<std::array<Vec3, 2>> segments;  ///< endpoints [m], reference frame
   std::vector<Event> pixel_events;          ///< the same events in pixels (outliers included)
   std::vector<int> labels;                  ///< per pixel event: cluster index, -1 for outliers

@@ -8,14 +8,18 @@ namespace celc {
 
 /// celc: CELC linear; celc_opt: CELC refined (v alone); celc_ml: v refined
 /// jointly with every cluster's lines; ce3lc: the paper's baseline; npt: Gao
-/// et al.'s N-point linear solver.
-enum class Method { Celc, CelcOpt, CelcMl, Ce3lc, Npt };
+/// et al.'s N-point linear solver; celc_acc: CELC with a constant
+/// acceleration (linear in v and a; solver/celc_acc.hpp).
+enum class Method { Celc, CelcOpt, CelcMl, Ce3lc, Npt, CelcAcc };
 std::string toString(Method method);
-/// Parses "celc", "celc_opt", "celc_ml", "ce3lc", "npt"; throws std::invalid_argument otherwise.
+/// Parses "celc", "celc_opt", "celc_ml", "ce3lc", "npt", "celc_acc"; throws std::invalid_argument otherwise.
 Method parseMethod(const std::string& name);
 /// Parses a comma-separated list of method names ("all": every method); duplicates dropped.
 std::vector<Method> parseMethodList(const std::string& list);
-/// Every method, in the order of the enum.
+/// Every method, in the order of the enum ("all" in a method list).
 const std::vector<Method>& allMethods();
+/// What `celc run`, `celc solve`, the studies and the library run unless told
+/// otherwise: every method but celc_acc, which is asked for by name.
+const std::vector<Method>& defaultMethods();
 
 }  // namespace celc

@@ -288,11 +288,33 @@ struct UncertaintyOptions {
   std::string validate() const;  ///< empty when valid
 };
 
+/// celc_acc: CELC with a constant acceleration (docs/method.md, "celc_acc").
+/// The joint refinement of v, a and the lines is kept where the window
+/// shows an acceleration; elsewhere the answer is celc_ml's, and the
+/// result says why (Degeneracy::AccelerationUnobservable).
+struct AccOptions {
+  /// Fewer usable lines than this: a is not observable (each line fixes
+  /// three of the five unknowns of v and a; three lines leave four checks).
+  int min_lines = 3;
+  /// a (over the speed) is observable when its standard deviation along its
+  /// worst-fixed direction, times the longest |t - t_ref| of the window's
+  /// events, is at most this [-]: 1 = the window cannot tell a velocity
+  /// change of the velocity's own size over it.
+  double max_sigma = 1.0;
+  /// The acceleration is seen when the likelihood ratio of the costs without
+  /// and with it, 2 (C_0 - C_a) / s^2 (s the residuals' robust scale), exceeds
+  /// this: the chi-square law's point with 3 degrees of freedom (a's) at
+  /// p = 0.001 is 16.27.
+  double test_chi2 = 16.27;  ///< [-]
+  std::string validate() const;  ///< empty when valid
+};
+
 struct SolverOptions {
   LinearOptions linear;
   RefineOptions refine;
   NptOptions npt;
   MlOptions ml;
+  AccOptions acc;
   UncertaintyOptions uncertainty;
   /// Run the parallax test of the window checks (solveMethods, once per
   /// window). Off where every window is known to move and outliers would
@@ -306,6 +328,7 @@ void describe(FieldVisitor& v, LinearOptions& options);
 void describe(FieldVisitor& v, RefineOptions& options);
 void describe(FieldVisitor& v, NptOptions& options);
 void describe(FieldVisitor& v, MlOptions& options);
+void describe(FieldVisitor& v, AccOptions& options);
 void describe(FieldVisitor& v, UncertaintyOptions& options);
 void describe(FieldVisitor& v, SolverOptions& options);
 

@@ -13,7 +13,10 @@ enum class SolveStatus { Ok, Degenerate, InvalidInput, Failed };
 std::string toString(SolveStatus status);
 
 /// Why a window is degenerate (status Degenerate), or None.
-enum class Degeneracy { None, TooFewClusters, NoParallax, NullspaceNotUnique };
+/// AccelerationUnobservable: celc_acc's window cannot fix an acceleration
+/// (too few lines, too short a window); its answer is then the
+/// constant-velocity one (status ok) and the message says why.
+enum class Degeneracy { None, TooFewClusters, NoParallax, NullspaceNotUnique, AccelerationUnobservable };
 std::string toString(Degeneracy reason);
 
 struct SolverResult {
@@ -52,6 +55,13 @@ struct SolverResult {
   /// min_parallax_ratio). NaN when the test did not run.
   double parallax = NAN;
   int n_lines = 0;                ///< usable clusters of the window (shared by every method)
+  /// celc_acc only: the constant acceleration over the speed, a / |v| [1/s],
+  /// reference frame, of the joint refinement (NaN for the other methods and
+  /// where it did not run), and whether the window shows it (a likelihood-ratio
+  /// test of the costs with and without it, SolverOptions::acc; when not, v is
+  /// the constant-velocity answer).
+  Vec3 acceleration = Vec3::Constant(NAN);
+  bool acceleration_seen = false;
   bool ok() const { return status == SolveStatus::Ok; }
 };
 
