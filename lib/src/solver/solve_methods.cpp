@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ce3lc.hpp"
@@ -163,152 +164,223 @@ SolverResult solveCelcOpt(const WindowObservations& obs, const MotionModel& moti
   return r;
 }
 
-}  // namespace
 
-std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
-                                       const std::vector<Method>& methods,
-                                       const SolverOptions& options, const SampleSeeds& seeds) {
-  std::vector<SolverResult> out;
-  // Window-level checks once; a degenerate window is degenerate for every method.
-  const SolverResult window = detail::checkWindow(obs, motion, options.linear, options.check_parallax);
-  if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
-  const detail::WindowFrames frames(obs, motion);
-  SolverResult linear;
-  bool have_linear = false;
-  auto getLinear = [&]() -> const SolverResult& {
-    if (!have_linear) {
-      linear = detail::solveCelcLinear(obs, motion, options.linear, frames, false, seeds.linear_rows);
-      have_linear = true;
+/// The estimates several methods share, each computed on first use and kept:
+/// celc's linear estimate, npt's (its sign resolved by cheirality with
+/// linear.resolve_sign) and celc_ml's with its end point's lines (celc_acc's
+/// start). Refers to its inputs, which outlive it.
+class SharedEstimates {
+ public:
+  SharedEstimates(const WindowObservations& obs, const MotionModel& motion, const SolverOptions& options,
+                  const detail::WindowFrames& frames, const SampleSeeds& seeds)
+      : obs_(obs), motion_(motion), options_(options), frames_(frames), seeds_(seeds) {}
+
+  /// celc's linear estimate on the rows seeded by seeds.linear_rows.
+  const SolverResult& linear() {
+    if (!linear_)
+      linear_ = detail::solveCelcLinear(obs_, motion_, options_.linear, frames_, false, seeds_.linear_rows);
+    return *linear_;
+  }
+  /// The linear estimate where a method asked for it; null otherwise.
+  const SolverResult* linearIfSolved() const { return linear_ ? &*linear_ : nullptr; }
+
+  /// npt's estimate, its sign resolved (and timed) with linear.resolve_sign.
+  const SolverResult& npt() {
+    if (npt_) return *npt_;
+    SolverResult r = solveNpt(obs_, motion_, options_.npt);
+    if (r.ok() && options_.linear.resolve_sign) {
+      const auto t0 = detail::Clock::now();
+      const SignDecision s = detail::resolveSign(obs_, motion_, r.v, frames_);
+      r.v *= s.sign;
+      r.sign_margin = s.margin * s.sign;
+      r.time_us += detail::microsecondsSince(t0);
     }
-    return linear;
-  };
-  SolverResult npt;
-  bool have_npt = false;
-  auto getNpt = [&]() -> const SolverResult& {
-    if (!have_npt) {
-      npt = solveNpt(obs, motion, options.npt);
-      if (npt.ok() && options.linear.resolve_sign) {
-        const auto t0 = detail::Clock::now();
-        const SignDecision s = detail::resolveSign(obs, motion, npt.v, frames);
-        npt.v *= s.sign;
-        npt.sign_margin = s.margin * s.sign;
-        npt.time_us += detail::microsecondsSince(t0);
-      }
-      have_npt = true;
+    npt_ = std::move(r);
+    return *npt_;
+  }
+
+  /// celc_ml's estimate from the linear one and, where its model holds, npt's.
+  const SolverResult& ml() {
+    if (ml_) return *ml_;
+    const bool npt_start = detail::nptStartApplies(obs_, motion_, options_.ml);
+    const SolverResult& from_linear = linear();
+    const SolverResult* from_npt = npt_start ? &npt() : nullptr;
+    ml_ = detail::solveCelcMl(obs_, motion_, from_linear, from_npt, options_, frames_, seeds_.refine_events,
+                              &ml_end_);
+    return *ml_;
+  }
+  /// celc_ml's end point's lines (ml() computed first).
+  const detail::MlEnd& mlEnd() {
+    ml();
+    return ml_end_;
+  }
+
+ private:
+  const WindowObservations& obs_;
+  const MotionModel& motion_;
+  const SolverOptions& options_;
+  const detail::WindowFrames& frames_;
+  const SampleSeeds& seeds_;
+  std::optional<SolverResult> linear_, npt_, ml_;
+  detail::MlEnd ml_end_;
+};
+
+/// Method m's result on the window, the shared estimates taken from `shared`.
+SolverResult solveMethod(Method m, SharedEstimates& shared, const WindowObservations& obs,
+                         const MotionModel& motion, const SolverOptions& options,
+                         const detail::WindowFrames& frames, const SampleSeeds& seeds) {
+  switch (m) {
+    case Method::Celc: return shared.linear();
+    case Method::Ce3lc: return detail::solveCe3lc(obs, motion, options.linear, frames, false);
+    case Method::Npt: return shared.npt();
+    case Method::CelcAcc: {
+      const SolverResult& ml = shared.ml();
+      return detail::solveCelcAcc(obs, motion, shared.linear(), ml, shared.mlEnd(), options, frames,
+                                  seeds.linear_rows, seeds.refine_events);
     }
-    return npt;
-  };
-  SolverResult ml;
-  detail::MlEnd ml_end;  // celc_ml's lines, celc_acc's start
-  bool have_ml = false;
-  auto getMl = [&]() -> const SolverResult& {
-    if (!have_ml) {
-      const bool npt_start = detail::nptStartApplies(obs, motion, options.ml);
-      ml = detail::solveCelcMl(obs, motion, getLinear(), npt_start ? &getNpt() : nullptr, options, frames,
-                               seeds.refine_events, &ml_end);
-      have_ml = true;
-    }
-    return ml;
-  };
-  for (Method m : methods) {
-    switch (m) {
-      case Method::Celc: out.push_back(getLinear()); break;
-      case Method::Ce3lc:
-        out.push_back(detail::solveCe3lc(obs, motion, options.linear, frames, false));
-        break;
-      case Method::Npt: out.push_back(getNpt()); break;
-      case Method::CelcAcc:
-        getMl();
-        out.push_back(detail::solveCelcAcc(obs, motion, getLinear(), ml, ml_end, options, frames, seeds.linear_rows,
-                                           seeds.refine_events));
-        break;
-      case Method::CelcMl: out.push_back(getMl()); break;
-      case Method::CelcOpt: {
-        const SolverResult& init = getLinear();
-        out.push_back(celcOptCanStart(init) ? solveCelcOpt(obs, motion, init, options, frames, seeds) : init);
-        break;
-      }
+    case Method::CelcMl: return shared.ml();
+    case Method::CelcOpt: {
+      const SolverResult& init = shared.linear();
+      return celcOptCanStart(init) ? solveCelcOpt(obs, motion, init, options, frames, seeds) : init;
     }
   }
-  const UncertaintyOptions& u = options.uncertainty;
-  // The events' terms of the bound, formed once for every direction asked about.
-  std::optional<DirectionTerms> direction_terms;
-  auto terms = [&]() -> const DirectionTerms& {
-    if (!direction_terms) direction_terms.emplace(obs, motion, u.max_events);
-    return *direction_terms;
-  };
-  // The linear methods' ambiguous verdicts checked against the events' bound.
-  std::vector<double> sigma_floor_deg(out.size(), 0.0);
-  for (size_t i = 0; i < out.size(); ++i)
-    if (options.linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc) &&
-        out[i].degeneracy == Degeneracy::NullspaceNotUnique)
-      sigma_floor_deg[i] = answerIfObservable(obs, motion, options.linear, terms(), frames, out[i]);
-  // Answers that put the clusters' lines behind the camera: their floor is
-  // applied last, so that they still witness with their Fisher sigma.
-  std::vector<bool> behind(out.size(), false);
-  if (u.enabled && u.cheiral_min > 0.0)
-    for (size_t i = 0; i < out.size(); ++i) {
-      const bool celc_family = methods[i] == Method::Celc || methods[i] == Method::CelcOpt ||
-                               methods[i] == Method::CelcMl;
-      behind[i] = celc_family && out[i].ok() &&
-                  std::abs(detail::resolveSign(obs, motion, out[i].v, frames).margin) < u.cheiral_min;
-    }
-  auto floorBehind = [&]() {
-    for (size_t i = 0; i < out.size(); ++i)
-      if (behind[i] && out[i].sigma_deg < kRandomDirectionRmsDeg) {
-        out[i].sigma_deg = kRandomDirectionRmsDeg;
-        out[i].sigma_rule = "behind_camera";
-      }
-    return out;
-  };
-  // The model-error budget, formed once for every direction asked about.
-  std::optional<ErrorBudget> budget;
-  auto budgetDeg = [&](const Vec3& v) {
-    if (!budget) budget.emplace(obs, motion, u);
-    return budget->sources() == 0 ? 0.0 : budget->sigmaDeg(terms(), v);
-  };
-  // The Fisher value times `scale` and the budget in quadrature.
-  auto sigmaOf = [&](SolverResult& r, double scale) {
+  return SolverResult{};
+}
+
+/// The window's uncertainty model: the events' terms of the bound and the
+/// model-error budget, each formed on first use for every direction asked
+/// about. Refers to its inputs, which outlive it.
+class UncertaintyModel {
+ public:
+  UncertaintyModel(const WindowObservations& obs, const MotionModel& motion, const UncertaintyOptions& u)
+      : obs_(obs), motion_(motion), u_(u) {}
+
+  /// The events' terms of the bound (u.max_events events).
+  const DirectionTerms& terms() {
+    if (!terms_) terms_.emplace(obs_, motion_, u_.max_events);
+    return *terms_;
+  }
+  /// The budget's sigma [deg] at v: 0 with no source, NaN where it fails.
+  double budgetDeg(const Vec3& v) {
+    if (!budget_) budget_.emplace(obs_, motion_, u_);
+    return budget_->sources() == 0 ? 0.0 : budget_->sigmaDeg(terms(), v);
+  }
+  /// Sets r's Fisher sigma (times `scale`), its budget and sigma_deg, the two
+  /// in quadrature (infinite where the budget fails).
+  void setSigma(SolverResult& r, double scale) {
     r.sigma_fisher_deg = terms().sigmaDeg(r.v, scale);
     r.sigma_budget_deg = budgetDeg(r.v);
     r.sigma_deg = std::isnan(r.sigma_budget_deg) ? INFINITY : std::hypot(r.sigma_fisher_deg, r.sigma_budget_deg);
-  };
-  // What every method shares (the window's verdict), and each estimate's
-  // uncertainty at its own direction.
+  }
+
+ private:
+  const WindowObservations& obs_;
+  const MotionModel& motion_;
+  const UncertaintyOptions& u_;
+  std::optional<DirectionTerms> terms_;
+  std::optional<ErrorBudget> budget_;
+};
+
+/// The linear methods' ambiguous verdicts checked against the events' bound
+/// (answerIfObservable, applied to `out`): per result, the floor of its
+/// sigma_deg [deg], 0 where none.
+std::vector<double> answerObservable(std::vector<SolverResult>& out, const std::vector<Method>& methods,
+                                     const WindowObservations& obs, const MotionModel& motion,
+                                     const LinearOptions& linear, UncertaintyModel& model,
+                                     const detail::WindowFrames& frames) {
+  std::vector<double> floor_deg(out.size(), 0.0);
+  for (size_t i = 0; i < out.size(); ++i)
+    if (linear.answer_when_observable && (methods[i] == Method::Celc || methods[i] == Method::Ce3lc) &&
+        out[i].degeneracy == Degeneracy::NullspaceNotUnique)
+      floor_deg[i] = answerIfObservable(obs, motion, linear, model.terms(), frames, out[i]);
+  return floor_deg;
+}
+
+/// Per result: whether it is an answer of the celc family that puts the
+/// clusters' lines behind the camera (sign margin below u.cheiral_min, with
+/// u.enabled).
+std::vector<bool> behindCamera(const std::vector<SolverResult>& out, const std::vector<Method>& methods,
+                               const WindowObservations& obs, const MotionModel& motion,
+                               const UncertaintyOptions& u, const detail::WindowFrames& frames) {
+  std::vector<bool> behind(out.size(), false);
+  if (!(u.enabled && u.cheiral_min > 0.0)) return behind;
+  for (size_t i = 0; i < out.size(); ++i) {
+    const bool celc_family =
+        methods[i] == Method::Celc || methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl;
+    behind[i] = celc_family && out[i].ok() &&
+                std::abs(detail::resolveSign(obs, motion, out[i].v, frames).margin) < u.cheiral_min;
+  }
+  return behind;
+}
+
+/// The uncertainty scale of method m's estimates (UncertaintyOptions).
+double sigmaScale(Method m, const UncertaintyOptions& u) {
+  switch (m) {
+    case Method::Celc: return u.scale_celc;
+    case Method::CelcOpt: return u.scale_celc_opt;
+    case Method::CelcMl: return u.scale_celc_ml;
+    case Method::Ce3lc: return u.scale_ce3lc;
+    case Method::Npt: return u.scale_npt;
+    case Method::CelcAcc: return u.scale_celc_ml;
+  }
+  return 1.0;
+}
+
+/// What every method shares (the window's parallax and lines), and each
+/// estimate's sigma_deg at its own direction, at least its floor_deg (NaN
+/// where it is no answer or u is off). celc_acc's accelerating answer keeps
+/// its own spread (celc_acc.hpp: the bound assumes a constant v).
+void setUncertainties(std::vector<SolverResult>& out, const std::vector<Method>& methods,
+                      const SolverResult& window, const std::vector<double>& floor_deg, UncertaintyModel& model,
+                      const UncertaintyOptions& u) {
   for (size_t i = 0; i < out.size(); ++i) {
     SolverResult& r = out[i];
     r.parallax = window.parallax;
     r.n_lines = window.n_lines;
-    // celc_acc's accelerating answer has its own spread (celc_acc.hpp): the
-    // bound assumes a constant v. Its constant-velocity answer is celc_ml's.
-    const bool own_sigma = methods[i] == Method::CelcAcc && r.acceleration_seen;
-    if (own_sigma) {
+    if (methods[i] == Method::CelcAcc && r.acceleration_seen) {
       if (!r.ok() || !u.enabled) r.sigma_deg = NAN;
       continue;
     }
     r.sigma_deg = NAN;
     if (!r.ok() || !u.enabled) continue;
-    double scale = 1.0;
-    switch (methods[i]) {
-      case Method::Celc: scale = u.scale_celc; break;
-      case Method::CelcOpt: scale = u.scale_celc_opt; break;
-      case Method::CelcMl: scale = u.scale_celc_ml; break;
-      case Method::Ce3lc: scale = u.scale_ce3lc; break;
-      case Method::Npt: scale = u.scale_npt; break;
-      case Method::CelcAcc: scale = u.scale_celc_ml; break;
-    }
-    sigmaOf(r, scale);
-    if (sigma_floor_deg[i] > r.sigma_deg) {
-      r.sigma_deg = sigma_floor_deg[i];
+    model.setSigma(r, sigmaScale(methods[i], u));
+    if (floor_deg[i] > r.sigma_deg) {
+      r.sigma_deg = floor_deg[i];
       r.sigma_rule = "ambiguous_nullspace";
     }
   }
-  if (!u.enabled || !u.agreement) return floorBehind();
-  // The witnesses: the ok estimates of the celc family with their Fisher
-  // sigma, and the linear celc estimate when celc itself was not asked for.
-  std::vector<SolverResult> witnesses;
-  std::vector<bool> witness_linear;
-  std::vector<int> witness_of(out.size(), -1);
+}
+
+/// The estimates the agreement test holds each answer to, with their Fisher
+/// sigma; `linear[j]` says whether witness j is a linear estimate, and
+/// `of[i]` is result i's own witness index or -1.
+struct Witnesses {
+  std::vector<SolverResult> estimates;
+  std::vector<bool> linear;
+  std::vector<int> of;
+};
+
+/// Adds the linear estimate r as a witness, with its sigma (times `scale`),
+/// where that sigma is finite.
+void addLinearWitness(Witnesses& w, SolverResult r, UncertaintyModel& model, double scale) {
+  model.setSigma(r, scale);
+  if (!std::isfinite(r.sigma_deg)) return;
+  w.estimates.push_back(std::move(r));
+  w.linear.push_back(true);
+}
+
+/// The witnesses: the ok estimates of the celc family with a finite sigma;
+/// the linear celc estimate where celc itself was not asked for but solved
+/// (`solved_linear`); and with u.witness_rows the linear estimate again on
+/// another random subset of rows (a seed apart from the estimate's own),
+/// its sampling spread.
+Witnesses collectWitnesses(const std::vector<SolverResult>& out, const std::vector<Method>& methods,
+                           const SolverResult* solved_linear, UncertaintyModel& model,
+                           const WindowObservations& obs, const MotionModel& motion, const SolverOptions& options,
+                           const detail::WindowFrames& frames, const SampleSeeds& seeds) {
+  const UncertaintyOptions& u = options.uncertainty;
+  Witnesses w;
+  w.of.assign(out.size(), -1);
   bool celc_asked = false;
   for (size_t i = 0; i < out.size(); ++i) {
     const Method m = methods[i];
@@ -316,45 +388,74 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
     if ((m != Method::Celc && m != Method::CelcOpt && m != Method::CelcMl) || !out[i].ok() ||
         !std::isfinite(out[i].sigma_deg))
       continue;
-    witness_of[i] = static_cast<int>(witnesses.size());
-    witnesses.push_back(out[i]);
-    witness_linear.push_back(m == Method::Celc);
+    w.of[i] = static_cast<int>(w.estimates.size());
+    w.estimates.push_back(out[i]);
+    w.linear.push_back(m == Method::Celc);
   }
-  if (!celc_asked && have_linear && linear.ok()) {
-    SolverResult w = linear;
-    sigmaOf(w, u.scale_celc);
-    if (std::isfinite(w.sigma_deg)) {
-      witnesses.push_back(w);
-      witness_linear.push_back(true);
-    }
-  }
-  if (u.witness_rows > 0 && have_linear) {
-    // The linear estimate again on another random subset of rows (a seed
-    // apart from the estimate's own): its sampling spread.
+  if (!celc_asked && solved_linear && solved_linear->ok()) addLinearWitness(w, *solved_linear, model, u.scale_celc);
+  if (u.witness_rows > 0 && solved_linear) {
     LinearOptions subset = options.linear;
     subset.max_rows = u.witness_rows;
-    SolverResult w = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
-    if (w.ok()) {
-      sigmaOf(w, u.scale_celc);
-      if (std::isfinite(w.sigma_deg)) {
-        witnesses.push_back(w);
-        witness_linear.push_back(true);
-      }
-    }
+    SolverResult r = detail::solveCelcLinear(obs, motion, subset, frames, false, seeds.linear_rows ^ kWitnessSeed);
+    if (r.ok()) addLinearWitness(w, std::move(r), model, u.scale_celc);
   }
-  // The witnesses assume a constant velocity: celc_acc's accelerating answer
-  // is not held to them.
+  return w;
+}
+
+/// raiseToDisagreement for every ok answer with a finite sigma against the
+/// witnesses; the refined methods' against the linear witnesses only with
+/// u.linear_witness_refined. The witnesses assume a constant velocity:
+/// celc_acc's accelerating answer is not held to them.
+void raiseByWitnesses(std::vector<SolverResult>& out, const std::vector<Method>& methods, const Witnesses& w,
+                      const UncertaintyOptions& u) {
   for (size_t i = 0; i < out.size(); ++i) {
     if (!out[i].ok() || !std::isfinite(out[i].sigma_deg)) continue;
     if (methods[i] == Method::CelcAcc && out[i].acceleration_seen) continue;
     const bool refined =
         methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl || methods[i] == Method::CelcAcc;
-    std::vector<bool> counts(witnesses.size(), true);
+    std::vector<bool> counts(w.estimates.size(), true);
     if (refined && !u.linear_witness_refined)
-      for (size_t j = 0; j < witnesses.size(); ++j) counts[j] = !witness_linear[j];
-    raiseToDisagreement(out[i], witness_of[i], witnesses, counts);
+      for (size_t j = 0; j < w.estimates.size(); ++j) counts[j] = !w.linear[j];
+    raiseToDisagreement(out[i], w.of[i], w.estimates, counts);
   }
-  return floorBehind();
+}
+
+/// The answers behind the camera get sigma_deg at least
+/// kRandomDirectionRmsDeg: applied last, so that they still witness with
+/// their Fisher sigma.
+void floorBehindCamera(std::vector<SolverResult>& out, const std::vector<bool>& behind) {
+  for (size_t i = 0; i < out.size(); ++i)
+    if (behind[i] && out[i].sigma_deg < kRandomDirectionRmsDeg) {
+      out[i].sigma_deg = kRandomDirectionRmsDeg;
+      out[i].sigma_rule = "behind_camera";
+    }
+}
+
+}  // namespace
+
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods,
+                                       const SolverOptions& options, const SampleSeeds& seeds) {
+  // Window-level checks once; a degenerate window is degenerate for every method.
+  const SolverResult window = detail::checkWindow(obs, motion, options.linear, options.check_parallax);
+  if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
+  const detail::WindowFrames frames(obs, motion);
+  SharedEstimates shared(obs, motion, options, frames, seeds);
+  std::vector<SolverResult> out;
+  for (Method m : methods) out.push_back(solveMethod(m, shared, obs, motion, options, frames, seeds));
+
+  const UncertaintyOptions& u = options.uncertainty;
+  UncertaintyModel model(obs, motion, u);
+  const std::vector<double> floor_deg = answerObservable(out, methods, obs, motion, options.linear, model, frames);
+  const std::vector<bool> behind = behindCamera(out, methods, obs, motion, u, frames);
+  setUncertainties(out, methods, window, floor_deg, model, u);
+  if (u.enabled && u.agreement) {
+    const Witnesses w =
+        collectWitnesses(out, methods, shared.linearIfSolved(), model, obs, motion, options, frames, seeds);
+    raiseByWitnesses(out, methods, w, u);
+  }
+  floorBehindCamera(out, behind);
+  return out;
 }
 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
