@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "joint_refine.hpp"
@@ -184,68 +185,59 @@ bool linearAcceleration(const WindowObservations& obs, const MotionModel& motion
   return true;
 }
 
-}  // namespace
 
-SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
-                          const SolverResult& ml, const MlEnd& ml_end, const SolverOptions& options,
-                          const WindowFrames& frames, std::uint64_t row_seed, std::uint64_t event_seed) {
-  const auto start = Clock::now();
-  SolverResult result;
-  if (rejectInput(obs, motion, options.linear, result)) return result;
-  const AccOptions& acc = options.acc;
-  // celc's time is inside celc_ml's (its start).
-  const double before_us = ml.time_us;
-  // The constant-velocity answer (celc_ml's), with the reason it stands.
-  auto constantVelocity = [&](Degeneracy reason, const std::string& why) {
-    SolverResult r = ml;
-    if (r.ok()) {
-      r.degeneracy = reason;
-      r.message = why + ": celc_ml's constant-velocity answer";
-    }
-    r.time_us = before_us + microsecondsSince(start);
-    return r;
-  };
-  if (!ml.ok()) return constantVelocity(Degeneracy::None, "");
-  const int lines = static_cast<int>(frames.clusters().size());
-  if (lines < acc.min_lines)
-    return constantVelocity(Degeneracy::AccelerationUnobservable,
-                            std::to_string(lines) + " lines, fewer than the " + std::to_string(acc.min_lines) +
-                                " that fix an acceleration");
-  JointProblem problem(obs, motion, frames, options.ml.max_events, options.refine.balance_clusters, event_seed,
-                       options.refine.huber_px, true);
-  if (problem.events() < 12 || static_cast<int>(problem.clusters()) < acc.min_lines)
-    return constantVelocity(Degeneracy::AccelerationUnobservable,
-                            std::to_string(problem.events()) + " events on " + std::to_string(problem.clusters()) +
-                                " lines, too few to fix an acceleration");
-  const int iterations = options.refine.max_iterations;
-  const double tolerance = std::max(options.refine.function_tolerance, kFunctionTolerance);
-  // The starts: celc_ml's answer with a = 0 and its lines (with its Huber
-  // threshold: the same events), or, where celc_ml hands over none, with the
-  // fitted lines; the linear (v, a) with the fitted lines. Each is refined
-  // ml.start_iterations iterations (a start that comes within kMergeDeg of
-  // an earlier end point, in v and in every line, stops: it would end
-  // there), and the lowest cost continues (kContinueIterations at most).
-  // Without celc_ml's threshold, the first end point sets it as celc_ml's
-  // does (MlOptions::huber_scale).
-  std::vector<JointProblem::State> starts;
-  const bool handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
-  JointProblem::State from_ml = problem.start(ml.v);
-  if (handed) {
-    from_ml.m1 = ml_end.m1;
-    from_ml.m3 = ml_end.m3;
-    starts.push_back(from_ml);
+/// celc_ml's constant-velocity answer `ml` as celc_acc's, with the reason it
+/// stands (where ml is ok), and celc_acc's time, time_us [us].
+SolverResult constantVelocity(const SolverResult& ml, Degeneracy reason, const std::string& why, double time_us) {
+  SolverResult r = ml;
+  if (r.ok()) {
+    r.degeneracy = reason;
+    r.message = why + ": celc_ml's constant-velocity answer";
+  }
+  r.time_us = time_us;
+  return r;
+}
+
+/// The joint refinement's starts and celc_ml's answer as a state.
+struct AccStarts {
+  std::vector<JointProblem::State> states;
+  JointProblem::State from_ml;  ///< celc_ml's v with a = 0, and its lines where handed over
+  bool handed = false;          ///< celc_ml handed over its lines and its Huber threshold
+};
+
+/// The starts: celc_ml's answer with a = 0 and its lines (with its Huber
+/// threshold, which the problem takes: the same events), or, where celc_ml
+/// hands over none, with the fitted lines; the linear (v, a) `linear` (null:
+/// none) with the fitted lines.
+AccStarts accStarts(JointProblem& problem, const SolverResult& ml, const MlEnd& ml_end, const Vec6* linear) {
+  AccStarts s;
+  s.handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
+  s.from_ml = problem.start(ml.v);
+  if (s.handed) {
+    s.from_ml.m1 = ml_end.m1;
+    s.from_ml.m3 = ml_end.m3;
+    s.states.push_back(s.from_ml);
     problem.setHuber(ml_end.huber_px);
   }
-  Vec6 linear;
-  if (linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear))
-    starts.push_back(problem.start(linear.head<3>(), linear.tail<3>()));
-  if (!handed) starts.push_back(problem.start(ml.v));
+  if (linear) s.states.push_back(problem.start(linear->head<3>(), linear->tail<3>()));
+  if (!s.handed) s.states.push_back(problem.start(ml.v));
+  return s;
+}
+
+/// The screen: each start refined ml.start_iterations iterations (a start
+/// that comes within kMergeDeg of an earlier end point, in v and in every
+/// line, stops: it would end there), and the lowest cost continues
+/// (kContinueIterations at most). Without celc_ml's threshold, the first end
+/// point sets the problem's as celc_ml's does (MlOptions::huber_scale).
+/// Returns the lowest end point, not ok where there is none.
+JointProblem::Result screenAccStarts(JointProblem& problem, const AccStarts& starts, int iterations,
+                                     double tolerance, const SolverOptions& options) {
   const int screen_iterations =
       options.ml.start_iterations > 0 ? std::min(options.ml.start_iterations, iterations) : iterations;
   JointProblem::Result best;
   std::vector<JointProblem::State> ends;
-  bool threshold_set = handed;
-  for (const JointProblem::State& s : starts) {
+  bool threshold_set = starts.handed;
+  for (const JointProblem::State& s : starts.states) {
     JointProblem::Result r = problem.refine(s, screen_iterations, tolerance, 1, ends, kMergeDeg * M_PI / 180.0);
     if (!r.ok || r.merged) continue;
     if (!threshold_set && options.ml.huber_scale > 0.0) {
@@ -267,53 +259,57 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
       best = std::move(rest);
     }
   }
-  if (!best.ok) return constantVelocity(Degeneracy::None, "the accelerating refinement failed");
-  // a with the sign of celc_ml's v, for the constant-velocity answers.
-  const Vec3 a_along_ml = best.state.v.dot(ml.v) < 0.0 ? Vec3(-best.state.a) : best.state.a;
-  // The test's C_0: celc_ml's answer refined on this problem under the
-  // constant-velocity model (the answer without a; from celc_ml's lines a
-  // few iterations).
-  const JointProblem::Result constant = problem.refineConstantVelocity(from_ml, iterations, tolerance);
-  // a's covariance with the lines and v eliminated, the residuals' robust
-  // scale as the noise's.
-  const double scale = problem.robustScale(best.state);
-  const Eigen::MatrixXd info = problem.information(best.state);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
-  double sigma_a = INFINITY;
+  return best;
+}
+
+/// The end point's spread: the residuals' robust scale [px] as the noise's,
+/// the covariance of (v's tangent, a) with the lines eliminated (NaN where
+/// the information is singular) and a's largest std [1/s] (infinite there).
+struct AccSpread {
+  double scale = 0.0;
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(5, 5, NAN);
+  double sigma_a = INFINITY;
+};
+
+/// The spread at s (AccSpread).
+AccSpread accelerationSpread(const JointProblem& problem, const JointProblem::State& s) {
+  AccSpread out;
+  out.scale = problem.robustScale(s);
+  const Eigen::MatrixXd info = problem.information(s);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
   if (es.info() == Eigen::Success && es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(4), 1e-300)) {
-    cov = scale * scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
-          es.eigenvectors().transpose();
-    const Mat3 cov_a = cov.bottomRightCorner<3, 3>();
+    out.cov = out.scale * out.scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
+              es.eigenvectors().transpose();
+    const Mat3 cov_a = out.cov.bottomRightCorner<3, 3>();
     const Eigen::SelfAdjointEigenSolver<Mat3> ea(cov_a);
-    sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
+    out.sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
   }
-  double reach = 0.0;  // the longest |t - t_ref| [s]
+  return out;
+}
+
+/// The longest |t - t_ref| [s] over the usable clusters' events.
+double windowReach(const WindowObservations& obs, const WindowFrames& frames, double t_ref) {
+  double reach = 0.0;
   for (int c : frames.clusters())
     for (double t : obs.clusters[c].times)
-      if (std::isfinite(t)) reach = std::max(reach, std::abs(t - motion.referenceTime()));
-  char text[240];
-  if (!(sigma_a * reach <= acc.max_sigma)) {
-    std::snprintf(text, sizeof text,
-                  "acceleration not observable: its std times the window's reach, %.3g, above %g", sigma_a * reach,
-                  acc.max_sigma);
-    SolverResult r = constantVelocity(Degeneracy::AccelerationUnobservable, text);
-    r.acceleration = a_along_ml;
-    return r;
-  }
-  const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / std::max(scale * scale, 1e-300) : INFINITY;
-  if (!(lr > acc.test_chi2)) {
-    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
-    SolverResult r = constantVelocity(Degeneracy::None, text);
-    r.acceleration = a_along_ml;
-    return r;
-  }
+      if (std::isfinite(t)) reach = std::max(reach, std::abs(t - t_ref));
+  return reach;
+}
+
+/// The accelerating answer from the end point `best`: v and a (their sign
+/// by cheirality with resolve_sign), the spread of v's tangent block as
+/// sigma_deg, the robust scale as the residual, the likelihood ratio lr in
+/// the message; its time is not set.
+SolverResult acceleratingAnswer(const JointProblem::Result& best, const AccSpread& spread, double lr,
+                                const WindowObservations& obs, const MotionModel& motion,
+                                const WindowFrames& frames, bool resolve_sign) {
+  SolverResult result;
   result.status = SolveStatus::Ok;
   result.acceleration_seen = true;
   result.v = best.state.v;
   result.acceleration = best.state.a;
   SignDecision sign;
-  if (options.linear.resolve_sign) {
+  if (resolve_sign) {
     sign = resolveSign(obs, motion, result.v, &result.acceleration, frames);
     result.v *= static_cast<double>(sign.sign);
     result.acceleration *= static_cast<double>(sign.sign);
@@ -321,13 +317,76 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   result.sign_margin = sign.margin * sign.sign;
   result.iterations = best.iterations;
   result.rows_used = best.events;
-  result.residual_px = scale;
-  // The direction's spread: v's tangent block of the covariance.
-  result.sigma_deg = std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
+  result.residual_px = spread.scale;
+  result.sigma_deg = std::sqrt(std::max(0.0, spread.cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
   if (!std::isfinite(result.sigma_deg)) result.sigma_deg = INFINITY;
+  char text[240];
   std::snprintf(text, sizeof text, "acceleration seen (likelihood ratio %.3g), |a|/|v| = %.3g 1/s", lr,
                 result.acceleration.norm());
   result.message = text;
+  return result;
+}
+
+}  // namespace
+
+SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& motion, const SolverResult& celc,
+                          const SolverResult& ml, const MlEnd& ml_end, const SolverOptions& options,
+                          const WindowFrames& frames, std::uint64_t row_seed, std::uint64_t event_seed) {
+  const auto start = Clock::now();
+  SolverResult rejected;
+  if (rejectInput(obs, motion, options.linear, rejected)) return rejected;
+  const AccOptions& acc = options.acc;
+  // celc's time is inside celc_ml's (its start).
+  const double before_us = ml.time_us;
+  if (!ml.ok()) return constantVelocity(ml, Degeneracy::None, "", before_us + microsecondsSince(start));
+  const int lines = static_cast<int>(frames.clusters().size());
+  if (lines < acc.min_lines)
+    return constantVelocity(ml, Degeneracy::AccelerationUnobservable,
+                            std::to_string(lines) + " lines, fewer than the " + std::to_string(acc.min_lines) +
+                                " that fix an acceleration",
+                            before_us + microsecondsSince(start));
+  JointProblem problem(obs, motion, frames, options.ml.max_events, options.refine.balance_clusters, event_seed,
+                       options.refine.huber_px, true);
+  if (problem.events() < 12 || static_cast<int>(problem.clusters()) < acc.min_lines)
+    return constantVelocity(ml, Degeneracy::AccelerationUnobservable,
+                            std::to_string(problem.events()) + " events on " + std::to_string(problem.clusters()) +
+                                " lines, too few to fix an acceleration",
+                            before_us + microsecondsSince(start));
+  const int iterations = options.refine.max_iterations;
+  const double tolerance = std::max(options.refine.function_tolerance, kFunctionTolerance);
+  Vec6 linear;
+  const bool have_linear = linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear);
+  const AccStarts starts = accStarts(problem, ml, ml_end, have_linear ? &linear : nullptr);
+  const JointProblem::Result best = screenAccStarts(problem, starts, iterations, tolerance, options);
+  if (!best.ok)
+    return constantVelocity(ml, Degeneracy::None, "the accelerating refinement failed",
+                            before_us + microsecondsSince(start));
+  // a with the sign of celc_ml's v, for the constant-velocity answers.
+  const Vec3 a_along_ml = best.state.v.dot(ml.v) < 0.0 ? Vec3(-best.state.a) : best.state.a;
+  // The test's C_0: celc_ml's answer refined on this problem under the
+  // constant-velocity model (the answer without a; from celc_ml's lines a
+  // few iterations).
+  const JointProblem::Result constant = problem.refineConstantVelocity(starts.from_ml, iterations, tolerance);
+  const AccSpread spread = accelerationSpread(problem, best.state);
+  const double reach = windowReach(obs, frames, motion.referenceTime());
+  char text[240];
+  if (!(spread.sigma_a * reach <= acc.max_sigma)) {
+    std::snprintf(text, sizeof text, "acceleration not observable: its std times the window's reach, %.3g, above %g",
+                  spread.sigma_a * reach, acc.max_sigma);
+    SolverResult r = constantVelocity(ml, Degeneracy::AccelerationUnobservable, text,
+                                      before_us + microsecondsSince(start));
+    r.acceleration = a_along_ml;
+    return r;
+  }
+  const double scale2 = std::max(spread.scale * spread.scale, 1e-300);
+  const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / scale2 : INFINITY;
+  if (!(lr > acc.test_chi2)) {
+    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
+    SolverResult r = constantVelocity(ml, Degeneracy::None, text, before_us + microsecondsSince(start));
+    r.acceleration = a_along_ml;
+    return r;
+  }
+  SolverResult result = acceleratingAnswer(best, spread, lr, obs, motion, frames, options.linear.resolve_sign);
   result.time_us = before_us + microsecondsSince(start);
   return result;
 }
