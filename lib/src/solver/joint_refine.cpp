@@ -240,6 +240,45 @@ JointProblem::Result JointProblem::refine(State s, int max_iterations, double fu
 }
 
 template <int G>
+Eigen::Matrix<double, G, 1> JointProblem::dampedStep(const Eigen::Matrix<double, G, G>& V,
+                                                     const Eigen::Matrix<double, G, 1>& bv, double lambda,
+                                                     std::vector<ClusterBlocks<G>>& blocks) {
+  Eigen::Matrix<double, G, G> S = V;
+  S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
+  Eigen::Matrix<double, G, 1> rhs = -bv;
+  for (ClusterBlocks<G>& k : blocks) {
+    Mat4 Ud = k.U;
+    Ud.diagonal() += lambda * k.U.diagonal().cwiseMax(1e-12);
+    k.X.template leftCols<G>() = k.W.transpose();
+    k.X.col(G) = k.bc;
+    solveSpd4(Ud, k.X);
+    S.noalias() -= k.X.template leftCols<G>().transpose() * k.W.transpose();
+    rhs.noalias() += k.X.template leftCols<G>().transpose() * k.bc;
+  }
+  return S.ldlt().solve(rhs);
+}
+
+template <int G>
+void JointProblem::takeStep(const State& s, const Eigen::Matrix<double, 3, 2>& Bv,
+                            const Eigen::Matrix<double, G, 1>& dg, const std::vector<ClusterBlocks<G>>& blocks,
+                            State& trial) {
+  trial.v = retract(s.v, Bv, dg.template head<2>());
+  if constexpr (G == 5) trial.a = s.a + dg.template tail<3>();
+  for (size_t c = 0; c < blocks.size(); ++c) {
+    // dc = -U_d^-1 (bc + W^T dg), from the columns dampedStep solved.
+    const ClusterBlocks<G>& k = blocks[c];
+    const Vec4 dc = -(k.X.col(G) + k.X.template leftCols<G>() * dg);
+    if (!dc.allFinite()) {
+      trial.m1[c] = s.m1[c];
+      trial.m3[c] = s.m3[c];
+      continue;
+    }
+    trial.m1[c] = retract(s.m1[c], k.B1, dc.template head<2>());
+    trial.m3[c] = retract(s.m3[c], k.B3, dc.template tail<2>());
+  }
+}
+
+template <int G>
 JointProblem::Result JointProblem::refineSteps(State s, int max_iterations, double function_tolerance,
                                                int stride, const std::vector<State>& merge_into,
                                                double merge_rad) const {
@@ -267,39 +306,13 @@ JointProblem::Result JointProblem::refineSteps(State s, int max_iterations, doub
     // Damped steps until one lowers the cost (lambda grows on failure).
     bool accepted = false;
     for (int tries = 0; tries < 12 && !accepted; ++tries) {
-      MatG S = V;
-      S.diagonal() += lambda * V.diagonal().cwiseMax(1e-12);
-      VecG rhs = -bv;
-      for (size_t c = 0; c < nc; ++c) {
-        ClusterBlocks<G>& k = blocks[c];
-        Mat4 Ud = k.U;
-        Ud.diagonal() += lambda * k.U.diagonal().cwiseMax(1e-12);
-        k.X.template leftCols<G>() = k.W.transpose();
-        k.X.col(G) = k.bc;
-        solveSpd4(Ud, k.X);
-        S.noalias() -= k.X.template leftCols<G>().transpose() * k.W.transpose();
-        rhs.noalias() += k.X.template leftCols<G>().transpose() * k.bc;
-      }
-      const VecG dg = S.ldlt().solve(rhs);
+      const VecG dg = dampedStep<G>(V, bv, lambda, blocks);
       if (!dg.allFinite()) {
         lambda *= 10.0;
         continue;
       }
       const Eigen::Vector2d dv = dg.template head<2>();
-      trial.v = retract(s.v, Bv, dv);
-      if constexpr (G == 5) trial.a = s.a + dg.template tail<3>();
-      for (size_t c = 0; c < nc; ++c) {
-        // dc = -U_d^-1 (bc + W^T dg), from the columns solved above.
-        const ClusterBlocks<G>& k = blocks[c];
-        const Vec4 dc = -(k.X.col(G) + k.X.template leftCols<G>() * dg);
-        if (!dc.allFinite()) {
-          trial.m1[c] = s.m1[c];
-          trial.m3[c] = s.m3[c];
-          continue;
-        }
-        trial.m1[c] = retract(s.m1[c], k.B1, dc.template head<2>());
-        trial.m3[c] = retract(s.m3[c], k.B3, dc.template tail<2>());
-      }
+      takeStep<G>(s, Bv, dg, blocks, trial);
       const double ft = cost(trial, stride);
       if (ft < f) {
         const double decrease = (f - ft) / std::max(f, 1e-300);

@@ -115,6 +115,19 @@ class JointProblem {
   template <int G>
   void linearise(const State& s, int stride, const Eigen::Matrix<double, 3, 2>& Bv, Eigen::Matrix<double, G, G>& V,
                  Eigen::Matrix<double, G, 1>& bv, std::vector<ClusterBlocks<G>>& blocks) const;
+  /// The damped Gauss-Newton step of the global unknowns (lambda times each
+  /// block's diagonal added) with every cluster's lines eliminated (Schur
+  /// complement); fills each block's X with U_d^-1 [W^T | bc].
+  template <int G>
+  static Eigen::Matrix<double, G, 1> dampedStep(const Eigen::Matrix<double, G, G>& V,
+                                                const Eigen::Matrix<double, G, 1>& bv, double lambda,
+                                                std::vector<ClusterBlocks<G>>& blocks);
+  /// trial = s moved by the global step dg (v retracted in the basis Bv, a
+  /// added) and each cluster's lines by their back-substituted step (kept
+  /// where that step is not finite); trial has s's sizes.
+  template <int G>
+  static void takeStep(const State& s, const Eigen::Matrix<double, 3, 2>& Bv, const Eigen::Matrix<double, G, 1>& dg,
+                       const std::vector<ClusterBlocks<G>>& blocks, State& trial);
   /// refine() with the global block of G unknowns: v's tangent (2), and a (5).
   template <int G>
   Result refineSteps(State s, int max_iterations, double function_tolerance, int stride,
