@@ -5,11 +5,10 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
-#include <map>
 #include <optional>
-#include <set>
 #include <utility>
 
+#include "celc/eval/result_table.hpp"
 #include "celc/eval/run_tables.hpp"
 #include "celc/io/labelled_events.hpp"
 #include "celc/pipeline/run_config.hpp"
@@ -33,31 +32,38 @@ struct TableArgs {
   bool quiet = false, allow_incomplete = false;
 };
 
-// One windows.csv and the row label it belongs to.
-struct Source {
-  fs::path csv;
-  std::string label;   ///< the given NAME, or the folder's name
-  bool named = false;  ///< from --label
-};
+// The sources the arguments name: the result paths, then the --label NAME=PATH ones.
+std::vector<ResultSource> argumentSources(const TableArgs& a) {
+  std::vector<ResultSource> sources;
+  for (const auto& r : a.results) {
+    const auto found = findResultSources(r, "");
+    sources.insert(sources.end(), found.begin(), found.end());
+  }
+  for (const auto& l : a.labels) {
+    const auto eq = l.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == l.size())
+      throw std::runtime_error("--label '" + l + "': expected NAME=PATH");
+    const auto found = findResultSources(l.substr(eq + 1), l.substr(0, eq));
+    sources.insert(sources.end(), found.begin(), found.end());
+  }
+  if (sources.empty()) throw std::runtime_error("table: give result folders, windows.csv files or --label NAME=PATH");
+  return sources;
+}
 
-// windows.csv files named directly, or found in the given folder (one level
-// of sub-folders too, as `celc batch` writes them, each labelled by its
-// folder's name; with a NAME, "NAME/<folder>").
-std::vector<Source> findCsvs(const std::string& in, const std::string& name) {
-  const fs::path p(in);
-  if (!fs::exists(p)) throw std::runtime_error(in + ": no such file or directory");
-  auto folderName = [](const fs::path& csv) { return fs::absolute(csv).parent_path().filename().string(); };
-  if (fs::is_regular_file(p)) return {{p, name.empty() ? folderName(p) : name, !name.empty()}};
-  std::vector<Source> out;
-  if (fs::exists(p / "windows.csv")) out.push_back({p / "windows.csv", name.empty() ? folderName(p / "windows.csv") : name, !name.empty()});
-  std::vector<fs::path> sub;
-  for (const auto& e : fs::directory_iterator(p))
-    if (e.is_directory() && fs::exists(e.path() / "windows.csv")) sub.push_back(e.path() / "windows.csv");
-  std::sort(sub.begin(), sub.end());
-  for (const auto& csv : sub)
-    out.push_back({csv, name.empty() ? folderName(csv) : name + "/" + folderName(csv), !name.empty()});
-  if (out.empty()) throw std::runtime_error(in + ": no windows.csv in it or in its sub-folders");
-  return out;
+// A run that has not completed is not a result: refused, or with
+// --allow-incomplete labelled "(incomplete)".
+void markIncomplete(std::vector<ResultSource>& sources, bool allow_incomplete) {
+  for (auto& s : sources) {
+    const fs::path folder = fs::path(s.csv).parent_path();
+    std::string reason;
+    if (!isIncompleteRun(folder.string(), &reason)) continue;
+    const std::string where = (folder / kIncompleteMarker).string();
+    if (!allow_incomplete)
+      throw std::runtime_error(where + ": incomplete run (" + reason +
+                               "); finish it with `celc run --resume`, or pass --allow-incomplete");
+    spdlog::warn("{}: incomplete run, shown as '{} (incomplete)'", where, s.label);
+    s.label += " (incomplete)";
+  }
 }
 
 // The run's configuration (config.yaml beside windows.csv), when readable.
@@ -72,186 +78,75 @@ std::optional<RunConfig> configOf(const fs::path& csv) {
   }
 }
 
+// --methods: the columns, in the order given (e.g. the paper's three); empty: every method.
+std::vector<std::string> columnMethods(const std::string& list) {
+  std::vector<std::string> wanted;
+  if (list.empty()) return wanted;
+  try {
+    for (Method m : parseMethodList(list)) wanted.push_back(toString(m));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("--methods '" + list + "': " + e.what());
+  }
+  return wanted;
+}
+
+// -o PREFIX: PREFIX.md, .tex and .csv; its folder is made as `celc run -o` makes its own.
+void writeTableFiles(const std::string& prefix, const std::vector<SequenceSummary>& table) {
+  if (const fs::path dir = fs::path(prefix).parent_path(); !dir.empty()) fs::create_directories(dir);
+  writeFileAtomically(prefix + ".md", tableMarkdown(table));
+  writeFileAtomically(prefix + ".tex", tableLatex(table));
+  writeFileAtomically(prefix + ".csv", tableCsv(table));
+  spdlog::info("wrote {}.md, {}.tex, {}.csv", prefix, prefix, prefix);
+}
+
+// The table on stdout, with the rows kept per run under --max-sigma.
+void printTable(const ResultTable& table, double max_sigma_deg) {
+  std::cout << tableMarkdown(table.sequences);
+  if (max_sigma_deg >= 0.0) {
+    std::cout << "\nOver the windows with sigma_deg <= " << max_sigma_deg
+              << " deg (rows above it, or without sigma_deg, are left out):\n";
+    for (const auto& n : table.kept_notes) std::cout << n << "\n";
+  }
+  std::cout << std::flush;
+}
+
+// --plot: the same rows as the table, per group its label and its CSVs (shards merge).
+void plotTable(const std::string& png, double max_sigma_deg, const std::vector<ResultGroup>& groups) {
+  std::vector<std::string> args = {"--table", png};
+  if (max_sigma_deg >= 0.0) {
+    args.push_back("--max-sigma");
+    args.push_back(fmt::format("{}", max_sigma_deg));
+  }
+  for (const auto& g : groups) {
+    args.push_back("--run");
+    args.push_back(g.label);
+    for (const auto& s : g.sources) args.push_back(s.csv);
+  }
+  if (const std::string error = runPlotScript("plot_run.py", args); !error.empty())
+    throw std::runtime_error("--plot " + png + ": " + error);
+  spdlog::info("wrote {}", png);
+}
+
 // Rows are grouped by label; without --label, results of the same name merge
 // only when they are shards of one run (the same configuration), else each
 // keeps its own row, named by its parent folder (or its path).
-struct Group {
-  std::string label;
-  std::optional<RunConfig> config;
-  std::vector<Source> sources;
-};
-
-bool sameRun(const Group& g, const Source& s, const std::optional<RunConfig>& config) {
-  if (g.label != s.label) return false;
-  if (s.named) return true;  // the user named them alike: one row
-  return g.config && config && firstConfigDifference(*g.config, *config).empty();
-}
-
 void runTable(const TableArgs& a) {
   configureLogging(a.quiet, false);
-  std::vector<Source> sources;
-  for (const auto& r : a.results) {
-    const auto found = findCsvs(r, "");
-    sources.insert(sources.end(), found.begin(), found.end());
-  }
-  for (const auto& l : a.labels) {
-    const auto eq = l.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == l.size())
-      throw std::runtime_error("--label '" + l + "': expected NAME=PATH");
-    const auto found = findCsvs(l.substr(eq + 1), l.substr(0, eq));
-    sources.insert(sources.end(), found.begin(), found.end());
-  }
-  if (sources.empty()) throw std::runtime_error("table: give result folders, windows.csv files or --label NAME=PATH");
-
-  // A run that has not completed is not a result.
-  for (auto& s : sources) {
-    std::string reason;
-    if (!isIncompleteRun(s.csv.parent_path().string(), &reason)) continue;
-    const std::string where = (s.csv.parent_path() / kIncompleteMarker).string();
-    if (!a.allow_incomplete)
-      throw std::runtime_error(where + ": incomplete run (" + reason +
-                               "); finish it with `celc run --resume`, or pass --allow-incomplete");
-    spdlog::warn("{}: incomplete run, shown as '{} (incomplete)'", where, s.label);
-    s.label += " (incomplete)";
-  }
-
-  std::vector<Group> groups;
-  for (const auto& s : sources) {
-    const auto config = configOf(s.csv);
-    auto g = std::find_if(groups.begin(), groups.end(), [&](const Group& x) { return sameRun(x, s, config); });
-    if (g == groups.end()) {
-      groups.push_back({s.label, config, {}});
-      g = groups.end() - 1;
-    }
-    g->sources.push_back(s);
-  }
-  // Labels shared by different runs: each named by its parent folder, else its path.
-  const auto count = [&](const std::string& label) {
-    return std::count_if(groups.begin(), groups.end(), [&](const Group& x) { return x.label == label; });
+  std::vector<ResultSource> sources = argumentSources(a);
+  markIncomplete(sources, a.allow_incomplete);
+  std::vector<std::optional<RunConfig>> configs;
+  for (const auto& s : sources) configs.push_back(configOf(s.csv));
+  const SameRun same_config = [&configs](std::size_t first, std::size_t other) {
+    return configs[first] && configs[other] && firstConfigDifference(*configs[first], *configs[other]).empty();
   };
-  for (int pass = 0; pass < 2; ++pass) {  // parent/name first, the full path where that clashes too
-    std::vector<bool> clashes;
-    for (const auto& g : groups) clashes.push_back(count(g.label) > 1);
-    for (std::size_t i = 0; i < groups.size(); ++i) {
-      if (!clashes[i]) continue;
-      Group& g = groups[i];
-      const fs::path folder = fs::absolute(g.sources.front().csv).parent_path();
-      const std::string old = g.label;
-      g.label = pass == 0 ? folder.parent_path().filename().string() + "/" + folder.filename().string()
-                          : folder.string();
-      spdlog::warn("results named '{}' from different runs: this one is the row '{}' (name rows with --label NAME=PATH)",
-                   old, g.label);
-    }
-  }
-
-  // --methods: the columns, in the order given (e.g. the paper's three).
-  std::vector<std::string> wanted;
-  if (!a.methods.empty()) {
-    try {
-      for (Method m : parseMethodList(a.methods)) wanted.push_back(toString(m));
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error("--methods '" + a.methods + "': " + e.what());
-    }
-  }
-  const auto column = [&](const std::string& method) {
-    return static_cast<std::size_t>(std::find(wanted.begin(), wanted.end(), method) - wanted.begin());
-  };
-  std::set<std::string> methods_found;
-
-  std::vector<SequenceSummary> table;
-  std::vector<std::string> kept_notes;
-  for (const auto& g : groups) {
-    // Shards of one run merge; a (window, method) seen twice is counted once.
-    std::vector<WindowsCsvRow> rows;
-    std::set<std::pair<std::int64_t, std::string>> seen;
-    for (const auto& s : g.sources) {
-      int dup = 0;
-      for (auto& r : readWindowsCsv(s.csv.string())) {
-        if (!seen.insert({r.window, r.method}).second) {
-          ++dup;
-          continue;
-        }
-        rows.push_back(r);
-      }
-      if (dup) spdlog::warn("{}: {} rows already read from another file of '{}' (ignored)", s.csv.string(), dup, g.label);
-    }
-    // Every window has a row per method of the run: a missing one means a
-    // file (a shard) was cut or edited, and the methods' columns would
-    // summarise different windows.
-    std::set<std::int64_t> windows;
-    std::set<std::string> methods;
-    for (const auto& [w, m] : seen) windows.insert(w), methods.insert(m);
-    if (const std::size_t missing = windows.size() * methods.size() - seen.size(); missing > 0) {
-      const auto first = [&]() -> std::pair<std::int64_t, std::string> {
-        for (std::int64_t w : windows)
-          for (const auto& m : methods)
-            if (!seen.count({w, m})) return {w, m};
-        return {};
-      }();
-      spdlog::warn("'{}': {} (window, method) rows missing, e.g. window {} of {}: a file of this run was cut or "
-                   "edited, so its methods are summarised over different windows",
-                   g.label, missing, first.first, first.second);
-    }
-    if (a.max_sigma_deg >= 0.0) {
-      // Only the windows a user would keep: ok rows above the threshold (or
-      // without sigma_deg, files of the first format) count as not ok.
-      int dropped = 0, ok = 0;
-      for (auto& r : rows) {
-        if (r.status != "ok") continue;
-        ++ok;
-        if (r.sigma_deg <= a.max_sigma_deg) continue;
-        r.status = "sigma_above_max";
-        r.has_v = r.has_metrics = false;
-        ++dropped;
-      }
-      kept_notes.push_back("- " + g.label + ": " + std::to_string(ok - dropped) + " of " + std::to_string(ok) +
-                           " ok rows kept");
-    }
-    if (!wanted.empty()) {
-      for (const auto& r : rows) methods_found.insert(r.method);
-      rows.erase(std::remove_if(rows.begin(), rows.end(),
-                                [&](const WindowsCsvRow& r) { return column(r.method) == wanted.size(); }),
-                 rows.end());
-    }
-    SequenceSummary summary{g.label, summarize(rows)};
-    std::stable_sort(summary.methods.begin(), summary.methods.end(),
-                     [&](const MethodSummary& x, const MethodSummary& y) { return column(x.method) < column(y.method); });
-    table.push_back(std::move(summary));
-  }
-  for (const auto& m : wanted)
-    if (!methods_found.count(m))
-      throw std::runtime_error("--methods: no rows of method '" + m + "' in the results");
-  if (!a.output.empty()) {
-    // -o DIR/prefix: DIR is made as `celc run -o` makes its folder.
-    if (const fs::path dir = fs::path(a.output).parent_path(); !dir.empty()) fs::create_directories(dir);
-    writeFileAtomically(a.output + ".md", tableMarkdown(table));
-    writeFileAtomically(a.output + ".tex", tableLatex(table));
-    writeFileAtomically(a.output + ".csv", tableCsv(table));
-    spdlog::info("wrote {}.md, {}.tex, {}.csv", a.output, a.output, a.output);
-  }
-  std::cout << tableMarkdown(table);
-  if (a.max_sigma_deg >= 0.0) {
-    std::cout << "\nOver the windows with sigma_deg <= " << a.max_sigma_deg
-              << " deg (rows above it, or without sigma_deg, are left out):\n";
-    for (const auto& n : kept_notes) std::cout << n << "\n";
-  }
-  std::cout << std::flush;
-  if (!a.plot.empty()) {
-    // The same rows as the table: per group its label and its CSVs (shards merge).
-    std::vector<std::string> args = {"--table", a.plot};
-    if (a.max_sigma_deg >= 0.0) {
-      args.push_back("--max-sigma");
-      args.push_back(fmt::format("{}", a.max_sigma_deg));
-    }
-    for (const auto& g : groups) {
-      args.push_back("--run");
-      args.push_back(g.label);
-      for (const auto& s : g.sources) args.push_back(s.csv.string());
-    }
-    if (const std::string error = runPlotScript("plot_run.py", args); !error.empty())
-      throw std::runtime_error("--plot " + a.plot + ": " + error);
-    spdlog::info("wrote {}", a.plot);
-  }
+  const TableWarn warn = [](const std::string& message) { spdlog::warn("{}", message); };
+  const std::vector<ResultGroup> groups = groupResultSources(sources, same_config, warn);
+  const ResultTable table = buildResultTable(groups, {a.max_sigma_deg, columnMethods(a.methods)}, warn);
+  if (!table.absent_methods.empty())
+    throw std::runtime_error("--methods: no rows of method '" + table.absent_methods.front() + "' in the results");
+  if (!a.output.empty()) writeTableFiles(a.output, table.sequences);
+  printTable(table, a.max_sigma_deg);
+  if (!a.plot.empty()) plotTable(a.plot, a.max_sigma_deg, groups);
 }
 
 }  // namespace
