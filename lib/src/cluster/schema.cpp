@@ -38,6 +38,15 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
            "cut each cluster to the events one moving line explains within this distance (sequential RANSAC); "
            "0 = not cut"},
           o.line_split_px);
+  v.field({"motion_reassign_px", "px",
+           "after a first solve, each event joins the one cluster whose line under the window's estimated motion "
+           "passes within this distance (kept where the first method still answers and 95% of the events stay "
+           "clustered); 0 = not redrawn"},
+          o.motion_reassign_px);
+  v.field({"motion_join_px", "px",
+           "clusters both within this median distance of their joint line under the estimated motion join "
+           "(fragments of one edge); 0 = none join"},
+          o.motion_join_px);
   v.field({"min_time_span_s", "s", "shortest cluster duration"}, o.min_time_span_s);
   v.field({"min_extent_px", "px", "smallest spatial extent"}, o.min_extent_px);
   v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane"}, o.min_density_per_px2);

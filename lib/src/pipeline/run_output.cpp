@@ -355,13 +355,15 @@ void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
     << (s.seconds_total > 0 ? s.events_processed / s.seconds_total / 1e6 : 0.0) << " M events/s)";
   out.notes.push_back(t.str());
   const double busy = s.seconds_reading + s.stage_seconds.cluster + s.stage_seconds.lines +
-                      s.stage_seconds.solve + s.stage_seconds.groundtruth + s.stage_seconds.truth;
+                      s.stage_seconds.solve + s.stage_seconds.redraw + s.stage_seconds.groundtruth +
+                      s.stage_seconds.truth;
   if (busy > 0) {
     std::ostringstream sh;
     sh.precision(3);
     sh << "time per stage (share of summed stage time): reading " << 100 * s.seconds_reading / busy
        << "%, clustering " << 100 * s.stage_seconds.cluster / busy << "%, undistortion+lines "
        << 100 * s.stage_seconds.lines / busy << "%, solvers " << 100 * s.stage_seconds.solve / busy
+       << "%, clusters redrawn under the motion and solved again " << 100 * s.stage_seconds.redraw / busy
        << "%, ground truth " << 100 * s.stage_seconds.groundtruth / busy << "%";
     if (s.stage_seconds.truth > 0)
       sh << ", clusters against the truth labels and the oracle " << 100 * s.stage_seconds.truth / busy << "%";

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "celc/cluster/line_split.hpp"
+#include "celc/cluster/motion_reassign.hpp"
 #include "celc/core/parallel.hpp"
 #include "celc/eval/metrics.hpp"
 #include "celc/geometry/undistort.hpp"
@@ -66,6 +67,58 @@ struct SequenceRunner::Impl {
     const std::vector<SolverResult> oracle = solveMethods(obs, motion, {Method::CelcMl}, config.solver, seeds);
     if (rec.has_gt && oracle.front().ok()) rec.oracle_phi = directionAngle(rec.gt, oracle.front().v);
     rec.times.truth = secondsSince(start);
+  }
+
+  /// The method whose answer redraws the clusters (cluster.motion_reassign_px):
+  /// the first of celc_ml, celc_opt, celc among the run's methods; none when
+  /// the redraw is off or the run has none of them.
+  std::optional<Method> redrawWitness(const ClusterOptions& cluster_options) const {
+    if (!(cluster_options.motion_reassign_px > 0.0)) return std::nullopt;
+    for (Method preferred : {Method::CelcMl, Method::CelcOpt, Method::Celc})
+      if (std::find(config.methods.begin(), config.methods.end(), preferred) != config.methods.end()) return preferred;
+    return std::nullopt;
+  }
+
+  /// The window's clusters redrawn under the witness's answer `first`
+  /// (cluster/motion_reassign.hpp), with their observations. Kept, replacing
+  /// `labels` (the clusters before fragments join), `report` and `obs`, when
+  /// the witness answers on them and the window's cost per event under that
+  /// answer and its clusters (motionCost) is below the first answer's with
+  /// the first clusters. Returns whether it was kept.
+  bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
+                         const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
+                         const SolverResult& first, std::vector<int>& labels, ObservationReport& report,
+                         WindowObservations& obs) const {
+    auto to_bearing = [&](const Vec2& p) { return bearing(p); };
+    std::vector<int> redrawn = report.event_clusters;
+    const MotionReassignReport redraw =
+        reassignToMotionLines(events, redrawn, to_bearing, calib.camera.focal(), motion, first.v, cluster_options);
+    const ClusterResult clusters = clustersFromLabels(events, redrawn);
+    if (clusters.status != ClusterStatus::Ok) return false;
+    ObservationReport redrawn_report;
+    WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
+                                                    config.observations, &motion, &redrawn_report);
+    const SolverResult after = solveMethods(redrawn_obs, motion, {witness}, config.solver, seeds).front();
+    // The window's cost per event (every event: the same set both times)
+    // under each answer with its clusters.
+    const double cost_before = motionCost(events, report.event_clusters, to_bearing, calib.camera.focal(), motion,
+                                          first.v, cluster_options);
+    const double cost_after = after.ok() ? motionCost(events, redrawn_report.event_clusters, to_bearing,
+                                                      calib.camera.focal(), motion, after.v, cluster_options)
+                                         : NAN;
+    const bool keep = cost_after < cost_before;
+    spdlog::debug("window {}: clusters under the motion: {} joined, {} moved, {} added, {} ambiguous, {} removed, "
+                  "{} of {} lines unexplained; {}: {:.2f} deg from the first answer, cost per event {:.4f} -> {:.4f}: "
+                  "{}",
+                  index, redraw.n_joined, redraw.n_moved, redraw.n_added, redraw.n_ambiguous, redraw.n_removed,
+                  redraw.n_unexplained, redraw.n_lines, toString(witness),
+                  angleBetweenSignAgnostic(first.v, after.v) * 180.0 / M_PI, cost_before, cost_after,
+                  keep ? "kept" : "not kept");
+    if (!keep) return false;
+    labels = clusters.labels;
+    report = std::move(redrawn_report);
+    obs = std::move(redrawn_obs);
+    return true;
   }
 
   /// Unit-plane bearing (x, y, 1) of a pixel: the undistortion table at whole
@@ -342,12 +395,15 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   splitByMovingLines(events, clusters, [&](const Vec2& p) { return m.bearing(p); }, m.calib.camera.focal(), &motion,
                      cluster_options);
   rec.times.cluster = secondsSince(start);
-  if (m.dump) {
+  // The clusters `celc solve` reproduces the window's answers from (dump_windows).
+  auto dump = [&](const std::vector<int>& labels) {
+    if (!m.dump) return;
     const GyroWindow gw = cfg.omega_source == OmegaSource::Gyro && !m.gyro.empty() ? m.gyro.window(t0, t1)
                                                                                  : GyroWindow{};
-    dumpWindow(*m.dump, index, t0, events, clusters.labels, &gw, rec.omega);
-  }
+    dumpWindow(*m.dump, index, t0, events, labels, &gw, rec.omega);
+  };
   if (clusters.status != ClusterStatus::Ok) {
+    dump(clusters.labels);
     if (m.truth) m.measureAgainstTruth(rec, events, clusters.labels, motion);
     rec.window_status = toString(clusters.status);
     return rec;
@@ -358,8 +414,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   const CameraModel& cam = m.calib.camera;
   auto bearing = [&](const Vec2& p) { return m.bearing(p); };
   ObservationReport report;
-  const WindowObservations obs =
-      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
+  WindowObservations obs = toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
   rec.n_clusters = report.n_used;  // with lines; npt also gets the others
   rec.n_line_fit_failed = report.n_line_fit_failed;
   for (std::size_t k = 0; k < report.failed_ids.size(); ++k) {
@@ -374,7 +429,6 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                   index, report.n_merged);
   rec.times.lines = secondsSince(start);
   rec.translation_px = lineTranslationPx(obs, motion, t0, t1);
-  if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);
 
   // The parallax policy grew the window as far as it could (to
   // windows.max_seconds, or to the end of the data) and its lines still show
@@ -393,12 +447,31 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
                                        shown_px, t1 - t0, cfg.parallax.no_parallax_px);
     }
     spdlog::debug("window {}: {}", index, rec.rows.front().result.message);
+    dump(clusters.labels);
+    if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);
     return rec;
   }
   start = Clock::now();
   const SampleSeeds seeds{cfg.seed + index, cfg.seed + index};  // windows draw different subsets
+  // The clusters redrawn under the witness's first answer, where kept; then
+  // every method on the window's final clusters.
+  std::vector<int> solved_labels = clusters.labels;  // the final clusters, before fragments join
+  if (const std::optional<Method> witness = m.redrawWitness(cluster_options)) {
+    const SolverResult first = solveMethods(obs, motion, {*witness}, cfg.solver, seeds).front();
+    rec.times.solve = secondsSince(start);
+    start = Clock::now();
+    if (first.ok() && m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, first,
+                                          solved_labels, report, obs)) {
+      rec.n_clusters = report.n_used;
+      rec.n_line_fit_failed = report.n_line_fit_failed;
+    }
+    rec.times.redraw = secondsSince(start);
+    start = Clock::now();
+  }
   const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds);
-  rec.times.solve = secondsSince(start);
+  rec.times.solve += secondsSince(start);
+  dump(solved_labels);
+  if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);
   for (size_t i = 0; i < cfg.methods.size(); ++i) {
     MethodRow& row = rec.rows[i];
     row.result = results[i];
@@ -530,6 +603,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         stats.stage_seconds.lines += rec.times.lines;
         stats.stage_seconds.solve += rec.times.solve;
         stats.stage_seconds.truth += rec.times.truth;
+        stats.stage_seconds.redraw += rec.times.redraw;
         stats.stage_seconds.groundtruth += rec.times.groundtruth;
         stats.clusters_line_fit_failed += static_cast<std::uint64_t>(rec.n_line_fit_failed);
         sink(rec);

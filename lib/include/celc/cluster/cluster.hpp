@@ -89,6 +89,15 @@ struct ClusterOptions {
   /// distance [px], by sequential RANSAC (line_split.hpp; needs the camera and
   /// the rotation, so `celc run` does it after clusterEvents); 0 = not cut.
   double line_split_px = 2.0;
+  /// After a first solve, the clusters are redrawn under the window's
+  /// estimated motion (motion_reassign.hpp; `celc run` keeps them where the
+  /// first method still answers on them and they hold 95% of the events):
+  /// an event joins the one cluster whose line passes within this distance
+  /// [px] (or 2.5 of its robust scales); 0 = not redrawn.
+  double motion_reassign_px = 1.5;
+  /// ... and clusters whose parts are both within this median distance [px]
+  /// of their joint line under the motion join (fragments of one edge); 0 = none join.
+  double motion_join_px = 0.0;
   double min_time_span_s = 0.0005; ///< minimum duration of a cluster [s]
   double min_extent_px = 5.0;      ///< minimum spatial extent of a cluster [px]
   /// Minimum density on the cluster's plane [events/px^2], area = 12 sqrt(l1 l2) from the

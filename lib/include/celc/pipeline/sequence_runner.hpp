@@ -52,6 +52,7 @@ struct MethodRow {
 struct StageTimes {
   double undistort = 0, cluster = 0, lines = 0, solve = 0, groundtruth = 0;
   double truth = 0;  ///< the clusters against the truth labels and the oracle's solve
+  double redraw = 0; ///< the clusters redrawn under the first solve's motion, and solved again
 };
 
 struct WindowRecord {
