@@ -66,6 +66,7 @@ std::string ClusterOptions::validate() const {
   if (max_split < 1 || max_split > 64) err << "max_split must be in [1, 64]; ";
   if (!(line_split_px >= 0.0 && line_split_px <= 50.0)) err << "line_split_px must be in [0, 50]; ";
   if (!(motion_reassign_px >= 0.0 && motion_reassign_px <= 50.0)) err << "motion_reassign_px must be in [0, 50]; ";
+  if (motion_redraw_rounds < 1 || motion_redraw_rounds > 10) err << "motion_redraw_rounds must be in [1, 10]; ";
   if (!(motion_join_px >= 0.0 && motion_join_px <= 50.0)) err << "motion_join_px must be in [0, 50]; ";
   if (!(min_time_span_s >= 0.0)) err << "min_time_span_s must be >= 0; ";
   if (!(min_extent_px >= 0.0)) err << "min_extent_px must be >= 0; ";

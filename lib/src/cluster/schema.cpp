@@ -43,6 +43,9 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
            "passes within this distance (kept where the first method still answers and 95% of the events stay "
            "clustered); 0 = not redrawn"},
           o.motion_reassign_px);
+  v.field({"motion_redraw_rounds", "",
+           "redraws at most, each from the answer on the last kept clusters (stops at the first not kept)"},
+          o.motion_redraw_rounds);
   v.field({"motion_join_px", "px",
            "clusters both within this median distance of their joint line under the estimated motion join "
            "(fragments of one edge); 0 = none join"},

@@ -81,13 +81,14 @@ struct SequenceRunner::Impl {
 
   /// The window's clusters redrawn under the witness's answer `first`
   /// (cluster/motion_reassign.hpp), with their observations. Kept, replacing
-  /// `labels` (the clusters before fragments join), `report` and `obs`, when
+  /// `first` (by the witness's answer on them), `labels` (the clusters before
+  /// fragments join), `report` and `obs`, when
   /// the witness answers on them and the window's cost per event under that
   /// answer and its clusters (motionCost) is below the first answer's with
   /// the first clusters. Returns whether it was kept.
   bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
                          const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
-                         const SolverResult& first, std::vector<int>& labels, ObservationReport& report,
+                         SolverResult& first, std::vector<int>& labels, ObservationReport& report,
                          WindowObservations& obs) const {
     auto to_bearing = [&](const Vec2& p) { return bearing(p); };
     std::vector<int> redrawn = report.event_clusters;
@@ -115,6 +116,7 @@ struct SequenceRunner::Impl {
                   angleBetweenSignAgnostic(first.v, after.v) * 180.0 / M_PI, cost_before, cost_after,
                   keep ? "kept" : "not kept");
     if (!keep) return false;
+    first = after;
     labels = clusters.labels;
     report = std::move(redrawn_report);
     obs = std::move(redrawn_obs);
@@ -457,11 +459,13 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // every method on the window's final clusters.
   std::vector<int> solved_labels = clusters.labels;  // the final clusters, before fragments join
   if (const std::optional<Method> witness = m.redrawWitness(cluster_options)) {
-    const SolverResult first = solveMethods(obs, motion, {*witness}, cfg.solver, seeds).front();
+    SolverResult answer = solveMethods(obs, motion, {*witness}, cfg.solver, seeds).front();
     rec.times.solve = secondsSince(start);
     start = Clock::now();
-    if (first.ok() && m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, first,
-                                          solved_labels, report, obs)) {
+    for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {
+      if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer, solved_labels,
+                               report, obs))
+        break;
       rec.n_clusters = report.n_used;
       rec.n_line_fit_failed = report.n_line_fit_failed;
     }

@@ -95,6 +95,9 @@ struct ClusterOptions {
   /// an event joins the one cluster whose line passes within this distance
   /// [px] (or 2.5 of its robust scales); 0 = not redrawn.
   double motion_reassign_px = 1.5;
+  /// Redraws at most, each from the answer on the last kept clusters; the
+  /// alternation stops at the first redraw not kept.
+  int motion_redraw_rounds = 3;
   /// ... and clusters whose parts are both within this median distance [px]
   /// of their joint line under the motion join (fragments of one edge); 0 = none join.
   double motion_join_px = 0.0;
