@@ -232,8 +232,10 @@ TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
 // 4000 this window is 0.07-0.14 rad off with the Tukey stage and 0.28-0.33
 // without (celc_opt does not move).
 // The clusters are grown at a fixed 20 deg (cluster.smoothness_noise_factor
-// 0), at 3x the median speed (cluster.c_speed_factor 3) and not cut to their
-// moving lines (cluster.line_split_px 0), which leaves these impure
+// 0), at 3x the median speed (cluster.c_speed_factor 3), neither cut to their
+// moving lines (cluster.line_split_px 0) nor redrawn under the motion
+// (cluster.motion_reassign_px 0; redrawn, celc is 0.018 and celc_opt 0.004
+// rad off without either stage), which leaves these impure
 // clusters; the defaults give this window purer clusters, where
 // the stage matters less (with the noise angle: celc 0.079, celc_opt
 // 0.036 rad).
@@ -250,7 +252,8 @@ TEST(EndToEnd, TukeyStageKeepsCelcOnTrackWithImpureClusters) {
     const fs::path out = d / ("run" + method + std::to_string(extra.size()));
     const auto run = test::runCelc("run '" + (d / "seq").string() + "' --window-seconds 0.225 --methods " + method +
                                        " --threads 2 -q --set cluster.smoothness_noise_factor=0 "
-                                       "--set cluster.c_speed_factor=3 --set cluster.line_split_px=0 " + extra +
+                                       "--set cluster.c_speed_factor=3 --set cluster.line_split_px=0 "
+                                       "--set cluster.motion_reassign_px=0 " + extra +
                                        " -o '" + out.string() + "'",
                                    d);
     EXPECT_EQ(run.status, 0) << run.err;
