@@ -277,10 +277,12 @@ bool fitWindowLines(const std::vector<Event>& events, const std::vector<int>& la
 
 }  // namespace
 
-double motionCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
-                  double focal_px, const MotionModel& motion, const Vec3& v, const ClusterOptions& options) {
-  WindowLines w;
-  if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, w)) return NAN;
+namespace {
+
+/// The mean over the events with a finite time of min((d / T)^2, 1) (1 for an
+/// event in no fitted cluster), the clusters' lines in `w`.
+double windowCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
+                  const WindowLines& w) {
   double sum = 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < events.size(); ++i) {
@@ -298,6 +300,15 @@ double motionCost(const std::vector<Event>& events, const std::vector<int>& labe
   return n > 0 ? sum / static_cast<double>(n) : NAN;
 }
 
+}  // namespace
+
+double motionCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
+                  double focal_px, const MotionModel& motion, const Vec3& v, const ClusterOptions& options) {
+  WindowLines w;
+  if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, w)) return NAN;
+  return windowCost(events, labels, bearing, w);
+}
+
 MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std::vector<int>& labels,
                                            const BearingFunction& bearing, double focal_px,
                                            const MotionModel& motion, const Vec3& v, const ClusterOptions& options) {
@@ -308,6 +319,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
   const int n_labels = w.n_labels;
   const double t_lo = w.t_lo, t_hi = w.t_hi;
   std::vector<Group>& groups = w.groups;
+  report.cost = windowCost(events, labels, bearing, w);
   for (const Group& g : groups) {
     report.n_lines += g.fitted ? 1 : 0;
     report.n_unexplained += g.fitted && !g.explained ? 1 : 0;

@@ -69,6 +69,14 @@ struct SequenceRunner::Impl {
     rec.times.truth = secondsSince(start);
   }
 
+  /// The solver options of the witness's solves while the clusters are
+  /// redrawn: the run's, without sigma_deg (only v is used).
+  SolverOptions witnessOptions() const {
+    SolverOptions options = config.solver;
+    options.uncertainty.enabled = false;
+    return options;
+  }
+
   /// The method whose answer redraws the clusters (cluster.motion_reassign_px):
   /// the first of celc_ml, celc_opt, celc among the run's methods; none when
   /// the redraw is off or the run has none of them.
@@ -99,11 +107,10 @@ struct SequenceRunner::Impl {
     ObservationReport redrawn_report;
     WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
                                                     config.observations, &motion, &redrawn_report);
-    const SolverResult after = solveMethods(redrawn_obs, motion, {witness}, config.solver, seeds).front();
+    const SolverResult after = solveMethods(redrawn_obs, motion, {witness}, witnessOptions(), seeds).front();
     // The window's cost per event (every event: the same set both times)
     // under each answer with its clusters.
-    const double cost_before = motionCost(events, report.event_clusters, to_bearing, calib.camera.focal(), motion,
-                                          first.v, cluster_options);
+    const double cost_before = redraw.cost;
     const double cost_after = after.ok() ? motionCost(events, redrawn_report.event_clusters, to_bearing,
                                                       calib.camera.focal(), motion, after.v, cluster_options)
                                          : NAN;
@@ -459,7 +466,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // every method on the window's final clusters.
   std::vector<int> solved_labels = clusters.labels;  // the final clusters, before fragments join
   if (const std::optional<Method> witness = m.redrawWitness(cluster_options)) {
-    SolverResult answer = solveMethods(obs, motion, {*witness}, cfg.solver, seeds).front();
+    SolverResult answer = solveMethods(obs, motion, {*witness}, m.witnessOptions(), seeds).front();
     rec.times.solve = secondsSince(start);
     start = Clock::now();
     for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {

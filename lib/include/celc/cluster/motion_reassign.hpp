@@ -19,6 +19,7 @@
 /// this line has 4: one v ties every cluster's motion, so a fragment's line
 /// extrapolates over the whole window, and two fragments of one edge fit
 /// one line.
+#include <cmath>
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
@@ -36,6 +37,9 @@ struct MotionReassignReport {
   int n_added = 0;        ///< unclustered events given to a cluster
   int n_ambiguous = 0;    ///< events within the threshold of two lines: made noise
   int n_removed = 0;      ///< clustered events no line explains: made noise
+  /// motionCost of the input clusters under v (from the same line fits); NaN
+  /// when nothing was fitted.
+  double cost = NAN;
 };
 
 /// Redraws the clusters `labels` (per event: a cluster id >= 0 or -1) of
