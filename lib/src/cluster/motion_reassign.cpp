@@ -438,21 +438,21 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
     k = e;
   }
 
-  // 4. Every event to the one line within the threshold.
+  // 4. Every clustered event to the one line within the threshold.
   std::vector<int> label_of(static_cast<std::size_t>(n_labels));  // input label -> its group
   for (int a = 0; a < n_labels; ++a) label_of[a] = joined.find(a);
   std::vector<int> out(events.size(), -1);
   for (std::size_t i = 0; i < events.size(); ++i) {
     const Event& e = events[i];
     const int current = labels[i] >= 0 ? label_of[labels[i]] : -1;
-    if (current >= 0 && !groups[current].explained) {  // left as it was
+    if (current < 0 || !std::isfinite(e.t)) continue;  // unclustered events stay noise
+    if (!groups[current].explained) {                  // left as it was
       out[i] = current;
       continue;
     }
-    if (!std::isfinite(e.t)) continue;
     const auto it = range.find(cellOf(e));
     int best = -1;
-    double d1 = std::numeric_limits<double>::infinity(), d2 = d1;
+    double d1 = std::numeric_limits<double>::infinity(), d2 = d1, d_current = d1;
     if (it != range.end()) {
       MotionPoint p;
       if (pointOf(events, bearing, w, static_cast<int>(i), p)) {
@@ -461,6 +461,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
           const Group& g = groups[a];
           if (options.separate_polarity && !(e.on ? g.on : g.off)) continue;
           const double d = g.line.distance(p) / g.tolerance;  // 1 at the group's tolerance
+          if (a == current) d_current = d;
           if (d < d1) d2 = d1, d1 = d, best = a;
           else if (d < d2) d2 = d;
         }
@@ -468,9 +469,9 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
     }
     if (d1 <= 1.0 && d2 > 1.0) {
       out[i] = best;
-      if (current < 0) ++report.n_added;
-      else if (current != best) ++report.n_moved;
+      if (current != best) ++report.n_moved;
     } else if (d1 <= 1.0) {
+      if (d_current <= 1.0) out[i] = current;  // its own line is one of those in reach
       ++report.n_ambiguous;
     } else if (current >= 0) {
       ++report.n_removed;

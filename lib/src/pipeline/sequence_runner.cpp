@@ -115,10 +115,10 @@ struct SequenceRunner::Impl {
                                                       calib.camera.focal(), motion, after.v, cluster_options)
                                          : NAN;
     const bool keep = cost_after < cost_before;
-    spdlog::debug("window {}: clusters under the motion: {} joined, {} moved, {} added, {} ambiguous, {} removed, "
+    spdlog::debug("window {}: clusters under the motion: {} joined, {} moved, {} ambiguous, {} removed, "
                   "{} of {} lines unexplained; {}: {:.2f} deg from the first answer, cost per event {:.4f} -> {:.4f}: "
                   "{}",
-                  index, redraw.n_joined, redraw.n_moved, redraw.n_added, redraw.n_ambiguous, redraw.n_removed,
+                  index, redraw.n_joined, redraw.n_moved, redraw.n_ambiguous, redraw.n_removed,
                   redraw.n_unexplained, redraw.n_lines, toString(witness),
                   angleBetweenSignAgnostic(first.v, after.v) * 180.0 / M_PI, cost_before, cost_after,
                   keep ? "kept" : "not kept");

@@ -2,7 +2,7 @@
 /// \file motion_reassign.hpp
 /// Clusters redrawn under the window's estimated motion: each cluster's 3D
 /// line given the velocity direction, fragments of one line joined, and every
-/// event near a cluster given to the one line that explains it.
+/// clustered event given to the one line that explains it.
 ///
 /// With the window's rotation R(t) and the camera centre c(t) = P(t) v
 /// (motion_model.hpp; v the estimated unit velocity, so lengths are in units
@@ -34,8 +34,7 @@ struct MotionReassignReport {
   int n_unexplained = 0;  ///< clusters the motion does not explain (robust scale above the threshold): kept as they were
   int n_joined = 0;       ///< clusters joined into another (fragments of one line)
   int n_moved = 0;        ///< clustered events given to another cluster
-  int n_added = 0;        ///< unclustered events given to a cluster
-  int n_ambiguous = 0;    ///< events within the threshold of two lines: made noise
+  int n_ambiguous = 0;    ///< events within the threshold of two lines (kept where their own line is one)
   int n_removed = 0;      ///< clustered events no line explains: made noise
   /// motionCost of the input clusters under v (from the same line fits); NaN
   /// when nothing was fitted.
@@ -52,11 +51,15 @@ struct MotionReassignReport {
 ///     when both parts' median distance to their joint line is within
 ///     options.motion_join_px [px] (0: none join; opposite polarities join
 ///     only with separate_polarity false);
-///  3. every event within a few pixels and one twentieth of the window's time
-///     of a cluster's events (same polarity, or either for a joined group of
-///     both) goes to the line nearest it when that is within the threshold
-///     and no other line is; an event within it of two lines, or of none,
-///     becomes noise (-1).
+///  3. every clustered event goes to the line nearest it among the groups
+///     whose events lie within a few pixels and one twentieth of the
+///     window's time of it (of a polarity the group holds) when that line
+///     is within the threshold and no other is; an event within it of two
+///     lines stays where it was if its own line is one of them (a corner,
+///     two edges crossing: noise otherwise); an event within it of none
+///     becomes noise (-1). Unclustered events stay noise: a line under any
+///     motion near the right one claims the events beside it, so adding
+///     them would lower the cost of a wrong answer as much as of a right one.
 /// Ids of the result are compact (0 .. n-1, in order of first event). Does
 /// nothing when the threshold is 0 or v is not finite. Deterministic; never
 /// throws on data.
