@@ -278,7 +278,8 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
   // celc_ml's last refinement: Tukey's biweight at 3 robust scales in `celc run`.
   EXPECT_EQ(RunConfig{}.solver.ml.tukey_scale, 3.0);
-  EXPECT_EQ(MlOptions{}.tukey_scale, 0.0);  // the library's default: Cauchy
+  EXPECT_EQ(MlOptions{}.tukey_scale, 3.0);  // the library's default is the tool's
+  EXPECT_EQ(SolverOptions::paper().ml.tukey_scale, 0.0);  // the paper's preset: Cauchy
   applyRunSetting("solver.ml.tukey_scale=4.5", c);
   EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=-1", c); }),
@@ -286,9 +287,10 @@ TEST(ConfigSchema, SetAssignments) {
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=nan", c); }),
             "--set solver.ml.tukey_scale=nan: key 'solver.ml.tukey_scale': expected a number, got 'nan'");
   EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);  // unchanged by a refused value
-  // celc_ml's answer in front of the camera: on in `celc run`, off in the library.
+  // celc_ml's answer in front of the camera: on by default, off in the paper's preset.
   EXPECT_EQ(RunConfig{}.solver.ml.cheiral_min, 0.9);
-  EXPECT_EQ(MlOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(MlOptions{}.cheiral_min, 0.9);
+  EXPECT_EQ(SolverOptions::paper().ml.cheiral_min, 0.0);
   EXPECT_EQ(MlOptions{}.cheiral_clusters, 10.0);
   applyRunSetting("solver.ml.cheiral_min=0.8", c);
   EXPECT_EQ(c.solver.ml.cheiral_min, 0.8);
@@ -310,9 +312,10 @@ TEST(ConfigSchema, SetAssignments) {
   applyRunSetting("solver.uncertainty.agreement=false", c);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=1000", c); }),
             "--set solver.uncertainty.witness_rows=1000: uncertainty.witness_rows needs uncertainty.agreement: true");
-  // The sigma_deg floor of answers behind the camera: on in `celc run`, off in the library.
+  // The sigma_deg floor of answers behind the camera: on by default, off in the paper's preset.
   EXPECT_EQ(RunConfig{}.solver.uncertainty.cheiral_min, 0.9);
-  EXPECT_EQ(UncertaintyOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(UncertaintyOptions{}.cheiral_min, 0.9);
+  EXPECT_EQ(SolverOptions::paper().uncertainty.cheiral_min, 0.0);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.cheiral_min=-0.1", c); }),
             "--set solver.uncertainty.cheiral_min=-0.1: uncertainty.cheiral_min must be in [0, 1]");
   SimulateConfig s;

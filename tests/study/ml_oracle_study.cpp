@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   int trials = 500, seed = 1;
   const int status = study::parseStudyArgs(argc, argv, "celc_ml_oracle_study", trials, seed);
   if (status >= 0) return status;
-  SolverOptions solver;  // the library defaults, as `celc simulate --study peers` takes them
+  SolverOptions solver = SolverOptions::paper();  // the paper's preset, as `celc simulate --study peers` takes it
   solver.check_parallax = false;
   std::vector<PeerCell> cells;
   for (const PeerCell& c : peerStudyCells())

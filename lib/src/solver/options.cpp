@@ -91,6 +91,23 @@ std::string UncertaintyOptions::validate() const {
   return e;
 }
 
+SolverOptions SolverOptions::paper() {
+  SolverOptions s;
+  s.linear.grid_directions = 0;
+  s.linear.grid_starts = 2;
+  s.linear.tukey_k = 0.0;
+  s.refine.tukey_scale = 0.0;
+  s.refine.starts = 1;
+  s.ml.grid_starts = 0;
+  s.ml.max_events = 5000;
+  s.ml.screen_events = 1000;
+  s.ml.finalists = 1;
+  s.ml.tukey_scale = 0.0;
+  s.ml.cheiral_min = 0.0;
+  s.uncertainty.cheiral_min = 0.0;
+  return s;
+}
+
 std::string SolverOptions::validate() const {
   return linear.validate() + refine.validate() + npt.validate() + ml.validate() + acc.validate() +
          uncertainty.validate();
