@@ -390,7 +390,7 @@ TEST(CelcMl, DrawsItsOwnEventBudget) {
   // windows hold 10^4-10^6 events (docs/method.md).
   EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions::paper().ml.max_events);
   options.ml.max_events = -1;
-  EXPECT_NE(options.validate().find("max_events must be >= 0"), std::string::npos);
+  EXPECT_NE(options.validate().find("ml.max_events: must be >= 0, got -1"), std::string::npos);
 }
 
 // The finalists (ml.finalists): the screen's lowest end points refined to
@@ -421,7 +421,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
   }
   EXPECT_GE(lower, 4);
   three.ml.finalists = 0;
-  EXPECT_NE(three.validate().find("finalists must be in [1, 100]"), std::string::npos);
+  EXPECT_NE(three.validate().find("ml.finalists: must be in [1, 100], got 0"), std::string::npos);
   // `celc run` refines three (docs/method.md, "celc_ml's finalists").
   EXPECT_EQ(RunConfig{}.solver.ml.finalists, 3);
 }
@@ -473,9 +473,9 @@ TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
     EXPECT_LE(changed, 30) << "sigma " << sigma;  // a tie-break, not a new estimator
   }
   tie.ml.cheiral_tie = -1.0;
-  EXPECT_NE(tie.validate().find("cheiral_tie must be finite and >= 0"), std::string::npos);
+  EXPECT_NE(tie.validate().find("ml.cheiral_tie: must be >= 0, got -1"), std::string::npos);
   tie.ml.cheiral_tie = NAN;
-  EXPECT_NE(tie.validate().find("cheiral_tie must be finite and >= 0"), std::string::npos);
+  EXPECT_NE(tie.validate().find("ml.cheiral_tie: must be finite and >= 0, got nan"), std::string::npos);
 }
 
 // The profile's minima as starts (the default) against the linear and npt
