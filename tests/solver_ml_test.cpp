@@ -665,7 +665,7 @@ struct LossAngles {
   std::vector<double> by_loss;
 };
 LossAngles lossAnglesFromTruth(const PeerSceneTrial& tr, const WindowObservations& obs,
-                               const std::vector<std::pair<detail::JointProblem::Loss, double>>& losses) {
+                               const std::vector<std::pair<detail::RobustLoss::Type, double>>& losses) {
   const RefineOptions ro = SolverOptions::paper().refine;
   LossAngles out;
   auto angle = [&](const Vec3& v) { return angleBetweenSignAgnostic(v, tr.true_direction) * kDeg; };
@@ -683,7 +683,7 @@ LossAngles lossAnglesFromTruth(const PeerSceneTrial& tr, const WindowObservation
   out.huber = angle(h.state.v);
   const double scale = problem.robustScale(h.state);
   for (const auto& [loss, factor] : losses) {
-    problem.setLoss(loss, factor * scale);
+    problem.setLoss({loss, factor * scale});
     const auto r = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
     if (!r.ok) return out;
     out.by_loss.push_back(angle(r.state.v));
@@ -714,7 +714,7 @@ TEST(JointProblem, CauchyLossLetsForeignEventsGo) {
     ASSERT_TRUE(tr.ok);
     WindowObservations obs;
     ASSERT_TRUE(withForeignEvents(tr, obs));
-    const LossAngles a = lossAnglesFromTruth(tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}});
+    const LossAngles a = lossAnglesFromTruth(tr, obs, {{detail::RobustLoss::Type::Cauchy, ml.cauchy_scale}});
     ASSERT_TRUE(a.ok);
     phi_clean.push_back(a.clean);
     phi_huber.push_back(a.huber);
@@ -770,7 +770,7 @@ TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
     WindowObservations obs;
     ASSERT_TRUE(withParallelEdge(tr, 3.0, obs));
     const LossAngles a = lossAnglesFromTruth(
-        tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}, {detail::JointProblem::Loss::Tukey, 3.0}});
+        tr, obs, {{detail::RobustLoss::Type::Cauchy, ml.cauchy_scale}, {detail::RobustLoss::Type::Tukey, 3.0}});
     ASSERT_TRUE(a.ok);
     phi_clean.push_back(a.clean);
     phi_huber.push_back(a.huber);

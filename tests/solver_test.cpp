@@ -379,6 +379,30 @@ TEST(Refinement, AnalyticJacobianMatchesNumeric) {
   }
 }
 
+// The one loss type: its two forms agree on the cost (r^2 = rho(d)), and
+// the last refinement's loss follows its keys (cauchy_scale 0: none;
+// tukey_scale > 0: Tukey's; else Cauchy's; none without a tail).
+TEST(RobustLoss, FormsAgreeAndTheLastStageFollowsItsKeys) {
+  using detail::RobustLoss;
+  const RobustLoss losses[] = {RobustLoss{}, RobustLoss::huber(1.5), RobustLoss::cauchy(0.8), RobustLoss::tukey(3.0)};
+  for (const RobustLoss& loss : losses)
+    for (double d : {-5.0, -1.0, 0.3, 1.5, 2.9, 7.0}) {
+      double slope = 0.0;
+      const double r = loss.sqrtResidual(d, &slope);
+      EXPECT_NEAR(r * r, loss.rho(d), 1e-12) << static_cast<int>(loss.type) << " " << d;
+    }
+  const auto px = [](double k) { return 2.0 * k; };  // a robust scale of 2 px, with a tail
+  const auto no_tail = [](double) { return 0.0; };
+  EXPECT_EQ(detail::redescendingLoss(0.0, 3.0, px).type, RobustLoss::Type::None);
+  EXPECT_EQ(detail::redescendingLoss(2.4, 0.0, no_tail).type, RobustLoss::Type::None);
+  const RobustLoss cauchy = detail::redescendingLoss(2.4, 0.0, px);
+  EXPECT_EQ(cauchy.type, RobustLoss::Type::Cauchy);
+  EXPECT_EQ(cauchy.scale, 4.8);
+  const RobustLoss tukey = detail::redescendingLoss(2.4, 3.0, px);
+  EXPECT_EQ(tukey.type, RobustLoss::Type::Tukey);
+  EXPECT_EQ(tukey.scale, 6.0);
+}
+
 TEST(MethodNames, RoundTrip) {
   for (Method m : allMethods()) EXPECT_EQ(parseMethod(toString(m)), m);
   EXPECT_EQ(parseMethodList("celc, ce3lc").size(), 2u);

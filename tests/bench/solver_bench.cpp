@@ -77,7 +77,7 @@ BENCHMARK(BM_PackRows1000)->Unit(benchmark::kMicrosecond);
 static void BM_HuberPass(benchmark::State& state) {
   const detail::PackedRows rows(rowsOf(scene(static_cast<int>(state.range(0)))));
   const Vec3 v = Vec3(1.0, 2.0, 0.1).normalized();
-  for (auto _ : state) benchmark::DoNotOptimize(detail::huberWeightedSums(rows, v, 1e-3));
+  for (auto _ : state) benchmark::DoNotOptimize(detail::weightedSums(rows, v, detail::RobustLoss::huber(1e-3)));
 }
 BENCHMARK(BM_HuberPass)->Arg(40)->Arg(200)->Arg(2000)->Unit(benchmark::kMicrosecond);
 

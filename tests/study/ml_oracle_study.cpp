@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
       // celc_ml's Huber threshold: huber_scale robust scales at its first end point.
       const double scaled = solver.ml.huber_scale * problem.robustScale(from_ml.state);
       if (scaled > solver.refine.huber_px) {
-        problem.setHuber(scaled);
+        problem.setLoss(detail::RobustLoss::huber(scaled));
         from_ml = problem.refine(from_ml.state, iterations, tolerance);
       }
       const detail::JointProblem::Result from_truth =
