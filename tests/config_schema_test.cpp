@@ -347,6 +347,13 @@ TEST(ConfigSchema, RangesOfTheSchemaValidate) {
   SolverOptions solver;
   solver.npt.max_sigma_ratio = 0.0;
   EXPECT_EQ(solver.validate(), "npt.max_sigma_ratio: must be in (0, 1], got 0; ");
+  RenderOptions render;
+  render.threads = 0;
+  render.min_step = 1.0;
+  EXPECT_EQ(render.validate(), "threads: must be in [1, 64], got 0; min_step: must be <= max_step; ");
+  ImuOptions imu;
+  imu.R_cam_imu(0, 0) = 2.0;  // a describe() that refuses a value itself: reported, not thrown
+  EXPECT_EQ(imu.validate(), "R_cam_imu: must be a rotation matrix (row-major 3x3); ");
   RunConfig run;
   run.fixed_omega.y() = NAN;
   run.groundtruth.degree = 5;

@@ -21,6 +21,12 @@ std::string numberText(double x) {
 
 std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
+/// A value that a describe() refuses itself (FieldVisitor::fail) while the
+/// ranges are checked.
+struct Refused {
+  std::string key, what;
+};
+
 /// Checks every numeric field against its range; collects "key: ...; ".
 class RangeChecker final : public FieldVisitor {
  public:
@@ -50,6 +56,9 @@ class RangeChecker final : public FieldVisitor {
       RangeChecker sub(out_, join(path_, i.key) + "[" + std::to_string(k) + "]");
       item(k, sub);
     }
+  }
+  [[noreturn]] void fail(const char* key, const std::string& what) override {
+    throw Refused{join(path_, key), what};
   }
 
  private:
@@ -97,7 +106,11 @@ std::string Range::text() const {
 std::string rangeProblems(const Describe& describe) {
   std::string out;
   RangeChecker checker(out, "");
-  describe(checker);
+  try {
+    describe(checker);
+  } catch (const Refused& r) {
+    out += (r.key.empty() ? "" : r.key + ": ") + r.what + "; ";
+  }
   return out;
 }
 
