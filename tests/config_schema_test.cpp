@@ -270,54 +270,99 @@ TEST(ConfigSchema, SetAssignments) {
   applyRunSetting("solver.refine.cauchy_scale=0", c);
   EXPECT_EQ(c.solver.refine.cauchy_scale, 0.0);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.cauchy_scale=-1", c); }),
-            "--set solver.refine.cauchy_scale=-1: cauchy_scale must be finite and >= 0");
+            "--set solver.refine.cauchy_scale=-1: solver.refine.cauchy_scale: must be >= 0, got -1");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.cauchy_min_tail=2", c); }),
-            "--set solver.refine.cauchy_min_tail=2: cauchy_min_tail must be in [0, 1]");
+            "--set solver.refine.cauchy_min_tail=2: solver.refine.cauchy_min_tail: must be in [0, 1], got 2");
   EXPECT_EQ(c.solver.refine.cauchy_min_tail, RefineOptions{}.cauchy_min_tail);  // unchanged
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.tukey_scale=-1", c); }),
-            "--set solver.refine.tukey_scale=-1: tukey_scale must be finite and >= 0");
+            "--set solver.refine.tukey_scale=-1: solver.refine.tukey_scale: must be >= 0, got -1");
   // celc_ml's last refinement: Tukey's biweight at 3 robust scales in `celc run`.
   EXPECT_EQ(RunConfig{}.solver.ml.tukey_scale, 3.0);
-  EXPECT_EQ(MlOptions{}.tukey_scale, 0.0);  // the library's default: Cauchy
+  EXPECT_EQ(MlOptions{}.tukey_scale, 3.0);  // the library's default is the tool's
+  EXPECT_EQ(SolverOptions::paper().ml.tukey_scale, 0.0);  // the paper's preset: Cauchy
   applyRunSetting("solver.ml.tukey_scale=4.5", c);
   EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=-1", c); }),
-            "--set solver.ml.tukey_scale=-1: tukey_scale must be finite and >= 0");
+            "--set solver.ml.tukey_scale=-1: solver.ml.tukey_scale: must be >= 0, got -1");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.tukey_scale=nan", c); }),
             "--set solver.ml.tukey_scale=nan: key 'solver.ml.tukey_scale': expected a number, got 'nan'");
   EXPECT_EQ(c.solver.ml.tukey_scale, 4.5);  // unchanged by a refused value
-  // celc_ml's answer in front of the camera: on in `celc run`, off in the library.
+  // celc_ml's answer in front of the camera: on by default, off in the paper's preset.
   EXPECT_EQ(RunConfig{}.solver.ml.cheiral_min, 0.9);
-  EXPECT_EQ(MlOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(MlOptions{}.cheiral_min, 0.9);
+  EXPECT_EQ(SolverOptions::paper().ml.cheiral_min, 0.0);
   EXPECT_EQ(MlOptions{}.cheiral_clusters, 10.0);
   applyRunSetting("solver.ml.cheiral_min=0.8", c);
   EXPECT_EQ(c.solver.ml.cheiral_min, 0.8);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.cheiral_min=1.5", c); }),
-            "--set solver.ml.cheiral_min=1.5: cheiral_min must be in [0, 1]");
+            "--set solver.ml.cheiral_min=1.5: solver.ml.cheiral_min: must be in [0, 1], got 1.5");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.ml.cheiral_clusters=-1", c); }),
-            "--set solver.ml.cheiral_clusters=-1: cheiral_clusters must be finite and >= 0");
+            "--set solver.ml.cheiral_clusters=-1: solver.ml.cheiral_clusters: must be >= 0, got -1");
   EXPECT_EQ(c.solver.ml.cheiral_min, 0.8);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.starts=0", c); }),
-            "--set solver.refine.starts=0: starts must be in [1, 64]");
+            "--set solver.refine.starts=0: solver.refine.starts: must be in [1, 64], got 0");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.refine.screen_events=-1", c); }),
-            "--set solver.refine.screen_events=-1: screen_events must be >= 0");
+            "--set solver.refine.screen_events=-1: solver.refine.screen_events: must be >= 0, got -1");
   applyRunSetting("solver.refine.starts=2", c);
   EXPECT_EQ(c.solver.refine.starts, 2);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.linear.tukey_k=-2", c); }),
-            "--set solver.linear.tukey_k=-2: tukey_k must be finite and >= 0 (0 = off)");
+            "--set solver.linear.tukey_k=-2: solver.linear.tukey_k: must be >= 0, got -2");
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=-1", c); }),
-            "--set solver.uncertainty.witness_rows=-1: uncertainty.witness_rows must be >= 0");
+            "--set solver.uncertainty.witness_rows=-1: solver.uncertainty.witness_rows: must be >= 0, got -1");
   applyRunSetting("solver.uncertainty.agreement=false", c);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.witness_rows=1000", c); }),
-            "--set solver.uncertainty.witness_rows=1000: uncertainty.witness_rows needs uncertainty.agreement: true");
-  // The sigma_deg floor of answers behind the camera: on in `celc run`, off in the library.
+            "--set solver.uncertainty.witness_rows=1000: solver.uncertainty.witness_rows: > 0 needs agreement: true");
+  // The sigma_deg floor of answers behind the camera: on by default, off in the paper's preset.
   EXPECT_EQ(RunConfig{}.solver.uncertainty.cheiral_min, 0.9);
-  EXPECT_EQ(UncertaintyOptions{}.cheiral_min, 0.0);
+  EXPECT_EQ(UncertaintyOptions{}.cheiral_min, 0.9);
+  EXPECT_EQ(SolverOptions::paper().uncertainty.cheiral_min, 0.0);
   EXPECT_EQ(errorOf([&] { applyRunSetting("solver.uncertainty.cheiral_min=-0.1", c); }),
-            "--set solver.uncertainty.cheiral_min=-0.1: uncertainty.cheiral_min must be in [0, 1]");
+            "--set solver.uncertainty.cheiral_min=-0.1: solver.uncertainty.cheiral_min: must be in [0, 1], got -0.1");
   SimulateConfig s;
   applySimulateSetting("scene.camera.fx=100", s);
   EXPECT_EQ(s.scene.camera.fx, 100.0);
+}
+
+// Validation generated from the schema: a field's range (core/fields.hpp)
+// refuses the values outside it, naming the key, the range and the value;
+// every default and the paper's preset are valid.
+TEST(ConfigSchema, RangesOfTheSchemaValidate) {
+  EXPECT_EQ(atLeast(0).text(), ">= 0");
+  EXPECT_EQ(above(0).text(), "> 0");
+  EXPECT_EQ(within(0, 1).text(), "in [0, 1]");
+  EXPECT_EQ(withinBelow(0, 1).text(), "in [0, 1)");
+  EXPECT_EQ(withinAbove(0, 1e-10).text(), "in (0, 1e-10]");
+  EXPECT_EQ(anyFinite().text(), "finite");
+  EXPECT_EQ(Range{}.text(), "");
+  EXPECT_TRUE(Range{}.contains(NAN));
+  EXPECT_FALSE(atLeast(0).contains(INFINITY));
+  EXPECT_FALSE(anyFinite().contains(-INFINITY));
+  EXPECT_FALSE(above(0).contains(0.0));
+  EXPECT_TRUE(withinBelow(0, 1).contains(0.0));
+  EXPECT_FALSE(withinBelow(0, 1).contains(1.0));
+  LinearOptions linear;
+  linear.max_rows = -1;
+  linear.huber_k = INFINITY;
+  EXPECT_EQ(linear.validate(), "max_rows: must be >= 0, got -1; huber_k: must be finite and > 0, got inf; ");
+  SolverOptions solver;
+  solver.npt.max_sigma_ratio = 0.0;
+  EXPECT_EQ(solver.validate(), "npt.max_sigma_ratio: must be in (0, 1], got 0; ");
+  RenderOptions render;
+  render.threads = 0;
+  render.min_step = 1.0;
+  EXPECT_EQ(render.validate(), "threads: must be in [1, 64], got 0; min_step: must be <= max_step; ");
+  ImuOptions imu;
+  imu.R_cam_imu(0, 0) = 2.0;  // a describe() that refuses a value itself: reported, not thrown
+  EXPECT_EQ(imu.validate(), "R_cam_imu: must be a rotation matrix (row-major 3x3); ");
+  RunConfig run;
+  run.fixed_omega.y() = NAN;
+  run.groundtruth.degree = 5;
+  run.groundtruth.min_poses = 10;
+  EXPECT_EQ(run.validate(),
+            "motion.fixed_omega: every element must be finite, got nan; groundtruth.degree: must be in [1, 4], got 5");
+  EXPECT_EQ(RunConfig{}.validate(), "");
+  EXPECT_EQ(SimulateConfig{}.validate(), "");
+  EXPECT_EQ(SolverOptions::paper().validate(), "");
 }
 
 TEST(ConfigSchema, HelpComesFromTheSchema) {

@@ -85,7 +85,7 @@ TEST(Crlb, MatchesEmpiricalSpreadOfMaximumLikelihood) {
   std::mt19937_64 rng(2024);
   double err_sq = 0.0, bound_sq = 0.0;
   int n = 0;
-  SolverOptions so;
+  SolverOptions so = SolverOptions::paper();
   so.check_parallax = false;
   for (int i = 0; i < 60; ++i) {
     const PeerSceneTrial tr = scene(rng, 5.0, 0.5, 5, 400);
@@ -118,7 +118,7 @@ TEST(MultiStart, JointRefinementEscapesWrongBasins) {
   // one: the linear and npt starts alone; many: also the line profile's
   // minima (the default) and a lattice of 16. Every start runs to
   // convergence, so that the lowest cost is kept among a superset of starts.
-  SolverOptions one, many;
+  SolverOptions one = SolverOptions::paper(), many = one;
   one.ml.profile_lattice = 0;
   one.ml.start_iterations = 0;
   many.ml.grid_starts = 16;

@@ -71,8 +71,10 @@ TEST(IrlsKernel, HuberAndTukeySumsMatchRowByRowEvaluation) {
       expectSumsNear(packed.plainSums(), directSums(rows, Vec3::Zero(), 0.0, Weight::Plain));
       const Vec3 v = Vec3(0.3, -0.8, 0.5).normalized();
       for (const double thr : {0.05, 0.5, 5.0}) {
-        expectSumsNear(detail::huberWeightedSums(packed, v, thr), directSums(rows, v, thr, Weight::Huber));
-        expectSumsNear(detail::tukeyWeightedSums(packed, v, thr), directSums(rows, v, thr, Weight::Tukey));
+        expectSumsNear(detail::weightedSums(packed, v, detail::RobustLoss::huber(thr)),
+                       directSums(rows, v, thr, Weight::Huber));
+        expectSumsNear(detail::weightedSums(packed, v, detail::RobustLoss::tukey(thr)),
+                       directSums(rows, v, thr, Weight::Tukey));
       }
     }
   }
@@ -90,8 +92,8 @@ TEST(IrlsKernel, AppendMatchesPackingAndRespectsCapacity) {
   const PackedRows packed(rows);
   ASSERT_EQ(appended.size(), packed.size());
   const Vec3 v = Vec3(1.0, 2.0, 0.5).normalized();
-  const PackedSums a = detail::huberWeightedSums(appended, v, 0.3);
-  const PackedSums b = detail::huberWeightedSums(packed, v, 0.3);
+  const PackedSums a = detail::weightedSums(appended, v, detail::RobustLoss::huber(0.3));
+  const PackedSums b = detail::weightedSums(packed, v, detail::RobustLoss::huber(0.3));
   for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k], b[k]);
 }
 

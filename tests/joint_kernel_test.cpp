@@ -12,7 +12,7 @@
 using namespace celc;
 using detail::JointBlockSums;
 using detail::JointColumns;
-using detail::JointLossKind;
+using detail::RobustLoss;
 
 namespace {
 
@@ -40,7 +40,7 @@ std::vector<EventTerm> randomTerms(size_t n, std::mt19937_64& rng) {
 // The sums event by event, as JointProblem::refine formed them before the kernel.
 JointBlockSums directSums(const std::vector<EventTerm>& terms, size_t begin, size_t end, size_t step,
                           const Vec3& v, const Vec3& m1, const Vec3& m3, const detail::Mat32& Bv,
-                          const detail::Mat32& B1, const detail::Mat32& B3, double focal, JointLossKind loss,
+                          const detail::Mat32& B1, const detail::Mat32& B3, double focal, RobustLoss::Type loss,
                           double scale) {
   Eigen::Matrix2d V = Eigen::Matrix2d::Zero();
   Eigen::Vector2d bv = Eigen::Vector2d::Zero();
@@ -52,9 +52,9 @@ JointBlockSums directSums(const std::vector<EventTerm>& terms, size_t begin, siz
     const double d = eventDistance(terms[k], v, m1, m3, focal, &gv, &g1, &g3);
     if (!std::isfinite(d)) continue;
     double slope, r;
-    if (loss == JointLossKind::Huber) {
+    if (loss == RobustLoss::Type::Huber) {
       r = detail::sqrtHuber(d, scale, &slope);
-    } else if (loss == JointLossKind::Cauchy) {
+    } else if (loss == RobustLoss::Type::Cauchy) {
       slope = 1.0 / std::sqrt(1.0 + (d / scale) * (d / scale));
       r = slope * d;
     } else {  // Tukey: sqrt(w) = 1 - (d / c)^2 within c, 0 beyond
@@ -109,15 +109,15 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
       const detail::Mat32 Bv = detail::tangentBasis(v), B1 = detail::tangentBasis(m1),
                           B3 = detail::tangentBasis(m3);
       for (size_t c = 0; c + 1 < begin.size(); ++c) {
-        for (JointLossKind loss : {JointLossKind::Huber, JointLossKind::Cauchy, JointLossKind::Tukey}) {
+        for (RobustLoss::Type loss : {RobustLoss::Type::Huber, RobustLoss::Type::Cauchy, RobustLoss::Type::Tukey}) {
           for (double scale : {0.5, 50.0}) {
             const JointBlockSums got =
                 detail::jointBlockSums(columns, column_begin[c], column_begin[c + 1], v, m1, m3, Bv.data(),
-                                       B1.data(), B3.data(), focal, loss, scale);
+                                       B1.data(), B3.data(), focal, RobustLoss{loss, scale});
             expectSumsNear(got, directSums(terms, begin[c], begin[c + 1], step, v, m1, m3, Bv, B1, B3, focal,
                                            loss, scale));
             ++checked;
-            if (loss == JointLossKind::Tukey)  // both sides of Tukey's cut are exercised
+            if (loss == RobustLoss::Type::Tukey)  // both sides of Tukey's cut are exercised
               for (size_t k = begin[c]; k < begin[c + 1]; k += step) {
                 const double d = eventDistance(terms[k], v, m1, m3, focal, nullptr, nullptr, nullptr);
                 if (std::isfinite(d)) ++(std::abs(d) < scale ? tukey_inside : tukey_beyond);

@@ -51,7 +51,7 @@ Outcome runScenes(const PeerSceneOptions& o, const std::vector<Method>& methods,
     if (!tr.ok) continue;
     ++out.trials;
     out.lines_rejected += o.n_lines - tr.lines_fitted;
-    const auto res = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions{});
+    const auto res = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions::paper());
     for (size_t k = 0; k < methods.size(); ++k)
       out.deg[k].push_back(res[k].ok() ? directionAngle(tr.true_direction, res[k].v) * kDeg : 180.0);
   }
@@ -133,9 +133,9 @@ TEST(LinesMotion, ClusterWithoutLinesServesNptOnly) {
   failed.clusters[0].has_lines = false;
   removed.clusters.erase(removed.clusters.begin());
   const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::Npt};
-  const auto all = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions{});
-  const auto with_failed = solveMethods(failed, tr.given_motion, methods, SolverOptions{});
-  const auto without = solveMethods(removed, tr.given_motion, methods, SolverOptions{});
+  const auto all = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions::paper());
+  const auto with_failed = solveMethods(failed, tr.given_motion, methods, SolverOptions::paper());
+  const auto without = solveMethods(removed, tr.given_motion, methods, SolverOptions::paper());
   for (size_t k = 0; k < 2; ++k) {
     ASSERT_TRUE(with_failed[k].ok() && without[k].ok()) << toString(methods[k]);
     EXPECT_LT(angleBetween(with_failed[k].v, without[k].v), 1e-9) << toString(methods[k]);

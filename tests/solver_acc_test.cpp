@@ -61,7 +61,7 @@ TEST(CelcAcc, NoiseFreeAcceleratingWindowsAreExact) {
   for (int trial = 0; trial < 10; ++trial) {
     const PeerSceneTrial tr = generatePeerScene(accelerating(2.0, 0.0), rng);
     ASSERT_TRUE(tr.ok) << tr.message;
-    const auto res = solveMethods(tr.observations, tr.given_motion, {Method::CelcAcc}, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, {Method::CelcAcc}, SolverOptions::paper());
     ASSERT_TRUE(res[0].ok()) << res[0].message;
     EXPECT_TRUE(res[0].acceleration_seen) << res[0].message;
     EXPECT_EQ(res[0].degeneracy, Degeneracy::None);
@@ -85,7 +85,7 @@ TEST(CelcAcc, NoiseFreePaperSceneIsExact) {
     o.event_noise_px = o.line_noise_px = 0.0;
     for (int trial = 0; trial < 5; ++trial) {
       const LineSceneTrial tr = generateLineScene(o, rng);
-      const auto res = solveMethods(tr.observations, tr.given_motion, {Method::CelcAcc}, {});
+      const auto res = solveMethods(tr.observations, tr.given_motion, {Method::CelcAcc}, SolverOptions::paper());
       ASSERT_TRUE(res[0].ok()) << res[0].message;
       EXPECT_LT(deg(res[0].v, tr.true_direction), 0.01) << "rho " << rho << " trial " << trial;
       EXPECT_LT(deg(res[0].acceleration, tr.true_acceleration), 0.01) << "rho " << rho << " trial " << trial;
@@ -101,7 +101,7 @@ TEST(CelcAcc, ConstantVelocityIsNotReadAsAcceleration) {
   for (int trial = 0; trial < 10; ++trial) {
     const PeerSceneTrial tr = generatePeerScene(accelerating(0.0, 0.5), rng);
     ASSERT_TRUE(tr.ok) << tr.message;
-    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, SolverOptions::paper());
     ASSERT_TRUE(res[1].ok()) << res[1].message;
     seen += res[1].acceleration_seen ? 1 : 0;
     if (!res[1].acceleration_seen) {
@@ -120,7 +120,7 @@ TEST(CelcAcc, NoWorseThanCelcMlWithoutAcceleration) {
   std::vector<double> acc, ml;
   for (int trial = 0; trial < 40; ++trial) {
     const LineSceneTrial tr = generateLineScene(paperScene(0.0), rng);
-    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, SolverOptions::paper());
     ml.push_back(res[0].ok() ? deg(res[0].v, tr.true_direction) : 180.0);
     acc.push_back(res[1].ok() ? deg(res[1].v, tr.true_direction) : 180.0);
   }
@@ -138,7 +138,7 @@ TEST(CelcAcc, BeatsConstantVelocityUnderAcceleration) {
   for (int trial = 0; trial < 20; ++trial) {
     const PeerSceneTrial tr = generatePeerScene(accelerating(2.0, 0.5), rng);
     ASSERT_TRUE(tr.ok) << tr.message;
-    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, SolverOptions::paper());
     ml.push_back(res[0].ok() ? deg(res[0].v, tr.true_direction) : 180.0);
     acc.push_back(res[1].ok() ? deg(res[1].v, tr.true_direction) : 180.0);
   }
@@ -154,7 +154,7 @@ TEST(CelcAcc, TooFewLinesFallBackToConstantVelocity) {
   LineSceneOptions o = paperScene(5.0);
   o.n_lines = 2;
   const LineSceneTrial tr = generateLineScene(o, rng);
-  const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, {});
+  const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, SolverOptions::paper());
   ASSERT_TRUE(res[0].ok()) << res[0].message;
   ASSERT_TRUE(res[1].ok()) << res[1].message;
   EXPECT_EQ(res[1].degeneracy, Degeneracy::AccelerationUnobservable);
@@ -173,13 +173,13 @@ TEST(CelcAcc, ShortNoisyWindowFallsBackToConstantVelocity) {
   LineSceneOptions o = paperScene(2.0);
   o.duration = 0.3;
   o.event_noise_px = 4.0;
-  SolverOptions off;
+  SolverOptions off = SolverOptions::paper();
   off.acc.max_sigma = 1e12;
   int unobservable = 0, unobservable_off = 0, trials = 0;
   std::mt19937_64 rng(9);
   for (int trial = 0; trial < 20; ++trial) {
     const LineSceneTrial tr = generateLineScene(o, rng);
-    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, kBoth, SolverOptions::paper());
     if (!res[0].ok()) continue;
     ++trials;
     ASSERT_TRUE(res[1].ok()) << res[1].message;
@@ -198,7 +198,7 @@ TEST(CelcAcc, ShortNoisyWindowFallsBackToConstantVelocity) {
 
 // The options check themselves.
 TEST(CelcAcc, OptionsValidate) {
-  SolverOptions o;
+  SolverOptions o = SolverOptions::paper();
   EXPECT_EQ(o.validate(), "");
   o.acc.min_lines = 1;
   o.acc.max_sigma = 0.0;

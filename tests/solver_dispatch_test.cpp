@@ -43,7 +43,7 @@ TEST(SolverDispatch, SharedFramesGiveTheStandaloneResults) {
     const LineSceneTrial tr = generateLineScene(o, rng);
     const auto& obs = tr.observations;
     const auto& motion = tr.given_motion;
-    SolverOptions so;
+    SolverOptions so = SolverOptions::paper();
     so.linear.answer_when_observable = false;  // the dispatcher's own step, beyond the standalone methods
     const auto all = solveMethods(obs, motion, methods, so);
     ASSERT_EQ(all.size(), methods.size());
@@ -83,7 +83,7 @@ TEST(SolverDispatch, SeedsAsArgumentsEqualSeedsInOptions) {
   LineSceneOptions o;
   o.events_per_line = 400;  // 2000 events: row and event subsets are drawn
   const LineSceneTrial tr = generateLineScene(o, rng);
-  SolverOptions in_options;
+  SolverOptions in_options = SolverOptions::paper();
   in_options.linear.seed = 7;
   in_options.refine.seed = 9;
   in_options.refine.max_events = 1500;

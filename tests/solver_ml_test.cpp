@@ -247,8 +247,8 @@ TEST(JointProblem, ReachesTheCeresRefinementsMinimum) {
   for (std::uint64_t seed : {7, 8, 9}) {
     const PeerSceneTrial tr = peerTrial(seed, 5.0, 1.0, 200);
     ASSERT_TRUE(tr.ok);
-    const RefineOptions ro;
-    const SolverResult linear = solveCelcLinear(tr.observations, tr.given_motion, {});
+    const RefineOptions ro = SolverOptions::paper().refine;
+    const SolverResult linear = solveCelcLinear(tr.observations, tr.given_motion, SolverOptions::paper().linear);
     ASSERT_TRUE(linear.ok());
     const SolverResult ceres = refineVelocity(tr.observations, tr.given_motion, linear.v, true, ro);
     ASSERT_TRUE(ceres.ok()) << ceres.message;
@@ -339,7 +339,7 @@ TEST(JointProblem, StopsWhereAnEarlierEndIs) {
 // of 40 trials beyond 4x their own bound (measured: 2, 0, 0; at V = 1 both
 // are trials whose lowest cost lies in a wrong basin).
 TEST(CelcMl, DefaultOptionsNearTheBound) {
-  SolverOptions options;
+  SolverOptions options = SolverOptions::paper();
   options.check_parallax = false;  // as the peer study runs it
   struct Cell {
     double speed, sigma;
@@ -374,7 +374,7 @@ TEST(CelcMl, DefaultOptionsNearTheBound) {
 TEST(CelcMl, DrawsItsOwnEventBudget) {
   const PeerSceneTrial tr = peerTrial(11, 2.0, 0.5, 600);
   ASSERT_TRUE(tr.ok);
-  SolverOptions options;
+  SolverOptions options = SolverOptions::paper();
   options.check_parallax = false;
   options.refine.max_events = 100;  // celc_opt's budget: not celc_ml's
   options.ml.max_events = 1000;
@@ -386,11 +386,11 @@ TEST(CelcMl, DrawsItsOwnEventBudget) {
   const SolverResult all = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options)[0];
   ASSERT_TRUE(all.ok());
   EXPECT_EQ(all.rows_used, 3000);
-  // The defaults of `celc run` draw more than the library's: its windows
-  // hold 10^4-10^6 events (docs/method.md).
-  EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions{}.ml.max_events);
+  // The defaults (`celc run`'s) draw more than the paper's preset: recorded
+  // windows hold 10^4-10^6 events (docs/method.md).
+  EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions::paper().ml.max_events);
   options.ml.max_events = -1;
-  EXPECT_NE(options.validate().find("max_events must be >= 0"), std::string::npos);
+  EXPECT_NE(options.validate().find("ml.max_events: must be >= 0, got -1"), std::string::npos);
 }
 
 // The finalists (ml.finalists): the screen's lowest end points refined to
@@ -401,7 +401,7 @@ TEST(CelcMl, DrawsItsOwnEventBudget) {
 // parallax (V = 1 m/s, 1 px, 5 x 200 events): measured lower in 9 of 40
 // trials, where near-tied basins swap places on convergence.
 TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
-  SolverOptions one;
+  SolverOptions one = SolverOptions::paper();
   one.check_parallax = false;
   one.ml.max_events = 0;
   one.ml.screen_events = 250;
@@ -421,7 +421,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
   }
   EXPECT_GE(lower, 4);
   three.ml.finalists = 0;
-  EXPECT_NE(three.validate().find("finalists must be in [1, 100]"), std::string::npos);
+  EXPECT_NE(three.validate().find("ml.finalists: must be in [1, 100], got 0"), std::string::npos);
   // `celc run` refines three (docs/method.md, "celc_ml's finalists").
   EXPECT_EQ(RunConfig{}.solver.ml.finalists, 3);
 }
@@ -435,7 +435,7 @@ TEST(CelcMl, FinalistsKeepTheLowestConvergedCost) {
 // 6.64 deg (4 trials changed) and 18.5 -> 16.0 deg (12 changed);
 // docs/accuracy.md has the study's 500 trials per cell.
 TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
-  SolverOptions tie;
+  SolverOptions tie = SolverOptions::paper();
   tie.check_parallax = false;
   ASSERT_EQ(tie.ml.cheiral_tie, 6.0);  // the default
   SolverOptions lowest = tie;
@@ -473,9 +473,9 @@ TEST(CelcMl, CheiralityBreaksTiesBetweenBasins) {
     EXPECT_LE(changed, 30) << "sigma " << sigma;  // a tie-break, not a new estimator
   }
   tie.ml.cheiral_tie = -1.0;
-  EXPECT_NE(tie.validate().find("cheiral_tie must be finite and >= 0"), std::string::npos);
+  EXPECT_NE(tie.validate().find("ml.cheiral_tie: must be >= 0, got -1"), std::string::npos);
   tie.ml.cheiral_tie = NAN;
-  EXPECT_NE(tie.validate().find("cheiral_tie must be finite and >= 0"), std::string::npos);
+  EXPECT_NE(tie.validate().find("ml.cheiral_tie: must be finite and >= 0, got nan"), std::string::npos);
 }
 
 // The profile's minima as starts (the default) against the linear and npt
@@ -545,9 +545,9 @@ TEST(CelcMl, AnswersWhenTheLinearStageIsAmbiguous) {
 // (without celc_ml to disagree with) trial 69's sigma_deg is 17.4 deg for
 // an error of 68.6: the agreement check is what makes it honest.
 //
-// With `celc run`'s Tukey stage (solver.linear.tukey_k = 3) no trial of this
-// cell is ambiguous for the linear stage any more (celc_solve_path_study):
-// the test runs the Huber-only stage, the library's default, to keep the path.
+// With the default Tukey stage (solver.linear.tukey_k = 3) no trial of this
+// cell is ambiguous for the linear stage (celc_solve_path_study): the test
+// runs the Huber-only stage of the paper's preset, to keep the path.
 TEST(CelcOpt, AnswersWhenTheLinearStageIsAmbiguous) {
   RunConfig defaults;
   defaults.solver.linear.tukey_k = 0.0;
@@ -665,8 +665,8 @@ struct LossAngles {
   std::vector<double> by_loss;
 };
 LossAngles lossAnglesFromTruth(const PeerSceneTrial& tr, const WindowObservations& obs,
-                               const std::vector<std::pair<detail::JointProblem::Loss, double>>& losses) {
-  const RefineOptions ro;
+                               const std::vector<std::pair<detail::RobustLoss::Type, double>>& losses) {
+  const RefineOptions ro = SolverOptions::paper().refine;
   LossAngles out;
   auto angle = [&](const Vec3& v) { return angleBetweenSignAgnostic(v, tr.true_direction) * kDeg; };
   const detail::WindowFrames clean_frames(tr.observations, tr.given_motion);
@@ -683,7 +683,7 @@ LossAngles lossAnglesFromTruth(const PeerSceneTrial& tr, const WindowObservation
   out.huber = angle(h.state.v);
   const double scale = problem.robustScale(h.state);
   for (const auto& [loss, factor] : losses) {
-    problem.setLoss(loss, factor * scale);
+    problem.setLoss({loss, factor * scale});
     const auto r = problem.refine(h.state, ro.max_iterations, ro.function_tolerance);
     if (!r.ok) return out;
     out.by_loss.push_back(angle(r.state.v));
@@ -706,7 +706,7 @@ double medianOf(std::vector<double> x) {
 // then under Cauchy from it, against the minimum on the clean events. 30
 // fixed trials, V = 2 m/s, 0.5 px.
 TEST(JointProblem, CauchyLossLetsForeignEventsGo) {
-  const MlOptions ml;
+  const MlOptions ml = SolverOptions::paper().ml;
   ASSERT_GT(ml.cauchy_scale, 0.0);  // on by default
   std::vector<double> phi_huber, phi_cauchy, phi_clean;
   for (std::uint64_t t = 0; t < 30; ++t) {
@@ -714,7 +714,7 @@ TEST(JointProblem, CauchyLossLetsForeignEventsGo) {
     ASSERT_TRUE(tr.ok);
     WindowObservations obs;
     ASSERT_TRUE(withForeignEvents(tr, obs));
-    const LossAngles a = lossAnglesFromTruth(tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}});
+    const LossAngles a = lossAnglesFromTruth(tr, obs, {{detail::RobustLoss::Type::Cauchy, ml.cauchy_scale}});
     ASSERT_TRUE(a.ok);
     phi_clean.push_back(a.clean);
     phi_huber.push_back(a.huber);
@@ -762,7 +762,7 @@ bool withParallelEdge(const PeerSceneTrial& tr, double offset_px, WindowObservat
 // events 1.32 (offsets of 2 / 4 / 6 px: Cauchy 2.62 / 2.39 / 1.65, Tukey
 // 1.41 / 1.19 / 1.41).
 TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
-  const MlOptions ml;
+  const MlOptions ml = SolverOptions::paper().ml;
   std::vector<double> phi_huber, phi_cauchy, phi_tukey, phi_clean;
   for (std::uint64_t t = 0; t < 30; ++t) {
     const PeerSceneTrial tr = peerTrial(400 + t, 2.0, 0.5, 200);
@@ -770,7 +770,7 @@ TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
     WindowObservations obs;
     ASSERT_TRUE(withParallelEdge(tr, 3.0, obs));
     const LossAngles a = lossAnglesFromTruth(
-        tr, obs, {{detail::JointProblem::Loss::Cauchy, ml.cauchy_scale}, {detail::JointProblem::Loss::Tukey, 3.0}});
+        tr, obs, {{detail::RobustLoss::Type::Cauchy, ml.cauchy_scale}, {detail::RobustLoss::Type::Tukey, 3.0}});
     ASSERT_TRUE(a.ok);
     phi_clean.push_back(a.clean);
     phi_huber.push_back(a.huber);
@@ -790,7 +790,7 @@ TEST(JointProblem, TukeyLossIgnoresANearbyParallelEdge) {
 // runs (their residuals have a Gaussian tail): the estimate is the Huber one
 // to the bit. 30 fixed trials, V = 2 m/s, 0.5 px.
 TEST(Refinement, CauchySolveLetsAWrongLineGo) {
-  const RefineOptions with_cauchy;
+  const RefineOptions with_cauchy = SolverOptions::paper().refine;
   ASSERT_GT(with_cauchy.cauchy_scale, 0.0);  // on by default
   RefineOptions huber_only = with_cauchy;
   huber_only.cauchy_scale = 0.0;
@@ -868,7 +868,7 @@ TEST(CelcOpt, FurtherStartsKeepTheLowerCostMinimum) {
 // answers stay. Measured here: 26.8 -> 6.0 deg, 20 of 24 kept, 2.9 deg/s
 // off; without an error 1 of 24 kept.
 TEST(CelcMl, RateOffsetFindsAGyroBias) {
-  SolverOptions off;
+  SolverOptions off = SolverOptions::paper();
   off.check_parallax = false;  // as the peer study runs it
   SolverOptions on = off;
   on.ml.rate_offset = true;

@@ -66,7 +66,7 @@ TEST(Npt, SignResolvedInSolveMethods) {
   for (int i = 0; i < 30; ++i) {
     const PeerSceneTrial tr = generatePeerScene(peerScene(5.0, 0.5), rng);
     ASSERT_TRUE(tr.ok);
-    const auto res = solveMethods(tr.observations, tr.given_motion, {Method::Npt}, {});
+    const auto res = solveMethods(tr.observations, tr.given_motion, {Method::Npt}, SolverOptions::paper());
     if (!res[0].ok()) continue;
     ++ok;
     if (angleBetween(res[0].v, tr.true_direction) < M_PI / 2) ++right;

@@ -30,7 +30,7 @@ struct MethodStats {
 // Runs `trials` scenes and accumulates per-method statistics.
 std::vector<MethodStats> runTrials(const LineSceneOptions& o, int trials, std::uint64_t seed,
                                    const std::vector<Method>& methods,
-                                   const SolverOptions& so = {}) {
+                                   const SolverOptions& so = SolverOptions::paper()) {
   std::mt19937_64 rng(seed);
   std::vector<MethodStats> stats(methods.size());
   for (int i = 0; i < trials; ++i) {
@@ -71,7 +71,7 @@ TEST(Solvers, NoiseFreeRecoversVelocityBothMotionModels) {
       const double angle = (i % 3 == 0) ? 3.0 : 1.2;
       o.omega = (i % 3 == 0 ? Vec3::UnitZ() : randomUnit(rng)) * angle / o.duration;
       const LineSceneTrial tr = generateLineScene(o, rng);
-      const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), {});
+      const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper());
       for (size_t m = 0; m < res.size(); ++m) {
         ASSERT_TRUE(res[m].ok()) << toString(defaultMethods()[m]) << " " << res[m].message;
         // npt models P(t) = tau I: exact for a reference-frame velocity only
@@ -108,7 +108,7 @@ TEST(Solvers, GyroIntegratedModelIsBodyFrameLikeTheTwist) {
       rates.push_back(o.omega);
     }
     const MotionModel gyro = MotionModel::gyroIntegrated(times, rates, t0);
-    const auto res = solveMethods(tr.observations, gyro, methods, {});
+    const auto res = solveMethods(tr.observations, gyro, methods, SolverOptions::paper());
     for (size_t m = 0; m < res.size(); ++m) {
       ASSERT_TRUE(res[m].ok()) << toString(methods[m]) << " " << res[m].message;
       EXPECT_LT(angleBetween(res[m].v, tr.true_direction), 1e-6) << toString(methods[m]) << " trial " << i;
@@ -170,7 +170,7 @@ TEST(Solvers, SignRightOnNoiseFreeData) {
 TEST(Solvers, LinearIrlsSettlesWhereTheDirectionIsWeak) {
   PeerSceneOptions o;
   std::mt19937_64 rng(42);
-  const LinearOptions opt;
+  const LinearOptions opt = SolverOptions::paper().linear;
   int trials = 0, at_limit = 0;
   double phi_sum = 0.0;
   while (trials < 20) {
@@ -198,7 +198,7 @@ TEST(Solvers, LinearTukeyStageAddsFewPasses) {
   PeerSceneOptions o;
   o.events_per_line = 20;
   std::mt19937_64 rng(42);
-  LinearOptions huber, tukey;
+  LinearOptions huber = SolverOptions::paper().linear, tukey = huber;
   tukey.tukey_k = 3.0;
   int trials = 0, extra = 0;
   double phi_huber = 0.0, phi_tukey = 0.0;
@@ -254,7 +254,7 @@ TEST(Degeneracy, OneClusterIsDegenerate) {
   o.n_lines = 1;
   std::mt19937_64 rng(1);
   const auto tr = generateLineScene(o, rng);
-  for (const auto& r : solveMethods(tr.observations, tr.given_motion, defaultMethods(), {})) {
+  for (const auto& r : solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper())) {
     EXPECT_EQ(r.status, SolveStatus::Degenerate);
     EXPECT_EQ(r.degeneracy, Degeneracy::TooFewClusters);
   }
@@ -264,23 +264,23 @@ TEST(Solvers, BadInputGivesStatusNotCrash) {
   std::mt19937_64 rng(2);
   const auto tr = generateLineScene(LineSceneOptions{}, rng);
   WindowObservations empty;
-  for (const auto& r : solveMethods(empty, tr.given_motion, defaultMethods(), {}))
+  for (const auto& r : solveMethods(empty, tr.given_motion, defaultMethods(), SolverOptions::paper()))
     EXPECT_EQ(r.status, SolveStatus::Degenerate);
   WindowObservations bad_focal = tr.observations;
   bad_focal.focal_px = 0.0;
-  EXPECT_EQ(solveCelcLinear(bad_focal, tr.given_motion, {}).status, SolveStatus::InvalidInput);
+  EXPECT_EQ(solveCelcLinear(bad_focal, tr.given_motion, SolverOptions::paper().linear).status, SolveStatus::InvalidInput);
   // NaN events are skipped, NaN lines make a cluster unusable: still a result.
   WindowObservations nan = tr.observations;
   for (size_t k = 0; k < nan.clusters[0].size(); k += 3)
     nan.clusters[0].bearings[k].x() = std::numeric_limits<double>::quiet_NaN();
   nan.clusters[1].l1.normal.setConstant(std::numeric_limits<double>::quiet_NaN());
-  for (const auto& r : solveMethods(nan, tr.given_motion, defaultMethods(), {})) {
+  for (const auto& r : solveMethods(nan, tr.given_motion, defaultMethods(), SolverOptions::paper())) {
     EXPECT_TRUE(r.ok()) << r.message;
     EXPECT_TRUE(r.v.allFinite());
   }
   const auto nan_motion = MotionModel::constantTwist(Vec3::Constant(NAN), 0.0);
-  EXPECT_EQ(solveCelcLinear(tr.observations, nan_motion, {}).status, SolveStatus::InvalidInput);
-  LinearOptions bad;
+  EXPECT_EQ(solveCelcLinear(tr.observations, nan_motion, SolverOptions::paper().linear).status, SolveStatus::InvalidInput);
+  LinearOptions bad = SolverOptions::paper().linear;
   bad.huber_k = -1.0;
   EXPECT_EQ(solveCelcLinear(tr.observations, tr.given_motion, bad).status,
             SolveStatus::InvalidInput);
@@ -377,6 +377,30 @@ TEST(Refinement, AnalyticJacobianMatchesNumeric) {
       EXPECT_EQ(slope, 0.0);
     }
   }
+}
+
+// The one loss type: its two forms agree on the cost (r^2 = rho(d)), and
+// the last refinement's loss follows its keys (cauchy_scale 0: none;
+// tukey_scale > 0: Tukey's; else Cauchy's; none without a tail).
+TEST(RobustLoss, FormsAgreeAndTheLastStageFollowsItsKeys) {
+  using detail::RobustLoss;
+  const RobustLoss losses[] = {RobustLoss{}, RobustLoss::huber(1.5), RobustLoss::cauchy(0.8), RobustLoss::tukey(3.0)};
+  for (const RobustLoss& loss : losses)
+    for (double d : {-5.0, -1.0, 0.3, 1.5, 2.9, 7.0}) {
+      double slope = 0.0;
+      const double r = loss.sqrtResidual(d, &slope);
+      EXPECT_NEAR(r * r, loss.rho(d), 1e-12) << static_cast<int>(loss.type) << " " << d;
+    }
+  const auto px = [](double k) { return 2.0 * k; };  // a robust scale of 2 px, with a tail
+  const auto no_tail = [](double) { return 0.0; };
+  EXPECT_EQ(detail::redescendingLoss(0.0, 3.0, px).type, RobustLoss::Type::None);
+  EXPECT_EQ(detail::redescendingLoss(2.4, 0.0, no_tail).type, RobustLoss::Type::None);
+  const RobustLoss cauchy = detail::redescendingLoss(2.4, 0.0, px);
+  EXPECT_EQ(cauchy.type, RobustLoss::Type::Cauchy);
+  EXPECT_EQ(cauchy.scale, 4.8);
+  const RobustLoss tukey = detail::redescendingLoss(2.4, 3.0, px);
+  EXPECT_EQ(tukey.type, RobustLoss::Type::Tukey);
+  EXPECT_EQ(tukey.scale, 6.0);
 }
 
 TEST(MethodNames, RoundTrip) {

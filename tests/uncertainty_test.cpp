@@ -41,7 +41,7 @@ std::vector<std::pair<WindowsCsvRow, WindowsCsvRow>> sameWindows(const fs::path&
 // of ok windows with phi <= 2 sigma_deg lies in 0.85-0.99.
 TEST(Uncertainty, CalibratedOnSimulatedWindows) {
   const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::CelcMl};
-  SolverOptions opt;
+  SolverOptions opt = SolverOptions::paper();
   opt.uncertainty.clearBudget();  // the simulated inputs are exact
   std::mt19937_64 rng(1313);
   std::vector<int> ok(methods.size(), 0), covered(methods.size(), 0);
@@ -75,9 +75,9 @@ TEST(Uncertainty, CalibratedOnSimulatedWindows) {
 // windows without, 10 of 40 with).
 TEST(Uncertainty, DisagreeingEstimatesRaiseSigma) {
   const std::vector<Method> methods = defaultMethods();
-  SolverOptions fisher_only;
+  SolverOptions fisher_only = SolverOptions::paper();
   fisher_only.uncertainty.agreement = false;
-  const SolverOptions defaults;
+  const SolverOptions defaults = SolverOptions::paper();
   ASSERT_TRUE(defaults.uncertainty.agreement);
   ASSERT_FALSE(defaults.uncertainty.linear_witness_refined);
   SolverOptions with_agreement = defaults;
@@ -136,7 +136,7 @@ TEST(Uncertainty, DisagreeingEstimatesRaiseSigma) {
 // error's own residuals, and the answer not least squares'.
 TEST(Uncertainty, BudgetShiftPredictsTheErrorOfAWrongGyroRate) {
   std::mt19937_64 rng(4242);
-  SolverOptions opt;
+  SolverOptions opt = SolverOptions::paper();
   opt.uncertainty.clearBudget();
   opt.ml.cauchy_scale = 0.0;
   int compared = 0;
@@ -164,7 +164,7 @@ TEST(Uncertainty, BudgetShiftPredictsTheErrorOfAWrongGyroRate) {
 // window), with gyro_bias_rad_s 0.1, on the paper's default scene. Without
 // the budget celc_ml covers about 0.43 at 2 sigma (sigma_calibration_sim.md).
 TEST(Uncertainty, BudgetCoversAWrongGyroRate) {
-  SolverOptions opt;
+  SolverOptions opt = SolverOptions::paper();
   opt.uncertainty.clearBudget();
   opt.uncertainty.gyro_bias_rad_s = 0.1;
   std::mt19937_64 rng(5151);
@@ -195,7 +195,7 @@ TEST(Uncertainty, BudgetCoversAWrongGyroRate) {
 // methods; 17 -> 20 of 30 windows covered).
 TEST(Uncertainty, SubsetWitnessRaisesSigmaUnderModelErrors) {
   const std::vector<Method> methods = defaultMethods();
-  SolverOptions without;
+  SolverOptions without = SolverOptions::paper();
   without.linear.max_rows = 4000;
   without.uncertainty.linear_witness_refined = true;  // the subset witness raises celc_ml too
   SolverOptions with = without;
@@ -246,7 +246,7 @@ TEST(Uncertainty, PureRotationIsNeverConfident) {
         o.omega = Vec3(0.3, -0.5, 0.8).normalized() * w;
         o.duration = T;
         const LineSceneTrial tr = generateLineScene(o, rng);
-        const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions{});
+        const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper());
         ++windows;
         for (size_t m = 0; m < res.size(); ++m) {
           EXPECT_FALSE(res[m].ok() && res[m].sigma_deg < 10.0)

@@ -1,4 +1,7 @@
-// Solver speed on the paper's default scene (5 lines, 2 px noise).
+// Solver speed on the paper's default scene (5 lines, 2 px noise) and the
+// peers' scene. Benchmarks time the solvers' defaults, the options of
+// `celc run` and `celc solve`; the `Paper` variants time the paper's preset
+// (SolverOptions::paper()), what `celc simulate` runs.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -74,7 +77,7 @@ BENCHMARK(BM_PackRows1000)->Unit(benchmark::kMicrosecond);
 static void BM_HuberPass(benchmark::State& state) {
   const detail::PackedRows rows(rowsOf(scene(static_cast<int>(state.range(0)))));
   const Vec3 v = Vec3(1.0, 2.0, 0.1).normalized();
-  for (auto _ : state) benchmark::DoNotOptimize(detail::huberWeightedSums(rows, v, 1e-3));
+  for (auto _ : state) benchmark::DoNotOptimize(detail::weightedSums(rows, v, detail::RobustLoss::huber(1e-3)));
 }
 BENCHMARK(BM_HuberPass)->Arg(40)->Arg(200)->Arg(2000)->Unit(benchmark::kMicrosecond);
 
@@ -99,8 +102,8 @@ BENCHMARK(BM_CelcLinearMethod1000Events)->Unit(benchmark::kMicrosecond);
 // (BM_WindowChecks1000Events). arg = events per line, 5 lines.
 // Paper's scene: constant twist, |w| T = 1 rad, 2 px noise.
 // The CELC linear method as the dispatcher runs it (frames, rows, IRLS, sign).
-static void timeCelcLinear(benchmark::State& state, const WindowObservations& obs, const MotionModel& motion) {
-  const LinearOptions opt;
+static void timeCelcLinear(benchmark::State& state, const WindowObservations& obs, const MotionModel& motion,
+                           const LinearOptions& opt) {
   int ok = 0, iterations = 0;
   for (auto _ : state) {
     const detail::WindowFrames frames(obs, motion);
@@ -115,9 +118,15 @@ static void timeCelcLinear(benchmark::State& state, const WindowObservations& ob
 
 static void BM_CelcLinear(benchmark::State& state) {
   const auto tr = scene(static_cast<int>(state.range(0)));
-  timeCelcLinear(state, tr.observations, tr.given_motion);
+  timeCelcLinear(state, tr.observations, tr.given_motion, LinearOptions{});
 }
 BENCHMARK(BM_CelcLinear)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+static void BM_CelcLinearPaper(benchmark::State& state) {
+  const auto tr = scene(static_cast<int>(state.range(0)));
+  timeCelcLinear(state, tr.observations, tr.given_motion, SolverOptions::paper().linear);
+}
+BENCHMARK(BM_CelcLinearPaper)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 // The same on the peers' scene (gyro-integrated rotation, V = 2 m/s, 1 px noise).
 static void BM_CelcLinearPeers(benchmark::State& state) {
@@ -125,7 +134,7 @@ static void BM_CelcLinearPeers(benchmark::State& state) {
   o.events_per_line = static_cast<int>(state.range(0));
   std::mt19937_64 rng(42);
   const auto tr = generatePeerScene(o, rng);
-  timeCelcLinear(state, tr.observations, tr.given_motion);
+  timeCelcLinear(state, tr.observations, tr.given_motion, LinearOptions{});
 }
 BENCHMARK(BM_CelcLinearPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
@@ -149,25 +158,31 @@ static void timeCelcLinearPeers16(benchmark::State& state, const LinearOptions& 
 static void BM_CelcLinearPeers16(benchmark::State& state) { timeCelcLinearPeers16(state, LinearOptions{}); }
 BENCHMARK(BM_CelcLinearPeers16)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
-// The same with the Tukey stage that `celc run` and `celc solve` add
-// (solver.linear.tukey_k 3): the timing as a user's run meets it.
+// The same under the paper's preset: one start, Huber only.
+static void BM_CelcLinearPeers16Paper(benchmark::State& state) {
+  timeCelcLinearPeers16(state, SolverOptions::paper().linear);
+}
+BENCHMARK(BM_CelcLinearPeers16Paper)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+// The same with the Tukey stage alone (the paper's preset with
+// solver.linear.tukey_k 3): its extra IRLS passes without the global start.
 static void BM_CelcLinearPeers16Tukey(benchmark::State& state) {
-  LinearOptions opt;
+  LinearOptions opt = SolverOptions::paper().linear;
   opt.tukey_k = 3.0;
   timeCelcLinearPeers16(state, opt);
 }
 BENCHMARK(BM_CelcLinearPeers16Tukey)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
-// celc_ml with the default options on the peers' scene (V = 2 m/s, 1 px
-// noise), as solveMethods runs it: its linear and npt starts, the line
-// profile's screen, the joint refinements. Cycles over 16 trials (the time
-// depends on the trial); arg = events per line, 5 lines. The time column
-// includes the window's uncertainty (sigma_deg, the witnesses);
-// method_median_us is the method alone. Target: median <= 1 ms at
-// 200 events per line, <= 0.3 ms at 20.
-static void BM_CelcMlPeers(benchmark::State& state) {
+// celc_ml on the peers' scene (V = 2 m/s, 1 px noise), as solveMethods runs
+// it: its linear and npt starts, the line profile's screen, the joint
+// refinements. Cycles over 16 trials (the time depends on the trial);
+// arg = events per line, 5 lines. The time column includes the window's
+// uncertainty (sigma_deg, the witnesses); method_median_us is the method
+// alone. BM_CelcMlPeers: the defaults (`celc solve`'s options);
+// BM_CelcMlPeersPaper: the paper's preset, as the peer study runs it
+// (target: median <= 1 ms at 200 events per line, <= 0.3 ms at 20).
+static void timeCelcMlPeers(benchmark::State& state, SolverOptions opt) {
   const std::vector<PeerSceneTrial> trials = peerTrials(static_cast<int>(state.range(0)));
-  SolverOptions opt;
   opt.check_parallax = false;  // as the peer study runs it
   size_t i = 0;
   std::vector<double> method_us;
@@ -186,7 +201,11 @@ static void BM_CelcMlPeers(benchmark::State& state) {
     state.counters["method_median_us"] = *mid;
   }
 }
+static void BM_CelcMlPeers(benchmark::State& state) { timeCelcMlPeers(state, SolverOptions{}); }
 BENCHMARK(BM_CelcMlPeers)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+static void BM_CelcMlPeersPaper(benchmark::State& state) { timeCelcMlPeers(state, SolverOptions::paper()); }
+BENCHMARK(BM_CelcMlPeersPaper)->Arg(20)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 // CE3LC itself (5 clusters, 15 rows) with its cluster frames; the window
 // checks are measured apart.
@@ -207,13 +226,21 @@ static void BM_WindowChecks1000Events(benchmark::State& state) {
 }
 BENCHMARK(BM_WindowChecks1000Events)->Unit(benchmark::kMicrosecond);
 
-// All four methods on one window, as `celc simulate` runs them.
+// All methods on one window with the defaults, and under the paper's preset
+// as `celc simulate` runs them.
 static void BM_AllMethodsOneWindow(benchmark::State& state) {
   const auto tr = scene(200);
   for (auto _ : state)
-    benchmark::DoNotOptimize(solveMethods(tr.observations, tr.given_motion, allMethods(), {}));
+    benchmark::DoNotOptimize(solveMethods(tr.observations, tr.given_motion, allMethods(), SolverOptions{}));
 }
 BENCHMARK(BM_AllMethodsOneWindow)->Unit(benchmark::kMillisecond);
+
+static void BM_AllMethodsOneWindowPaper(benchmark::State& state) {
+  const auto tr = scene(200);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(solveMethods(tr.observations, tr.given_motion, allMethods(), SolverOptions::paper()));
+}
+BENCHMARK(BM_AllMethodsOneWindowPaper)->Unit(benchmark::kMillisecond);
 
 // Refinement of v alone (Ceres) from the linear estimate; arg = events.
 static void BM_RefineVelocity(benchmark::State& state) {

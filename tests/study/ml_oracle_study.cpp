@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   int trials = 500, seed = 1;
   const int status = study::parseStudyArgs(argc, argv, "celc_ml_oracle_study", trials, seed);
   if (status >= 0) return status;
-  SolverOptions solver;  // the library defaults, as `celc simulate --study peers` takes them
+  SolverOptions solver = SolverOptions::paper();  // the paper's preset, as `celc simulate --study peers` takes it
   solver.check_parallax = false;
   std::vector<PeerCell> cells;
   for (const PeerCell& c : peerStudyCells())
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
       // celc_ml's Huber threshold: huber_scale robust scales at its first end point.
       const double scaled = solver.ml.huber_scale * problem.robustScale(from_ml.state);
       if (scaled > solver.refine.huber_px) {
-        problem.setHuber(scaled);
+        problem.setLoss(detail::RobustLoss::huber(scaled));
         from_ml = problem.refine(from_ml.state, iterations, tolerance);
       }
       const detail::JointProblem::Result from_truth =

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   int trials = 500, seed = 1;
   const int status = study::parseStudyArgs(argc, argv, "celc_rate_offset_study", trials, seed);
   if (status >= 0) return status;
-  SolverOptions off;  // the library defaults, as `celc simulate --study peers` takes them
+  SolverOptions off = SolverOptions::paper();  // the paper's preset, as `celc simulate --study peers` takes it
   off.check_parallax = false;
   SolverOptions on = off;
   on.ml.rate_offset = true;

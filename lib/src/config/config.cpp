@@ -4,11 +4,19 @@
 
 namespace celc {
 
+namespace {
+/// The `study` section's keys.
+void describeStudy(FieldVisitor& s, SimulateConfig& c) {
+  s.field({"trials", "", "random trials per level", atLeast(1)}, c.trials);
+  s.field({"seed", "", "seed of the trials"}, c.seed);
+  s.enumerations({"methods", "", "methods compared"}, c.methods, allMethods());
+}
+}  // namespace
+
 std::string SimulateConfig::validate() const {
-  std::string e;
-  if (const std::string s = scene.validate(); !s.empty()) e += "scene: " + s + "; ";
-  if (const std::string s = solver.validate(); !s.empty()) e += "solver: " + s + "; ";
-  if (trials < 1) e += "study.trials must be >= 1; ";
+  SimulateConfig copy = *this;
+  std::string e = inSection("scene", scene.validate()) + inSection("solver", solver.validate()) +
+                  inSection("study", rangeProblems([&](FieldVisitor& v) { describeStudy(v, copy); }));
   if (methods.empty()) e += "study.methods: at least one; ";
   return e;
 }
@@ -17,11 +25,7 @@ void describe(FieldVisitor& v, SimulateConfig& c) {
   v.section({"scene", "", "the paper's synthetic line scene (Sec. 5.1)"},
             [&](FieldVisitor& s) { describe(s, c.scene); });
   v.section({"solver", "", "the solvers"}, [&](FieldVisitor& s) { describe(s, c.solver); });
-  v.section({"study", "", "the Monte-Carlo study"}, [&](FieldVisitor& s) {
-    s.field({"trials", "", "random trials per level"}, c.trials);
-    s.field({"seed", "", "seed of the trials"}, c.seed);
-    s.enumerations({"methods", "", "methods compared"}, c.methods, allMethods());
-  });
+  v.section({"study", "", "the Monte-Carlo study"}, [&](FieldVisitor& s) { describeStudy(s, c); });
 }
 
 namespace {

@@ -448,7 +448,7 @@ class Lister final : public TextVisitor {
 
  private:
   void value(const FieldInfo& i, const std::string& value, const std::vector<std::string>& allowed = {}) override {
-    out_.push_back({join(path_, i.key), i.unit ? i.unit : "", i.doc ? i.doc : "", value, allowed});
+    out_.push_back({join(path_, i.key), i.unit ? i.unit : "", i.doc ? i.doc : "", value, allowed, i.range.text()});
   }
   std::vector<FieldEntry>& out_;
   std::string path_;

@@ -7,11 +7,10 @@
 namespace celc {
 
 std::string GtVelocityOptions::validate() const {
-  if (!(half_width > 0.0) || !std::isfinite(half_width)) return "half_width must be > 0 [s]";
-  if (degree < 1 || degree > 4) return "degree must be in 1..4";
-  if (min_poses < degree + 1) return "min_poses must be > degree";
-  if (samples < 1) return "samples must be >= 1";
-  return {};
+  std::string e = rangeProblemsOf(*this);
+  if (min_poses < degree + 1)
+    e += "min_poses: must be > degree (" + std::to_string(degree) + "), got " + std::to_string(min_poses) + "; ";
+  return e;
 }
 
 std::string toString(GtStatus s) {

@@ -59,21 +59,14 @@ ImuColumns parseImuColumns(const std::string& name) {
 ReaderOptions::ReaderOptions() = default;
 
 std::string ReaderOptions::validate() const {
-  if (width < 0 || height < 0) return "width and height must be >= 0";
-  if ((width == 0) != (height == 0)) return "give both width and height, or neither";
-  if (width > kMaxReaderSensorSide || height > kMaxReaderSensorSide)
-    return "width and height must be <= " + std::to_string(kMaxReaderSensorSide);
-  if (!(text_time_scale > 0.0) || !std::isfinite(text_time_scale)) return "text_time_scale must be > 0";
-  if (max_packet_bytes < 1024) return "max_packet_bytes must be >= 1024";
-  if (aedat_source < -1 || aedat_source > 32767) return "aedat_source must be -1 or a source id";
-  if (!(max_time_jump > 0.0) || !std::isfinite(max_time_jump)) return "max_time_jump must be > 0 and finite";
-  if (!(backwards_tolerance >= 0.0) || !std::isfinite(backwards_tolerance))
-    return "backwards_tolerance must be >= 0 and finite";
-  if (!(max_outside_share >= 0.0 && max_outside_share <= 1.0)) return "max_outside_share must be in [0, 1]";
+  std::string e = rangeProblemsOf(*this);
+  if ((width == 0) != (height == 0)) e += "width, height: give both, or neither; ";
   for (const std::string* topic : {&topic_events, &topic_imu, &topic_pose})
-    if (topic->size() > 256 || detail::firstNonTextByte(*topic) != std::string::npos)
-      return "a topic name must be text of at most 256 characters";
-  return {};
+    if (topic->size() > 256 || detail::firstNonTextByte(*topic) != std::string::npos) {
+      e += "topic_events, topic_imu, topic_pose: a topic name must be text of at most 256 characters; ";
+      break;
+    }
+  return e;
 }
 
 namespace detail {

@@ -17,10 +17,7 @@ std::string toString(GyroStatus status) {
   return "no_gyro";
 }
 
-std::string GyroWindowOptions::validate() const {
-  if (!(max_gap > 0.0) || !std::isfinite(max_gap)) return "max_gap must be > 0 [s]";
-  return {};
-}
+std::string GyroWindowOptions::validate() const { return rangeProblemsOf(*this); }
 
 GyroTrack::GyroTrack(const std::vector<ImuSample>& imu, const Mat3& R_cam_imu, double time_offset,
                      const GyroWindowOptions& options)

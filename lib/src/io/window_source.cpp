@@ -13,21 +13,18 @@ namespace celc {
 std::string WindowOptions::validate() const {
   std::ostringstream e;
   e.precision(6);
+  e << rangeProblemsOf(*this);
+  // The rules that tie fields together; each speaks only where its fields are in range.
   const bool seconds_ok = std::isfinite(seconds_per_window) && seconds_per_window >= 0.0;
   if (!seconds_ok)
     e << "seconds: must be finite and > 0 (0 = windows by events), got " << seconds_per_window << "; ";
   else if ((events_per_window > 0) == (seconds_per_window > 0.0))
     e << "events, seconds: give exactly one of events (> 0) and seconds (> 0); ";
   const bool overlap_ok = overlap >= 0.0 && overlap < 1.0;
-  if (!overlap_ok)
-    e << "overlap: must be in [0, 1), got " << overlap << "; ";
-  else if (events_per_window > 0 && std::size_t(std::floor((1.0 - overlap) * double(events_per_window))) < 1)
+  if (overlap_ok && events_per_window > 0 && std::size_t(std::floor((1.0 - overlap) * double(events_per_window))) < 1)
     e << "overlap: leaves a step of 0 events; ";
-  if (!(partial_min_share >= 0.0 && partial_min_share <= 1.0))
-    e << "partial_min_share: must be in [0, 1], got " << partial_min_share << "; ";
-  if (!(max_windows_per_second > 0.0) || !std::isfinite(max_windows_per_second))
-    e << "max_windows_per_second: must be finite and > 0, got " << max_windows_per_second << "; ";
-  else if (seconds_ok && overlap_ok && seconds_per_window > 0.0) {
+  if (seconds_ok && overlap_ok && seconds_per_window > 0.0 && max_windows_per_second > 0.0 &&
+      std::isfinite(max_windows_per_second)) {
     // By duration the rate is known before reading: one window per step.
     const double per_second = 1.0 / ((1.0 - overlap) * seconds_per_window);
     if (!(per_second <= max_windows_per_second))
@@ -35,9 +32,7 @@ std::string WindowOptions::validate() const {
         << " windows per second of data, more than max_windows_per_second = " << max_windows_per_second << "; ";
   }
   if (std::isnan(t_start) || std::isnan(t_end) || !(t_end > t_start)) e << "t_start, t_end: need t_start < t_end; ";
-  if (read_batch < 1) e << "read_batch: must be >= 1; ";
-  if (max_events < 1) e << "max_events: must be >= 1; ";
-  else if (events_per_window > max_events)
+  if (max_events >= 1 && events_per_window > max_events)
     e << "events: " << events_per_window << " per window, more than max_events = " << max_events << "; ";
   return e.str();
 }

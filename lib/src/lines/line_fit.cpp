@@ -12,17 +12,11 @@ namespace celc {
 std::string toString(LineModel model) { return model == LineModel::Moving ? "moving" : "static"; }
 
 std::string LineFitOptions::validate() const {
-  std::ostringstream err;
-  if (!(interval_s > 0.0)) err << "interval_s must be > 0; ";
-  if (!(interval_fraction >= 0.0 && interval_fraction <= 0.5))
-    err << "interval_fraction must be in [0, 0.5]; ";
-  if (min_events < 2) err << "min_events must be >= 2; ";
+  std::string e = rangeProblemsOf(*this);
   if (model == LineModel::Moving && min_events < 6)
-    err << "min_events must be >= 6 with the moving line model (five degrees of freedom); ";
-  if (!(target_length_px >= 0.0)) err << "target_length_px must be >= 0; ";
-  if (!(max_rms_px > 0.0)) err << "max_rms_px must be > 0; ";
-  if (!(min_length_px >= 0.0)) err << "min_length_px must be >= 0; ";
-  return err.str();
+    e += "min_events: must be >= 6 with the moving line model (five degrees of freedom), got " +
+         std::to_string(min_events) + "; ";
+  return e;
 }
 
 std::string toString(LineFitStatus status) {

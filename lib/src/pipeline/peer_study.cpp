@@ -77,7 +77,7 @@ std::vector<PeerCell> peerStudyCells() {
 }
 
 std::string PeerStudyConfig::validate() const {
-  std::string e = scene.validate() + solver.validate();
+  std::string e = scene.validate() + inSection("solver", solver.validate());
   if (trials < 1) e += "trials must be >= 1; ";
   if (methods.empty()) e += "no methods; ";
   return e;

@@ -14,17 +14,22 @@ std::string toString(StillBias mode) {
 }
 
 namespace {
-// "key: what; key: what; " of one section -> "section.key: what; ..."
-std::string inSection(const std::string& section, const std::string& problems) {
-  std::string out;
-  std::size_t at = 0;
-  while (at < problems.size()) {
-    std::size_t end = problems.find("; ", at);
-    if (end == std::string::npos) end = problems.size();
-    out += section + "." + problems.substr(at, end - at) + "; ";
-    at = end + 2;
-  }
-  return out;
+/// The `motion:` section's keys (the gyro window's among them).
+void describeMotion(FieldVisitor& s, RunConfig& c) {
+  s.enumeration({"model", "", "gyro_integrated: the gyro's rotation within the window; constant_twist: its mean (paper)"}, c.motion,
+                {MotionModelKind::ConstantTwist, MotionModelKind::GyroIntegrated});
+  s.enumeration({"omega_source", "", "gyro: the recording's IMU; fixed: fixed_omega"}, c.omega_source,
+                {OmegaSource::Gyro, OmegaSource::Fixed});
+  s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed", anyFinite()},
+          c.fixed_omega);
+  s.field({"gyro_bias", "rad/s",
+           "constant gyro bias, IMU frame, subtracted from every sample (celc info estimates it)", anyFinite()},
+          c.gyro_bias);
+  s.enumeration({"gyro_bias_from_still", "",
+                 "the mean gyro rate over the recording's first still second as the bias: auto = when it is "
+                 "significant and gyro_bias is zero; true = always (an error without one); false = never"},
+                c.gyro_bias_from_still, {StillBias::Auto, StillBias::On, StillBias::Off});
+  describe(s, c.gyro);
 }
 }  // namespace
 
@@ -53,8 +58,11 @@ std::string RunConfig::windowsValidate() const {
 }
 
 std::string RunConfig::validate() const {
-  std::string e = reader.validate() + inSection("windows", windowsValidate()) + gyro.validate() +
-                  cluster.validate() + observations.validate() + solver.validate() + groundtruth.validate();
+  RunConfig copy = *this;
+  std::string e = inSection("input", reader.validate()) + inSection("windows", windowsValidate()) +
+                  inSection("motion", rangeProblems([&](FieldVisitor& v) { describeMotion(v, copy); })) +
+                  cluster.validate() + observations.validate() + inSection("solver", solver.validate()) +
+                  inSection("groundtruth", groundtruth.validate());
   if (methods.empty()) e += "methods: at least one; ";
   for (size_t i = 0; i < methods.size(); ++i)
     if (std::find(methods.begin(), methods.begin() + static_cast<std::ptrdiff_t>(i), methods[i]) !=
@@ -62,8 +70,6 @@ std::string RunConfig::validate() const {
       e += "methods: " + toString(methods[i]) + " listed twice; ";
       break;
     }
-  if (!fixed_omega.allFinite()) e += "motion.fixed_omega must be finite; ";
-  if (!gyro_bias.allFinite()) e += "motion.gyro_bias must be finite; ";
   if (gyro_bias_from_still == StillBias::On && !gyro_bias.isZero(0.0))
     e += "motion.gyro_bias_from_still: set with motion.gyro_bias (use one of them); ";
   if (gyro_bias_from_still == StillBias::On && omega_source != OmegaSource::Gyro)
@@ -89,20 +95,7 @@ void describe(FieldVisitor& v, RunConfig& c) {
     describe(s, c.windows);
     describe(s, c.parallax);
   });
-  v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) {
-    s.enumeration({"model", "", "gyro_integrated: the gyro's rotation within the window; constant_twist: its mean (paper)"}, c.motion,
-                  {MotionModelKind::ConstantTwist, MotionModelKind::GyroIntegrated});
-    s.enumeration({"omega_source", "", "gyro: the recording's IMU; fixed: fixed_omega"}, c.omega_source,
-                  {OmegaSource::Gyro, OmegaSource::Fixed});
-    s.field({"fixed_omega", "rad/s", "camera-frame angular velocity with omega_source fixed"}, c.fixed_omega);
-    s.field({"gyro_bias", "rad/s", "constant gyro bias, IMU frame, subtracted from every sample (celc info estimates it)"},
-            c.gyro_bias);
-    s.enumeration({"gyro_bias_from_still", "",
-                   "the mean gyro rate over the recording's first still second as the bias: auto = when it is "
-                   "significant and gyro_bias is zero; true = always (an error without one); false = never"},
-                  c.gyro_bias_from_still, {StillBias::Auto, StillBias::On, StillBias::Off});
-    describe(s, c.gyro);
-  });
+  v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) { describeMotion(s, c); });
   describeClustering(v, c.cluster, c.observations.lines);
   v.section({"observations", "", "clusters turned into the solvers' observations"},
             [&](FieldVisitor& s) { describe(s, c.observations); });

@@ -28,12 +28,12 @@ std::string markdownReference(const Describe& describe, const std::string& title
     const std::string head = f.key.substr(0, f.key.find_first_of(".["));
     if (head != section) {
       section = head;
-      out += "\n## " + section + "\n\n| key | default | unit | meaning |\n|---|---|---|---|\n";
+      out += "\n## " + section + "\n\n| key | default | unit | valid | meaning |\n|---|---|---|---|---|\n";
     }
-    std::string doc = f.doc;
-    for (std::size_t k = 0; k < f.choices.size(); ++k)
-      doc += (k == 0 ? " (one of " : ", ") + ("`" + f.choices[k] + "`") + (k + 1 == f.choices.size() ? ")" : "");
-    out += "| `" + cell(f.key) + "` | `" + cell(f.value) + "` | " + cell(f.unit) + " | " + cell(doc) + " |\n";
+    std::string valid = f.range;
+    for (std::size_t k = 0; k < f.choices.size(); ++k) valid += (k == 0 ? "" : ", ") + ("`" + f.choices[k] + "`");
+    out += "| `" + cell(f.key) + "` | `" + cell(f.value) + "` | " + cell(f.unit) + " | " + cell(valid) + " | " +
+           cell(f.doc) + " |\n";
   }
   return out;
 }

@@ -22,47 +22,42 @@ std::string toString(WindowPolicy policy) {
 std::string ParallaxWindowOptions::validate() const {
   std::ostringstream e;
   e.precision(6);
-  if (!(target_px > 0.0) || !std::isfinite(target_px)) e << "parallax_px: must be finite and > 0; ";
+  e << rangeProblemsOf(*this);
+  // The rules that tie fields together.
   if (!(no_parallax_px >= 0.0) || !(no_parallax_px <= target_px))
-    e << "no_parallax_px: must be in [0, parallax_px (" << target_px << ")]; ";
-  if (!(step_seconds > 0.0) || !std::isfinite(step_seconds)) e << "step_seconds: must be finite and > 0; ";
-  if (!(min_seconds > 0.0) || !std::isfinite(min_seconds)) e << "min_seconds: must be finite and > 0; ";
-  if (!(max_seconds >= min_seconds) || !std::isfinite(max_seconds))
-    e << "max_seconds: must be finite and >= min_seconds (" << min_seconds << "); ";
-  else if (step_seconds > 0.0 && max_seconds / step_seconds > 10000.0)
+    e << "no_parallax_px: must be in [0, parallax_px (" << target_px << ")], got " << no_parallax_px << "; ";
+  if (std::isfinite(max_seconds) && !(max_seconds >= min_seconds))
+    e << "max_seconds: must be >= min_seconds (" << min_seconds << "), got " << max_seconds << "; ";
+  else if (std::isfinite(max_seconds) && step_seconds > 0.0 && max_seconds / step_seconds > 10000.0)
     e << "max_seconds: more than 10000 steps of step_seconds; ";
-  if (!(slow_turn_max_seconds > 0.0) || !std::isfinite(slow_turn_max_seconds))
-    e << "slow_turn_max_seconds: must be finite and > 0; ";
-  else if (step_seconds > 0.0 && slow_turn_max_seconds / step_seconds > 10000.0)
+  if (std::isfinite(slow_turn_max_seconds) && step_seconds > 0.0 && slow_turn_max_seconds / step_seconds > 10000.0)
     e << "slow_turn_max_seconds: more than 10000 steps of step_seconds; ";
-  if (!(slow_turn_rad >= 0.0) || !std::isfinite(slow_turn_rad)) e << "slow_turn_rad: must be finite and >= 0; ";
-  if (probe_events < 1000) e << "probe_events: must be >= 1000; ";
   return e.str();
 }
 
 void describe(FieldVisitor& v, ParallaxWindowOptions& o) {
-  v.field({"parallax_px", "px", "parallax policy: grow a window until its lines' translation reaches this"},
+  v.field({"parallax_px", "px", "parallax policy: grow a window until its lines' translation reaches this", above(0)},
           o.target_px);
   v.field({"no_parallax_px", "px",
            "parallax policy: a window grown to its longest (max_seconds, or slow_turn_max_seconds) with less is "
            "degenerate (no_parallax)"},
           o.no_parallax_px);
-  v.field({"min_seconds", "s", "parallax policy: shortest window"}, o.min_seconds);
+  v.field({"min_seconds", "s", "parallax policy: shortest window", above(0)}, o.min_seconds);
   v.field({"max_seconds", "s",
            "parallax policy: longest window but where the camera turns slowly (reached without parallax: "
-           "degenerate)"},
+           "degenerate)", anyFinite()},
           o.max_seconds);
   v.field({"slow_turn_max_seconds", "s",
            "parallax policy: longest window while the camera turns less than slow_turn_rad over it (at or "
-           "below max_seconds: none grows past max_seconds)"},
+           "below max_seconds: none grows past max_seconds)", above(0)},
           o.slow_turn_max_seconds);
   v.field({"slow_turn_rad", "rad",
            "parallax policy: a window turning less than this (|mean gyro rate| x duration) may grow past "
-           "max_seconds"},
+           "max_seconds", atLeast(0)},
           o.slow_turn_rad);
-  v.field({"step_seconds", "s", "parallax policy: windows grow by whole steps of this"}, o.step_seconds);
+  v.field({"step_seconds", "s", "parallax policy: windows grow by whole steps of this", above(0)}, o.step_seconds);
   v.field({"probe_events", "events",
-           "parallax policy: events clustered to measure a growing window, per max_seconds of window"},
+           "parallax policy: events clustered to measure a growing window, per max_seconds of window", atLeast(1000)},
           o.probe_events);
 }
 

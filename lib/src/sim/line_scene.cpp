@@ -7,22 +7,11 @@
 namespace celc {
 
 std::string LineSceneOptions::validate() const {
-  std::ostringstream e;
-  if (n_lines < 1) e << "n_lines must be >= 1; ";
-  if (events_per_line < 2) e << "events_per_line must be >= 2; ";
-  if (!(duration > 0.0)) e << "duration must be > 0; ";
-  if (!velocity.allFinite() || !omega.allFinite()) e << "velocity and omega must be finite; ";
-  if (!(event_noise_px >= 0.0) || !(line_noise_px >= 0.0) || !(omega_noise >= 0.0))
-    e << "noise levels must be >= 0; ";
-  if (!(outlier_fraction >= 0.0 && outlier_fraction < 1.0)) e << "outlier_fraction must be in [0, 1); ";
-  if (!(edge_offset_px >= 0.0 && edge_offset_px < 100.0)) e << "edge_offset_px must be in [0, 100); ";
+  std::string e = rangeProblemsOf(*this);
   if (!(x_range[1] >= x_range[0] && y_range[1] >= y_range[0] && z_range[1] >= z_range[0]))
-    e << "ranges must be [min, max]; ";
-  if (!(z_range[0] > 0.0)) e << "z_range must be in front of the camera (> 0); ";
-  if (!(gyro_rate_hz > 0.0)) e << "gyro_rate_hz must be > 0; ";
-  if (!(acceleration >= 0.0) || !std::isfinite(acceleration)) e << "acceleration must be finite and >= 0; ";
-  e << camera.validate();
-  return e.str();
+    e += "x_range, y_range, z_range: each must be [min, max]; ";
+  if (!(z_range[0] > 0.0)) e += "z_range: must lie in front of the camera (> 0); ";
+  return e + inSection("camera", camera.validate());
 }
 
 namespace {

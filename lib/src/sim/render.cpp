@@ -46,20 +46,9 @@ inline bool eventLess(const SimEvent& a, const SimEvent& b) {
 }  // namespace
 
 std::string RenderOptions::validate() const {
-  std::ostringstream e;
-  auto pos = [](double x) { return x > 0.0 && std::isfinite(x); };
-  if (!pos(contrast_on) || !pos(contrast_off)) e << "contrast thresholds must be > 0; ";
-  if (!(contrast_sigma >= 0.0) || !std::isfinite(contrast_sigma))
-    e << "contrast_sigma must be >= 0; ";
-  if (!(refractory >= 0.0) || !(refractory < 10.0)) e << "refractory must be in [0, 10) s; ";
-  if (!(noise_rate >= 0.0) || !(noise_rate <= 1e3)) e << "noise_rate must be in [0, 1000] Hz; ";
-  if (!pos(log_eps)) e << "log_eps must be > 0; ";
-  if (!pos(max_step_px)) e << "max_step_px must be > 0; ";
-  if (!pos(max_step) || !pos(min_step) || min_step > max_step)
-    e << "steps must satisfy 0 < min_step <= max_step; ";
-  if (!pos(smoothing_px) || smoothing_px > 100.0) e << "smoothing_px must be in (0, 100]; ";
-  if (threads < 1 || threads > 64) e << "threads must be in [1, 64]; ";
-  return e.str();
+  std::string e = rangeProblemsOf(*this);
+  if (min_step > max_step) e += "min_step: must be <= max_step; ";
+  return e;
 }
 
 std::vector<double> pixelBearings(const CameraModel& camera) {

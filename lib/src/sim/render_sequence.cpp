@@ -19,30 +19,9 @@ namespace celc {
 namespace fs = std::filesystem;
 namespace file = sequence_file;
 
-std::string ImuOptions::validate() const {
-  std::ostringstream e;
-  if (!(rate > 0.0) || !(rate <= 1e6)) e << "imu rate must be in (0, 1e6] Hz; ";
-  if (!(gyro_noise >= 0.0) || !(accel_noise >= 0.0) || !std::isfinite(gyro_noise) ||
-      !std::isfinite(accel_noise))
-    e << "imu noise densities must be >= 0; ";
-  if (!gyro_bias.allFinite() || !accel_bias.allFinite() || !gravity.allFinite())
-    e << "imu biases and gravity must be finite; ";
-  if (!R_cam_imu.allFinite() ||
-      (R_cam_imu.transpose() * R_cam_imu - Mat3::Identity()).norm() > 1e-6 ||
-      R_cam_imu.determinant() < 0.0)
-    e << "R_cam_imu must be a rotation matrix; ";
-  return e.str();
-}
+std::string ImuOptions::validate() const { return rangeProblemsOf(*this); }
 
-std::string GroundTruthOptions::validate() const {
-  std::ostringstream e;
-  if (!(rate > 0.0) || !(rate <= 1e6)) e << "groundtruth rate must be in (0, 1e6] Hz; ";
-  if (!T_body_cam.R.allFinite() || !T_body_cam.p.allFinite() ||
-      (T_body_cam.R.transpose() * T_body_cam.R - Mat3::Identity()).norm() > 1e-6 ||
-      T_body_cam.R.determinant() < 0.0)
-    e << "T_body_cam must be a rigid transform; ";
-  return e.str();
-}
+std::string GroundTruthOptions::validate() const { return rangeProblemsOf(*this); }
 
 std::string SynthConfig::validate() const {
   std::string e;
@@ -60,8 +39,8 @@ std::string SynthConfig::validate() const {
   if (!t.empty()) e += "trajectory: " + t;
   const std::string r = events.validate();
   if (!r.empty()) e += "events: " + r;
-  e += imu.validate();
-  e += groundtruth.validate();
+  e += inSection("imu", imu.validate());
+  e += inSection("groundtruth", groundtruth.validate());
   return e;
 }
 

@@ -99,43 +99,45 @@ void describeTrajectory(FieldVisitor& v, TrajectorySpec& t) {
     if (const std::string err = t.validate(); !err.empty()) v.fail("", err);
 }
 
-void describeEvents(FieldVisitor& v, RenderOptions& o) {
-  v.field({"contrast_on", "log I", "ON threshold C+"}, o.contrast_on);
-  v.field({"contrast_off", "log I", "OFF threshold C-"}, o.contrast_off);
-  v.field({"contrast_sigma", "log I", "per-pixel threshold mismatch, std"}, o.contrast_sigma);
-  v.field({"refractory", "s", "refractory period (0 = off)"}, o.refractory);
-  v.field({"noise_rate", "Hz", "background events per pixel, <= 1000"}, o.noise_rate);
-  v.field({"log_eps", "-", "eps in L = log(eps + I)"}, o.log_eps);
-  v.field({"max_step_px", "px", "largest image motion per render step"}, o.max_step_px);
-  v.field({"max_step", "s", "largest render step"}, o.max_step);
-  v.field({"min_step", "s", "smallest render step"}, o.min_step);
-  v.field({"smoothing_px", "px", "width of the anti-aliasing ramp across edges"}, o.smoothing_px);
+}  // namespace
+
+void describe(FieldVisitor& v, RenderOptions& o) {
+  v.field({"contrast_on", "log I", "ON threshold C+", above(0)}, o.contrast_on);
+  v.field({"contrast_off", "log I", "OFF threshold C-", above(0)}, o.contrast_off);
+  v.field({"contrast_sigma", "log I", "per-pixel threshold mismatch, std", atLeast(0)}, o.contrast_sigma);
+  v.field({"refractory", "s", "refractory period (0 = off)", withinBelow(0, 10)}, o.refractory);
+  v.field({"noise_rate", "Hz", "background events per pixel, <= 1000", within(0, 1000)}, o.noise_rate);
+  v.field({"log_eps", "-", "eps in L = log(eps + I)", above(0)}, o.log_eps);
+  v.field({"max_step_px", "px", "largest image motion per render step", above(0)}, o.max_step_px);
+  v.field({"max_step", "s", "largest render step", above(0)}, o.max_step);
+  v.field({"min_step", "s", "smallest render step", above(0)}, o.min_step);
+  v.field({"smoothing_px", "px", "width of the anti-aliasing ramp across edges", withinAbove(0, 100)},
+          o.smoothing_px);
   v.field({"skip_static", "", "skip render steps where nothing moves"}, o.skip_static);
-  v.field({"threads", "", "worker threads, [1, 64]"}, o.threads);
-  if (o.threads < 1 || o.threads > 64) v.fail("threads", "must be in [1, 64]");
+  v.field({"threads", "", "worker threads, [1, 64]", within(1, 64)}, o.threads);
   if (v.reading())
     if (const std::string err = o.validate(); !err.empty()) v.fail("", err);
 }
 
-void describeImu(FieldVisitor& v, ImuOptions& o) {
-  v.field({"rate", "Hz", "sample rate"}, o.rate);
-  v.field({"gyro_noise", "rad/s/sqrt(Hz)", "gyro white-noise density"}, o.gyro_noise);
-  v.field({"gyro_bias", "rad/s", "constant gyro bias"}, o.gyro_bias);
-  v.field({"accel_noise", "m/s^2/sqrt(Hz)", "accelerometer white-noise density"}, o.accel_noise);
-  v.field({"accel_bias", "m/s^2", "constant accelerometer bias"}, o.accel_bias);
+void describe(FieldVisitor& v, ImuOptions& o) {
+  v.field({"rate", "Hz", "sample rate", withinAbove(0, 1e6)}, o.rate);
+  v.field({"gyro_noise", "rad/s/sqrt(Hz)", "gyro white-noise density", atLeast(0)}, o.gyro_noise);
+  v.field({"gyro_bias", "rad/s", "constant gyro bias", anyFinite()}, o.gyro_bias);
+  v.field({"accel_noise", "m/s^2/sqrt(Hz)", "accelerometer white-noise density", atLeast(0)}, o.accel_noise);
+  v.field({"accel_bias", "m/s^2", "constant accelerometer bias", anyFinite()}, o.accel_bias);
   const Mat3 transposed = o.R_cam_imu.transpose();  // its column-major storage is row-major R
   std::vector<double> R(transposed.data(), transposed.data() + 9);
   v.field({"R_cam_imu", "-", "rotation IMU -> camera, row-major 3x3"}, R, {9});
   const Mat3 read = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R.data());
   if (!isRotation(read)) v.fail("R_cam_imu", "must be a rotation matrix (row-major 3x3)");
   o.R_cam_imu = read;
-  v.field({"gravity", "m/s^2", "gravity in the world frame"}, o.gravity);
+  v.field({"gravity", "m/s^2", "gravity in the world frame", anyFinite()}, o.gravity);
   if (v.reading())
     if (const std::string err = o.validate(); !err.empty()) v.fail("", err);
 }
 
-void describeGroundTruth(FieldVisitor& v, GroundTruthOptions& o) {
-  v.field({"rate", "Hz", "pose rate"}, o.rate);
+void describe(FieldVisitor& v, GroundTruthOptions& o) {
+  v.field({"rate", "Hz", "pose rate", withinAbove(0, 1e6)}, o.rate);
   Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>::Identity();
   T.topLeftCorner<3, 3>() = o.T_body_cam.R;
   T.topRightCorner<3, 1>() = o.T_body_cam.p;
@@ -150,8 +152,6 @@ void describeGroundTruth(FieldVisitor& v, GroundTruthOptions& o) {
     if (const std::string err = o.validate(); !err.empty()) v.fail("", err);
 }
 
-}  // namespace
-
 void describe(FieldVisitor& v, SynthConfig& c) {
   v.field({"seed", "", "seed of the textures, thresholds and noise"}, c.seed);
   v.field({"duration", "s", "length of the sequence, (0, 3600]"}, c.duration);
@@ -163,9 +163,9 @@ void describe(FieldVisitor& v, SynthConfig& c) {
   v.items({"planes", "", "textured planes of the scene (1 to 16)"}, c.planes, describePlane);
   if (c.planes.empty() || c.planes.size() > 16) v.fail("planes", "expected a non-empty list of at most 16 planes");
   v.section({"trajectory", "", "the camera's motion"}, [&](FieldVisitor& s) { describeTrajectory(s, c.trajectory); });
-  v.section({"events", "", "the event model"}, [&](FieldVisitor& s) { describeEvents(s, c.events); });
-  v.section({"imu", "", "the simulated IMU"}, [&](FieldVisitor& s) { describeImu(s, c.imu); });
-  v.section({"groundtruth", "", "the pose file"}, [&](FieldVisitor& s) { describeGroundTruth(s, c.groundtruth); });
+  v.section({"events", "", "the event model"}, [&](FieldVisitor& s) { describe(s, c.events); });
+  v.section({"imu", "", "the simulated IMU"}, [&](FieldVisitor& s) { describe(s, c.imu); });
+  v.section({"groundtruth", "", "the pose file"}, [&](FieldVisitor& s) { describe(s, c.groundtruth); });
 }
 
 namespace {

@@ -217,7 +217,7 @@ AccStarts accStarts(JointProblem& problem, const SolverResult& ml, const MlEnd& 
     s.from_ml.m1 = ml_end.m1;
     s.from_ml.m3 = ml_end.m3;
     s.states.push_back(s.from_ml);
-    problem.setHuber(ml_end.huber_px);
+    problem.setLoss(RobustLoss::huber(ml_end.huber_px));
   }
   if (linear) s.states.push_back(problem.start(linear->head<3>(), linear->tail<3>()));
   if (!s.handed) s.states.push_back(problem.start(ml.v));
@@ -244,7 +244,7 @@ JointProblem::Result screenAccStarts(JointProblem& problem, const AccStarts& sta
       threshold_set = true;
       const double scaled = options.ml.huber_scale * problem.robustScale(r.state);
       if (scaled > options.refine.huber_px) {
-        problem.setHuber(scaled);
+        problem.setLoss(RobustLoss::huber(scaled));
         r = problem.refine(r.state, screen_iterations, tolerance);
         if (!r.ok) continue;
       }

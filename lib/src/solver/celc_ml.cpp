@@ -212,7 +212,7 @@ std::vector<End> screenStarts(JointProblem& problem, const std::vector<Start>& s
     if (options.ml.huber_scale > 0.0 && ends.empty()) {
       const double scaled = options.ml.huber_scale * problem.robustScale(r.state);
       if (scaled > options.refine.huber_px) {
-        problem.setHuber(scaled);
+        problem.setLoss(RobustLoss::huber(scaled));
         JointProblem::Result again = problem.refine(r.state, s.start_iterations, s.tolerance, s.stride);
         if (!again.ok) continue;
         r = std::move(again);
@@ -361,10 +361,10 @@ JointProblem::Result redescend(JointProblem& problem, JointProblem::Result best,
                                const MlOptions& ml) {
   if (!(ml.cauchy_scale > 0.0)) return best;
   const ResidualSpread spread = problem.spread(best.state);
-  const bool tukey = ml.tukey_scale > 0.0;
-  const double scale_px = spread.cauchyScale(tukey ? ml.tukey_scale : ml.cauchy_scale, ml.cauchy_min_tail);
-  if (!(scale_px > 0.0)) return best;
-  problem.setLoss(tukey ? JointProblem::Loss::Tukey : JointProblem::Loss::Cauchy, scale_px);
+  const RobustLoss loss = redescendingLoss(ml.cauchy_scale, ml.tukey_scale,
+                                           [&](double k) { return spread.cauchyScale(k, ml.cauchy_min_tail); });
+  if (loss.type == RobustLoss::Type::None) return best;
+  problem.setLoss(loss);
   JointProblem::Result r = problem.refine(best.state, s.iterations, s.tolerance, 1);
   return r.ok ? r : best;
 }
@@ -442,7 +442,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
 
   // ml.rate_offset: the rest runs with the gyro shifted where the events ask for it.
   const std::unique_ptr<ShiftedWindow> shift =
-      rateShift(obs, motion, best.result.state.v, options, event_seed, problem.lossScale());
+      rateShift(obs, motion, best.result.state.v, options, event_seed, problem.loss().scale);
   JointProblem* active = &problem;
   std::string rate_note;
   if (shift) {
@@ -454,7 +454,7 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
       rate_note = rateOffsetNote(shift->fit);
     }
   }
-  if (end && !shift) *end = MlEnd{best.result.state.m1, best.result.state.m3, active->lossScale(), true};
+  if (end && !shift) *end = MlEnd{best.result.state.m1, best.result.state.m3, active->loss().scale, true};
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.result.cost / std::max(1, best.result.events));
   best.result = redescend(*active, std::move(best.result), schedule, options.ml);

@@ -14,17 +14,15 @@ namespace {
 constexpr size_t L = PackedRows::kLanes;
 using LaneSums = double[12][L];
 
-enum class Weights { Plain, Huber, Tukey };
-
 // One pass over n rows (a multiple of L) stored as columns c (stride s; a,
 // then R rows of N). Row b + l of each block b adds to lane l's sums: the
 // weight w (Huber's or Tukey's of r = a.v / |N v| at the threshold thr, over
-// |N v|^2; or 1 when Plain), then w a a^T and w N^T N.
-template <int R, Weights kWeights>
+// |N v|^2; or 1 without a loss), then w a a^T and w N^T N.
+template <int R, RobustLoss::Type kWeights>
 CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double* v, double thr,
                      LaneSums& out) {
   LaneSums acc = {};  // local: nothing the loop stores aliases the columns it reads
-  constexpr bool kPlain = kWeights == Weights::Plain;
+  constexpr bool kPlain = kWeights == RobustLoss::Type::None;
   const double v0 = kPlain ? 0.0 : v[0], v1 = kPlain ? 0.0 : v[1], v2 = kPlain ? 0.0 : v[2];
   const double thr2 = thr * thr;
   for (size_t b = 0; b < n; b += L) {
@@ -45,7 +43,7 @@ CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double
           g2 += u * u;
         }
         const double d2 = d * d;
-        if (kWeights == Weights::Tukey) {
+        if (kWeights == RobustLoss::Type::Tukey) {
           // (1 - r^2 / thr^2)^2 / g2 for |r| < thr, else 0.
           const double q = 1.0 - d2 / (thr2 * g2);
           w = g2 > 0.0 && q > 0.0 ? q * q / g2 : 0.0;
@@ -75,14 +73,14 @@ CELC_PASS_INLINE void sumsPass(const double* c, size_t n, size_t s, const double
 }
 
 // Every pass (R rows of N kept; plain, Huber or Tukey weights).
-CELC_ISA_CLONES void sums(int R, Weights weights, const double* c, size_t n, size_t s, const double* v,
+CELC_ISA_CLONES void sums(int R, RobustLoss::Type weights, const double* c, size_t n, size_t s, const double* v,
                           double thr, LaneSums& out) {
-  if (R == 2 && weights == Weights::Plain) sumsPass<2, Weights::Plain>(c, n, s, v, thr, out);
-  if (R == 2 && weights == Weights::Huber) sumsPass<2, Weights::Huber>(c, n, s, v, thr, out);
-  if (R == 2 && weights == Weights::Tukey) sumsPass<2, Weights::Tukey>(c, n, s, v, thr, out);
-  if (R == 3 && weights == Weights::Plain) sumsPass<3, Weights::Plain>(c, n, s, v, thr, out);
-  if (R == 3 && weights == Weights::Huber) sumsPass<3, Weights::Huber>(c, n, s, v, thr, out);
-  if (R == 3 && weights == Weights::Tukey) sumsPass<3, Weights::Tukey>(c, n, s, v, thr, out);
+  if (R == 2 && weights == RobustLoss::Type::None) sumsPass<2, RobustLoss::Type::None>(c, n, s, v, thr, out);
+  if (R == 2 && weights == RobustLoss::Type::Huber) sumsPass<2, RobustLoss::Type::Huber>(c, n, s, v, thr, out);
+  if (R == 2 && weights == RobustLoss::Type::Tukey) sumsPass<2, RobustLoss::Type::Tukey>(c, n, s, v, thr, out);
+  if (R == 3 && weights == RobustLoss::Type::None) sumsPass<3, RobustLoss::Type::None>(c, n, s, v, thr, out);
+  if (R == 3 && weights == RobustLoss::Type::Huber) sumsPass<3, RobustLoss::Type::Huber>(c, n, s, v, thr, out);
+  if (R == 3 && weights == RobustLoss::Type::Tukey) sumsPass<3, RobustLoss::Type::Tukey>(c, n, s, v, thr, out);
 }
 
 // r2_k = (a_k.v)^2 / |N_k v|^2 (r2_degenerate where |N_k v| = 0) over m rows
@@ -297,7 +295,7 @@ void PackedRows::sealWithoutSample() {
   const size_t columns = 3 + 3 * static_cast<size_t>(normal_rows_);
   for (size_t j = 0; j < columns; ++j) std::fill(c + j * stride_ + n_, c + j * stride_ + padded_, 0.0);
   LaneSums plain;
-  sums(normal_rows_, Weights::Plain, c, padded_, stride_, nullptr, 0.0, plain);
+  sums(normal_rows_, RobustLoss::Type::None, c, padded_, stride_, nullptr, 0.0, plain);
   plain_sums_ = laneTotals(plain);
 }
 
@@ -332,17 +330,10 @@ void PackedRows::squaredResiduals(const Vec3& v, double r_degenerate, std::vecto
     squaredResiduals3(data_.get(), n_, stride_, vv, r2_degenerate, r2.data());
 }
 
-PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr) {
+PackedSums weightedSums(const PackedRows& rows, const Vec3& v, const RobustLoss& loss) {
   const double vv[3] = {v.x(), v.y(), v.z()};
   LaneSums acc;
-  sums(rows.normalRows(), Weights::Huber, rows.data(), rows.paddedSize(), rows.stride(), vv, thr, acc);
-  return laneTotals(acc);
-}
-
-PackedSums tukeyWeightedSums(const PackedRows& rows, const Vec3& v, double thr) {
-  const double vv[3] = {v.x(), v.y(), v.z()};
-  LaneSums acc;
-  sums(rows.normalRows(), Weights::Tukey, rows.data(), rows.paddedSize(), rows.stride(), vv, thr, acc);
+  sums(rows.normalRows(), loss.type, rows.data(), rows.paddedSize(), rows.stride(), vv, loss.scale, acc);
   return laneTotals(acc);
 }
 

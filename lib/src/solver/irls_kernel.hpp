@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "constraint_rows.hpp"
+#include "robust_loss.hpp"
 
 namespace celc::detail {
 
@@ -81,16 +82,16 @@ class PackedRows {
   std::shared_ptr<const PackedRows> sample_;  // null when every row is sampled
 };
 
-/// Sums with the Huber weight over |N_i v|^2,
-///   w_i = min(1, thr / |r_i|) / |N_i v|^2 = min(1 / g2, thr / sqrt(d^2 g2)),
-/// with r_i = d / sqrt(g2) the geometric residual (d = a_i.v, g2 = |N_i v|^2);
-/// rows with |N_i v| = 0 get no weight. One fused pass over the columns in
-/// blocks of kLanes rows: lane l of every block adds to its own partial sums
-/// (rows l, l + kLanes, ...), and the lanes' sums are added in lane order, so
-/// the result does not depend on how the compiler vectorises the lanes.
-PackedSums huberWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
-/// The same with Tukey's biweight: w_i = (1 - r_i^2 / thr^2)^2 / |N_i v|^2 for
-/// |r_i| < thr, else 0 (a row beyond thr has no influence at all).
-PackedSums tukeyWeightedSums(const PackedRows& rows, const Vec3& v, double thr);
+/// Sums with the IRLS weights of `loss` (Huber or Tukey; its scale thr on the
+/// geometric residual r_i = d / sqrt(g2), d = a_i.v, g2 = |N_i v|^2) over
+/// |N_i v|^2: Huber's w_i = min(1, thr / |r_i|) / g2 = min(1 / g2, thr /
+/// sqrt(d^2 g2)); Tukey's w_i = (1 - r_i^2 / thr^2)^2 / g2 for |r_i| < thr,
+/// else 0 (a row beyond thr has no influence at all); without a loss
+/// (Type::None) w_i = 1. Rows with |N_i v| = 0 get no weight. One fused pass
+/// over the columns in blocks of kLanes rows: lane l of every block adds to
+/// its own partial sums (rows l, l + kLanes, ...), and the lanes' sums are
+/// added in lane order, so the result does not depend on how the compiler
+/// vectorises the lanes. loss.type is Huber, Tukey or None.
+PackedSums weightedSums(const PackedRows& rows, const Vec3& v, const RobustLoss& loss);
 
 }  // namespace celc::detail

@@ -127,41 +127,13 @@ CELC_PASS_INLINE Distance distance(const double* c, size_t s, size_t i, const do
   return out;
 }
 
-// The loss's square-root residual r of a distance d and its slope dr/dd.
-struct LossRoot {
-  double r, slope;
-};
-template <JointLossKind kLoss>
-CELC_PASS_INLINE LossRoot lossRoot(double d, double scale) {
-  LossRoot out;
-  if (kLoss == JointLossKind::Huber) {
-    // sqrtHuber: r = d inside the threshold, sign(d) sqrt(2 delta |d| - delta^2) beyond.
-    const double a = std::abs(d);
-    const bool inside = a <= scale;
-    const double root = std::sqrt(inside ? 1.0 : 2.0 * scale * a - scale * scale);
-    out.slope = inside ? 1.0 : scale / root;
-    out.r = inside ? d : (d < 0.0 ? -root : root);
-  } else if (kLoss == JointLossKind::Cauchy) {
-    const double q = d / scale;
-    out.slope = 1.0 / std::sqrt(1.0 + q * q);
-    out.r = out.slope * d;
-  } else {
-    // Tukey's biweight by reweighting: sqrt(w) = 1 - q^2 inside, 0 beyond.
-    const double q = d / scale;
-    const double t = 1.0 - q * q;
-    out.slope = t > 0.0 ? t : 0.0;
-    out.r = out.slope * d;
-  }
-  return out;
-}
-
 // The sums of jointBlockSums (in its order: V, bv, U, W, bc) over the
 // events begin .. begin + count - 1, in blocks of kLanes events whose lanes
 // the compiler forms together, each lane with its own accumulators. Values
 // stay in locals returned by value: through pointers (output arguments, a
 // struct's arrays, a lambda holding the index by reference) the compiler
 // kept them in memory per lane and the loop ran scalar.
-template <JointLossKind kLoss>
+template <RobustLoss::Type kLoss>
 CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t count,
                                 const double* v, const double* m1, const double* m3, const double* Bv,
                                 const double* B1, const double* B3, double focal, double scale,
@@ -181,7 +153,7 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
       const Distance e = distance<true>(c, s, i, v, m1, m3, focal);
       const double d = e.d;
       const bool ok = e.ok;
-      const LossRoot root = lossRoot<kLoss>(d, scale);
+      const ReweightedRoot root = reweighted<kLoss>(d, scale);
       const double r = root.r, slope = root.slope;
       const bool use = in & ok & std::isfinite(d);
       const double w = use ? slope : 0.0, rr = use ? r : 0.0;
@@ -218,24 +190,24 @@ CELC_PASS_INLINE void blockSums(const double* c, size_t s, size_t begin, size_t 
 CELC_ISA_CLONES void blockSumsTukey(const double* c, size_t s, size_t begin, size_t count, const double* v,
                                     const double* m1, const double* m3, const double* Bv, const double* B1,
                                     const double* B3, double focal, double scale, double* out) {
-  blockSums<JointLossKind::Tukey>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
+  blockSums<RobustLoss::Type::Tukey>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 
 CELC_ISA_CLONES void blockSumsHuber(const double* c, size_t s, size_t begin, size_t count, const double* v,
                                     const double* m1, const double* m3, const double* Bv, const double* B1,
                                     const double* B3, double focal, double scale, double* out) {
-  blockSums<JointLossKind::Huber>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
+  blockSums<RobustLoss::Type::Huber>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 CELC_ISA_CLONES void blockSumsCauchy(const double* c, size_t s, size_t begin, size_t count, const double* v,
                                      const double* m1, const double* m3, const double* Bv, const double* B1,
                                      const double* B3, double focal, double scale, double* out) {
-  blockSums<JointLossKind::Cauchy>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
+  blockSums<RobustLoss::Type::Cauchy>(c, s, begin, count, v, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 
 // The sums of jointAccelerationSums (G, bg, U, W, bc), laid out as
 // blockSums' with the global block g = (v's tangent, a) of 5.
 constexpr int kAccelerationSums = 15 + 5 + 10 + 20 + 4;
-template <JointLossKind kLoss>
+template <RobustLoss::Type kLoss>
 CELC_PASS_INLINE void accelerationSums(const double* c, size_t s, size_t begin, size_t count, const double* v,
                                        const double* a, const double* m1, const double* m3, const double* Bv,
                                        const double* B1, const double* B3, double focal, double scale,
@@ -249,7 +221,7 @@ CELC_PASS_INLINE void accelerationSums(const double* c, size_t s, size_t begin, 
       const size_t i = begin + b + l;
       const bool in = b + l < count;
       const Distance e = distance<true, true>(c, s, i, v, m1, m3, focal, av);
-      const LossRoot root = lossRoot<kLoss>(e.d, scale);
+      const ReweightedRoot root = reweighted<kLoss>(e.d, scale);
       const bool use = in & e.ok & std::isfinite(e.d);
       const double w = use ? root.slope : 0.0, rr = use ? root.r : 0.0;
       double jg[5], jc[4];
@@ -294,19 +266,19 @@ CELC_ISA_CLONES void accelerationSumsHuber(const double* c, size_t s, size_t beg
                                            const double* a, const double* m1, const double* m3, const double* Bv,
                                            const double* B1, const double* B3, double focal, double scale,
                                            double* out) {
-  accelerationSums<JointLossKind::Huber>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
+  accelerationSums<RobustLoss::Type::Huber>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 CELC_ISA_CLONES void accelerationSumsCauchy(const double* c, size_t s, size_t begin, size_t count,
                                             const double* v, const double* a, const double* m1, const double* m3,
                                             const double* Bv, const double* B1, const double* B3, double focal,
                                             double scale, double* out) {
-  accelerationSums<JointLossKind::Cauchy>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
+  accelerationSums<RobustLoss::Type::Cauchy>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 CELC_ISA_CLONES void accelerationSumsTukey(const double* c, size_t s, size_t begin, size_t count, const double* v,
                                            const double* a, const double* m1, const double* m3, const double* Bv,
                                            const double* B1, const double* B3, double focal, double scale,
                                            double* out) {
-  accelerationSums<JointLossKind::Tukey>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
+  accelerationSums<RobustLoss::Type::Tukey>(c, s, begin, count, v, a, m1, m3, Bv, B1, B3, focal, scale, out);
 }
 
 // sum rho(d) over the events begin .. begin + count - 1, and the number of
@@ -364,15 +336,15 @@ CELC_ISA_CLONES void distancesAcceleration(const double* c, size_t s, size_t beg
 
 JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, const Vec3& v,
                               const Vec3& m1, const Vec3& m3, const double* Bv,
-                              const double* B1, const double* B3, double focal, JointLossKind loss,
-                              double scale) {
+                              const double* B1, const double* B3, double focal, const RobustLoss& loss) {
+  const double scale = loss.scale;
   double total[kSums];
   const double vv[3] = {v.x(), v.y(), v.z()}, a1[3] = {m1.x(), m1.y(), m1.z()},
                a3[3] = {m3.x(), m3.y(), m3.z()};
   const size_t count = end > begin ? end - begin : 0;
-  if (loss == JointLossKind::Huber)
+  if (loss.type == RobustLoss::Type::Huber)
     blockSumsHuber(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
-  else if (loss == JointLossKind::Cauchy)
+  else if (loss.type == RobustLoss::Type::Cauchy)
     blockSumsCauchy(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
   else
     blockSumsTukey(columns.data(), columns.stride(), begin, count, vv, a1, a3, Bv, B1, B3, focal, scale, total);
@@ -388,16 +360,17 @@ JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t 
 JointAccelerationSums jointAccelerationSums(const JointColumns& columns, size_t begin, size_t end,
                                             const Vec3& v, const Vec3& a, const Vec3& m1, const Vec3& m3,
                                             const double* Bv, const double* B1, const double* B3, double focal,
-                                            JointLossKind loss, double scale) {
+                                            const RobustLoss& loss) {
+  const double scale = loss.scale;
   double total[kAccelerationSums];
   const double vv[3] = {v.x(), v.y(), v.z()}, aa[3] = {a.x(), a.y(), a.z()}, a1[3] = {m1.x(), m1.y(), m1.z()},
                a3[3] = {m3.x(), m3.y(), m3.z()};
   const size_t count = end > begin ? end - begin : 0;
   const double* c = columns.data();
   const size_t s = columns.stride();
-  if (loss == JointLossKind::Huber)
+  if (loss.type == RobustLoss::Type::Huber)
     accelerationSumsHuber(c, s, begin, count, vv, aa, a1, a3, Bv, B1, B3, focal, scale, total);
-  else if (loss == JointLossKind::Cauchy)
+  else if (loss.type == RobustLoss::Type::Cauchy)
     accelerationSumsCauchy(c, s, begin, count, vv, aa, a1, a3, Bv, B1, B3, focal, scale, total);
   else
     accelerationSumsTukey(c, s, begin, count, vv, aa, a1, a3, Bv, B1, B3, focal, scale, total);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "celc/solver/celc_residual.hpp"
+#include "robust_loss.hpp"
 
 namespace celc::detail {
 
@@ -43,15 +44,12 @@ class JointColumns {
   std::vector<double> data_;
 };
 
-/// The loss of a pass: Huber with threshold `scale` [px], or the Cauchy loss
-/// or Tukey's biweight with scale c [px] by iteratively reweighted steps
-/// (weights frozen at the point of linearisation: r = d / sqrt(1 + d^2 / c^2),
-/// r = (1 - d^2 / c^2) d within c and 0 beyond).
-enum class JointLossKind { Huber, Cauchy, Tukey };
-
 /// One cluster's Gauss-Newton sums at (v, m1, m3) over the events
 /// begin .. end - 1 of the columns: with d the event distance [px]
-/// (eventDistance), r the loss's square-root residual, dr/dd its slope, and
+/// (eventDistance), r the loss's residual in the reweighted form
+/// (robust_loss.hpp: Huber's square root, Cauchy's and Tukey's with the
+/// weights frozen at the point of linearisation; scale in px), dr/dd its
+/// slope, and
 /// the tangent bases Bv, B1, B3 (3 x 2, column-major), jv = slope Bv^T dd/dv
 /// and jc = slope (B1^T dd/dm1, B3^T dd/dm3):
 ///   V = sum jv jv^T (xx, xy, yy), bv = sum jv r,
@@ -63,7 +61,7 @@ struct JointBlockSums {
 };
 JointBlockSums jointBlockSums(const JointColumns& columns, size_t begin, size_t end, const Vec3& v,
                               const Vec3& m1, const Vec3& m3, const double* Bv, const double* B1,
-                              const double* B3, double focal, JointLossKind loss, double scale);
+                              const double* B3, double focal, const RobustLoss& loss);
 
 /// The same sums with a constant acceleration a (columns with the
 /// acceleration's): the camera's position P(t) v + q(t) a, so that
@@ -77,7 +75,7 @@ struct JointAccelerationSums {
 JointAccelerationSums jointAccelerationSums(const JointColumns& columns, size_t begin, size_t end,
                                             const Vec3& v, const Vec3& a, const Vec3& m1, const Vec3& m3,
                                             const double* Bv, const double* B1, const double* B3, double focal,
-                                            JointLossKind loss, double scale);
+                                            const RobustLoss& loss);
 
 /// sum of the Huber rho(d) = d^2 (|d| <= delta), 2 delta |d| - delta^2
 /// (beyond) over the same events; +inf when a distance is not finite. With

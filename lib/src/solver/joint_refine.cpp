@@ -42,7 +42,7 @@ bool near(const JointProblem::State& a, const JointProblem::State& b, double min
 JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& motion,
                            const WindowFrames& frames, int max_events, bool balance_clusters,
                            std::uint64_t event_seed, double huber_px, bool acceleration)
-    : acceleration_(acceleration), focal_(obs.focal_px), scale_(huber_px) {
+    : acceleration_(acceleration), focal_(obs.focal_px), loss_(RobustLoss::huber(huber_px)) {
   const double t_ref = motion.referenceTime();
   auto q = [t_ref](double t) { return 0.5 * (t - t_ref) * (t - t_ref); };
   const std::vector<int>& usable = frames.clusters();
@@ -91,34 +91,6 @@ JointProblem::~JointProblem() {
 
 size_t JointProblem::events() const { return terms_.size(); }
 
-double JointProblem::rho(double d) const {
-  if (loss_ == Loss::Tukey) {
-    const double q = d / scale_, t = std::max(0.0, 1.0 - q * q);
-    return scale_ * scale_ / 3.0 * (1.0 - t * t * t);
-  }
-  if (loss_ == Loss::Cauchy) {
-    const double q = d / scale_;
-    return scale_ * scale_ * std::log1p(q * q);
-  }
-  double slope;
-  const double r = sqrtHuber(d, scale_, &slope);
-  return r * r;
-}
-
-double JointProblem::weighted(double d, double* slope) const {
-  if (loss_ == Loss::Tukey) {
-    const double q = d / scale_;
-    *slope = std::max(0.0, 1.0 - q * q);
-    return *slope * d;
-  }
-  if (loss_ == Loss::Cauchy) {
-    const double q = d / scale_;
-    *slope = 1.0 / std::sqrt(1.0 + q * q);
-    return *slope * d;
-  }
-  return sqrtHuber(d, scale_, slope);
-}
-
 ResidualSpread JointProblem::spread(const State& s) const {
   if (!acceleration_) {
     std::vector<double> d;
@@ -145,11 +117,11 @@ JointProblem::State JointProblem::start(const Vec3& v, const Vec3& a) const {
 
 double JointProblem::cost(const State& s, int stride) const {
   double total = 0.0;
-  if (loss_ == Loss::Huber) {
+  if (loss_.type == RobustLoss::Type::Huber) {
     const JointColumns& cols = columns(stride);
     for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
-      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_, scale_,
-                              acceleration_ ? &s.a : nullptr);
+      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
+                              loss_.scale, acceleration_ ? &s.a : nullptr);
     return 0.5 * total;  // +inf when a distance is not finite
   }
   const JointColumns& cols = columns(stride);
@@ -159,7 +131,7 @@ double JointProblem::cost(const State& s, int stride) const {
                    distances_.data() + column_begin_[c], acceleration_ ? &s.a : nullptr);
   for (double d : distances_) {
     if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
-    total += rho(d);
+    total += loss_.rho(d);
   }
   return 0.5 * total;
 }
@@ -167,9 +139,6 @@ double JointProblem::cost(const State& s, int stride) const {
 template <int G>
 void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen::Matrix<double, G, G>& V,
                              Eigen::Matrix<double, G, 1>& bv, std::vector<ClusterBlocks<G>>& blocks) const {
-  const JointLossKind loss = loss_ == Loss::Huber    ? JointLossKind::Huber
-                             : loss_ == Loss::Cauchy ? JointLossKind::Cauchy
-                                                     : JointLossKind::Tukey;
   const JointColumns& cols = columns(stride);
   V.setZero();
   bv.setZero();
@@ -184,11 +153,11 @@ void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen:
     JointAccelerationSums ba;
     if constexpr (G == 2) {
       b = jointBlockSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], Bv.data(),
-                         k.B1.data(), k.B3.data(), focal_, loss, scale_);
+                         k.B1.data(), k.B3.data(), focal_, loss_);
       sum_v = b.V, sum_bv = b.bv, sum_u = b.U, sum_w = b.W, sum_bc = b.bc;
     } else {
       ba = jointAccelerationSums(cols, column_begin_[c], column_begin_[c + 1], s.v, s.a, s.m1[c], s.m3[c],
-                                 Bv.data(), k.B1.data(), k.B3.data(), focal_, loss, scale_);
+                                 Bv.data(), k.B1.data(), k.B3.data(), focal_, loss_);
       sum_v = ba.G, sum_bv = ba.bg, sum_u = ba.U, sum_w = ba.W, sum_bc = ba.bc;
     }
     for (int i = 0, n = 0; i < G; ++i)
@@ -296,7 +265,7 @@ JointProblem::Result JointProblem::refineSteps(State s, int max_iterations, doub
   State trial = s;
   for (int it = 0; it < max_iterations; ++it) {
     out.iterations = it + 1;
-    // Linearise: the Gauss-Newton blocks of r = sqrtHuber(d) at s (Huber),
+    // Linearise: the Gauss-Newton blocks of Huber's r = sqrt(rho(d)) at s,
     // or of r = sqrt(w(d_s)) d with the weights frozen at s (Cauchy: IRLS).
     // The global block: v's tangent, then (G = 5) the acceleration.
     const Mat32 Bv = tangentBasis(s.v);

@@ -7,7 +7,8 @@
 // a 4x4 block per cluster (the tangents of m1 and m3) and their coupling,
 // so one step costs O(events) and a 2x2 solve. The same cost as the Ceres
 // refinement (refine.hpp), without its per-problem set-up; or, after
-// setLoss(Cauchy / Tukey), that cost by iteratively reweighted steps.
+// setLoss() with Cauchy's or Tukey's loss, that cost by iteratively
+// reweighted steps (robust_loss.hpp).
 #include <cstdint>
 #include <vector>
 
@@ -82,21 +83,12 @@ class JointProblem {
   /// The spread of the residuals at s (sampling.hpp).
   ResidualSpread spread(const State& s) const;
   double robustScale(const State& s) const;  ///< spread(s).scale
-  /// The loss of the cost: Huber with threshold scale [px] (sum of Huber
-  /// rho(d^2)), or Cauchy with scale c [px], rho = c^2 log(1 + d^2 / c^2),
-  /// a redescending loss: an event far from its cluster's line (another
-  /// edge's) pulls ~c^2 / d instead of Huber's constant c; or Tukey's
-  /// biweight with scale c [px], rho = c^2 / 3 (1 - (1 - d^2 / c^2)^3)
-  /// within c and c^2 / 3 beyond: an event beyond c does not pull at all.
-  /// Cauchy and Tukey are minimised by reweighted steps (weights frozen at
-  /// the point of linearisation).
-  enum class Loss { Huber, Cauchy, Tukey };
-  void setLoss(Loss loss, double scale_px) {
-    loss_ = loss;
-    scale_ = scale_px;
-  }
-  void setHuber(double huber_px) { setLoss(Loss::Huber, huber_px); }
-  double lossScale() const { return scale_; }  ///< the loss's threshold or scale [px]
+  /// The loss of the cost (robust_loss.hpp; scale in px): Huber's at first
+  /// (huber_px); Cauchy's, whose far events (another edge's) pull ~c^2 / d
+  /// instead of Huber's constant c, or Tukey's, whose events beyond c do not
+  /// pull at all, minimised by reweighted steps.
+  void setLoss(const RobustLoss& loss) { loss_ = loss; }
+  const RobustLoss& loss() const { return loss_; }
 
  private:
   /// Per cluster: the Gauss-Newton blocks at a state, the tangent bases of
@@ -147,13 +139,10 @@ class JointProblem {
   mutable std::vector<size_t> column_begin_;
   mutable int column_stride_ = 0;
   const JointColumns& columns(int stride) const;
-  mutable std::vector<double> distances_;  // cost()'s under a Cauchy loss, per event
+  mutable std::vector<double> distances_;  // cost()'s under a loss other than Huber's, per event
   std::vector<Vec3> m1_, m3_;                  // fitted lines (frames), unit
-  /// rho(d) (twice the event's cost) and the IRLS residual r with dr/dd.
-  double rho(double d) const;
-  double weighted(double d, double* slope) const;
-  double focal_, scale_;
-  Loss loss_ = Loss::Huber;
+  double focal_;
+  RobustLoss loss_;
 };
 
 }  // namespace celc::detail

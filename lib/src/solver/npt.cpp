@@ -17,16 +17,6 @@ std::string toString(NptLineNormalisation normalisation) {
   return normalisation == NptLineNormalisation::Vector ? "vector" : "moment";
 }
 
-std::string NptOptions::validate() const {
-  std::ostringstream e;
-  if (min_line_events < 5) e << "min_line_events must be >= 5; ";
-  if (min_lines < 2) e << "min_lines must be >= 2; ";
-  if (!(min_line_sigma_ratio >= 0.0 && min_line_sigma_ratio < 1.0))
-    e << "min_line_sigma_ratio must be in [0, 1); ";
-  if (!(max_sigma_ratio > 0.0 && max_sigma_ratio <= 1.0)) e << "max_sigma_ratio must be in (0, 1]; ";
-  return e.str();
-}
-
 namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;

@@ -159,19 +159,14 @@ int redescendingSolve(ceres::Problem& problem, const ceres::Solver::Options& so,
     for (size_t k = begin[c]; k < begin[c + 1]; ++k)
       d.push_back(eventDistance(terms[k], vh, m1[c], m3[c], focal_px, nullptr, nullptr, nullptr));
   const ResidualSpread spread = residualSpread(std::move(d));
-  const double cauchy_px = spread.cauchyScale(opt.cauchy_scale, opt.cauchy_min_tail);
-  if (!(cauchy_px > 0.0)) return 0;
-  const double tukey_px = opt.tukey_scale > 0.0 ? spread.cauchyScale(opt.tukey_scale, opt.cauchy_min_tail) : 0.0;
-  for (EventChunkCost* cost : costs) {
-    if (tukey_px > 0.0)
-      cost->setTukey(tukey_px);
-    else
-      cost->setCauchy(cauchy_px);
-  }
-  ceres::Solver::Summary cauchy;
-  ceres::Solve(so, &problem, &cauchy);
-  if (!cauchy.IsSolutionUsable() || !v.allFinite()) v = huber_v;
-  return static_cast<int>(cauchy.iterations.size());
+  const RobustLoss loss = redescendingLoss(opt.cauchy_scale, opt.tukey_scale,
+                                           [&](double k) { return spread.cauchyScale(k, opt.cauchy_min_tail); });
+  if (loss.type == RobustLoss::Type::None) return 0;
+  for (EventChunkCost* cost : costs) cost->setLoss(loss);
+  ceres::Solver::Summary last;
+  ceres::Solve(so, &problem, &last);
+  if (!last.IsSolutionUsable() || !v.allFinite()) v = huber_v;
+  return static_cast<int>(last.iterations.size());
 }
 
 }  // namespace

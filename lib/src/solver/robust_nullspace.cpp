@@ -162,7 +162,7 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
     // fixed scale): one fixed-point map, and no MAD per pass.
     if (!tukey || it == huber_iterations) scale = sampledMad(P, v, 0.0, sample, band, median_r2);
     const double thr = (tukey ? opt.tukey_k : opt.huber_k) * std::max(scale, 1e-15);
-    const PackedSums s = tukey ? tukeyWeightedSums(P, v, thr) : huberWeightedSums(P, v, thr);
+    const PackedSums s = weightedSums(P, v, tukey ? RobustLoss::tukey(thr) : RobustLoss::huber(thr));
     const Mat3 Ma = unpack(s.data()), Mn = unpack(s.data() + 6);
     if (!generalizedEigen3(Ma, Mn, lambda, X)) {
       if (tukey) break;  // no row within Tukey's threshold: keep the Huber end point

@@ -16,11 +16,11 @@ namespace celc {
 /// `celc simulate` configuration: the scene, the solvers and the study.
 struct SimulateConfig {
   LineSceneOptions scene;
-  /// The library's solver defaults with an empty model-error budget: the
-  /// simulated calibration is exact, and each trial's own gyro error
-  /// (scene.omega_noise) is added to gyro_bias_rad_s (runSweep).
+  /// The paper's preset (SolverOptions::paper()) with an empty model-error
+  /// budget: the simulated calibration is exact, and each trial's own gyro
+  /// error (scene.omega_noise) is added to gyro_bias_rad_s (runSweep).
   SolverOptions solver = [] {
-    SolverOptions s;
+    SolverOptions s = SolverOptions::paper();
     s.uncertainty.clearBudget();
     return s;
   }();

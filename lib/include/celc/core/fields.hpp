@@ -7,7 +7,9 @@
 /// the comments of the shipped config/*.yaml files and the round-trip tests
 /// are visitors over that one declaration (config/yaml_schema.hpp).
 #include <cstdint>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -28,12 +30,47 @@ struct ConfigError : std::runtime_error {
   std::string key;     ///< dotted key, e.g. "solver.linear.huber_k"
 };
 
+/// The valid values of a numeric field: from min to max, either end
+/// excluded when open, infinite ends unbounded. A range that checks at all
+/// (a finite end, or `finite`) also needs a finite value; the default range
+/// holds every value.
+struct Range {
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_open = false;  ///< min itself is not valid
+  bool max_open = false;  ///< max itself is not valid
+  bool finite = false;    ///< without finite ends: any finite value
+  /// Whether the range constrains the value at all.
+  bool checks() const { return finite || std::isfinite(min) || std::isfinite(max); }
+  /// Whether `x` is valid: always when the range does not check; else finite and within.
+  bool contains(double x) const;
+  /// ">= 0", "> 0", "<= 1", "in [0, 1)", "finite"; "" when the range does not check.
+  std::string text() const;
+};
+/// x and above.
+inline Range atLeast(double x) { return {x, std::numeric_limits<double>::infinity(), false, false, false}; }
+/// Above x, x excluded.
+inline Range above(double x) { return {x, std::numeric_limits<double>::infinity(), true, false, false}; }
+/// [lo, hi].
+inline Range within(double lo, double hi) { return {lo, hi, false, false, false}; }
+/// [lo, hi), hi excluded.
+inline Range withinBelow(double lo, double hi) { return {lo, hi, false, true, false}; }
+/// (lo, hi], lo excluded.
+inline Range withinAbove(double lo, double hi) { return {lo, hi, true, false, false}; }
+/// Any finite value.
+inline Range anyFinite() {
+  return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), false, false, true};
+}
+
 /// What a field is: its key (one YAML map key), unit ("" when none; "-" for
-/// dimensionless ratios) and a one-line doc.
+/// dimensionless ratios), a one-line doc and its valid range (numbers; a
+/// list's every element). Choices are given where a field is visited
+/// (FieldVisitor::choice).
 struct FieldInfo {
   const char* key;
   const char* unit;
   const char* doc;
+  Range range = {};
 };
 
 /// Visits the fields of an options struct. A reader writes the members, a
@@ -123,5 +160,23 @@ class FieldVisitor {
 
 /// A whole configuration's describe function.
 using Describe = std::function<void(FieldVisitor&)>;
+
+/// The fields `describe` visits whose values lie outside their ranges, as
+/// "key: must be >= 0, got -1; " per field (dotted keys below the struct, in
+/// schema order); "" when every value is valid. The generated part of every
+/// validate().
+std::string rangeProblems(const Describe& describe);
+
+/// rangeProblems of one options struct, through its describe() (found by
+/// argument-dependent lookup) on a copy: `options` is only read.
+template <class Options>
+std::string rangeProblemsOf(const Options& options) {
+  Options copy = options;
+  return rangeProblems(Describe([&](FieldVisitor& v) { describe(v, copy); }));
+}
+
+/// "key: what; key: what; " of one section's validate() with "section." put
+/// before every key.
+std::string inSection(const std::string& section, const std::string& problems);
 
 }  // namespace celc

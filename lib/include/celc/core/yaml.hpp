@@ -46,6 +46,7 @@ struct FieldEntry {
   std::string doc;
   std::string value;  ///< YAML text, exactly as writeYaml writes it
   std::vector<std::string> choices;  ///< the allowed names of an enumeration (empty otherwise)
+  std::string range;  ///< the valid numbers, Range::text() ("" when any)
 };
 /// Every field `describe` visits, in order, with its value: to compare two
 /// configurations field by field or to list the schema.

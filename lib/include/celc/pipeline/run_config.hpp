@@ -78,35 +78,8 @@ struct RunConfig {
   GyroWindowOptions gyro;
   ClusterOptions cluster;
   ObservationOptions observations;
-  /// The solvers' defaults, except the global starts: on clustered real or
-  /// rendered events the linear stage's robust cost and the joint refinement
-  /// both have local minima that a single start falls into; and a larger
-  /// event budget for celc_ml, whose recorded windows hold 10^4-10^6 events,
-  /// with its three lowest screened basins refined to convergence; and
-  /// Tukey's biweight in the linear stage and in celc_opt's and celc_ml's
-  /// last refinements, for clusters that hold a few per cent of another
-  /// edge's events; and celc_opt started from celc on 4 random row subsets,
-  /// its lowest cost kept; and celc_ml's answer kept in front of the camera
-  /// (docs/method.md, "celc_ml's event budget", "celc_ml's finalists", "The
-  /// linear stage's Tukey stage", "celc_opt's starts", "celc_ml's last
-  /// refinement under Tukey's biweight", "celc_ml's answer in front of the
-  /// camera").
-  SolverOptions solver = [] {  // the pipeline's solver defaults (docs/simulation.md)
-    SolverOptions s;
-    s.linear.grid_directions = 256;
-    s.linear.grid_starts = 4;
-    s.linear.tukey_k = 3.0;
-    s.refine.tukey_scale = 3.0;
-    s.refine.starts = 4;
-    s.ml.grid_starts = 8;
-    s.ml.max_events = 40000;
-    s.ml.screen_events = 4000;
-    s.ml.finalists = 3;
-    s.ml.tukey_scale = 3.0;
-    s.ml.cheiral_min = 0.9;
-    s.uncertainty.cheiral_min = 0.9;
-    return s;
-  }();
+  /// The solvers' defaults (solver/options.hpp): the library's and the tool's are one.
+  SolverOptions solver;
   std::vector<Method> methods = defaultMethods();
   GtVelocityOptions groundtruth;
   std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)

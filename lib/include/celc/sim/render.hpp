@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/geometry/camera.hpp"
 #include "celc/sim/scene.hpp"
 #include "celc/sim/scene_trajectory.hpp"
@@ -57,6 +58,8 @@ struct RenderOptions {
   uint64_t seed = 1;             ///< thresholds and noise
   std::string validate() const;  ///< empty when valid
 };
+/// The schema of a scene's `events:` section (core/fields.hpp).
+void describe(FieldVisitor& v, RenderOptions& options);
 
 /// One simulated event: time [us], pixel, polarity and the scene edge that
 /// triggered it (-1: background noise).

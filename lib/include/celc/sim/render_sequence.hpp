@@ -51,6 +51,10 @@ struct GroundTruthOptions {
   std::string validate() const;
 };
 
+/// The schema of a scene's `imu:` and `groundtruth:` sections (core/fields.hpp).
+void describe(FieldVisitor& v, ImuOptions& options);
+void describe(FieldVisitor& v, GroundTruthOptions& options);
+
 /// Everything `celc synth` needs (one SCENE.yaml).
 struct SynthConfig {
   std::string source;  ///< the file it was read from

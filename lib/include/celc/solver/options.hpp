@@ -1,8 +1,10 @@
 #pragma once
 /// \file options.hpp
 /// Options of the solvers, one struct per stage, each with a validate() that
-/// returns what is wrong (empty when valid). Defaults are the pipeline's;
-/// docs/method.md gives the measurements behind them.
+/// returns what is wrong (empty when valid). The defaults are what `celc run`,
+/// `celc solve` and the Python module use; SolverOptions::paper() is the
+/// preset of the paper's and the peers' simulation studies. docs/method.md
+/// gives the measurements behind both.
 #include <cstdint>
 #include <string>
 
@@ -24,16 +26,17 @@ struct LinearOptions {
   /// weight. Huber keeps a bounded pull of every far row; on rendered
   /// clusters that hold a few per cent of another edge's events (at corners)
   /// those rows together move the direction far off (docs/method.md).
-  double tukey_k = 0.0;
+  double tukey_k = 3.0;
   /// Stop when the direction moves less than this [rad]; well below the
   /// direction error at realistic noise.
   double tolerance = 1e-3;
   /// Global start: the robust cost is scored on this many hemisphere
-  /// directions (0 = off) and IRLS also runs from the best grid_starts of them.
-  /// Off: the single start from the plain generalised eigenvector suffices on
-  /// the paper's scene, and the grid costs more than the rest of the solve.
-  int grid_directions = 0;
-  int grid_starts = 2;
+  /// directions (0 = off) and IRLS also runs from the best grid_starts of them:
+  /// on clustered real or rendered events the robust cost has local minima
+  /// that the single start from the plain generalised eigenvector falls into.
+  /// The paper's scene needs no grid (SolverOptions::paper()).
+  int grid_directions = 256;
+  int grid_starts = 4;
   int grid_rows = 200;           ///< rows used to score the grid
   int min_clusters = 2;          ///< fewer usable clusters -> degenerate
   int min_cluster_events = 5;    ///< a cluster needs this many events to be usable
@@ -90,13 +93,13 @@ struct RefineOptions {
   /// scales instead of the Cauchy loss: an event beyond has no pull at all,
   /// where under Cauchy many far events of other edges together still move v
   /// (docs/method.md). cauchy_scale = 0 still turns the last refinement off.
-  double tukey_scale = 0.0;       ///< [-]
+  double tukey_scale = 3.0;       ///< [-]
   /// celc_opt: starts of the refinement, the linear estimate on this many
   /// random row subsets (the first is celc's own; one within 1 deg of an
   /// earlier one is dropped). With several, each is refined under Huber on
   /// screen_events events, and the one with the lowest cost there is refined
   /// as a single start is.
-  int starts = 1;
+  int starts = 4;
   int screen_events = 1000;  ///< [events] (0 = max_events)
   std::string validate() const;
 };
@@ -149,17 +152,16 @@ struct MlOptions {
   /// Also start from this many directions of a hemisphere lattice (0 = off)
   /// and keep the end point of lowest robust cost; each start costs one joint
   /// refinement.
-  int grid_starts = 0;
+  int grid_starts = 8;
   /// Events of the joint problem: a seeded subset of about this many (0 =
-  /// all), drawn as refine.max_events draws celc_opt's. `celc run` draws
-  /// more (pipeline/run_config.hpp; docs/method.md, "celc_ml's event
-  /// budget").
-  int max_events = 5000;
+  /// all), drawn as refine.max_events draws celc_opt's; recorded windows hold
+  /// 10^4-10^6 events (docs/method.md, "celc_ml's event budget").
+  int max_events = 40000;
   /// With several starts, each is refined on every k-th event of the
   /// joint problem's subset, k chosen so that about this many are used, and
   /// only the lowest-cost end point on all (max_events) of them
   /// (0 = every start on all events).
-  int screen_events = 1000;
+  int screen_events = 4000;
   /// Also start from the lowest local minima of the line profile J(v), the
   /// algebraic event-line cost with every cluster's line eliminated in closed
   /// form (no fitted lines; docs/accuracy.md): J on a hemisphere lattice of
@@ -176,7 +178,7 @@ struct MlOptions {
   /// ... then the finalists, this many lowest end points of the starts,
   /// are each refined to convergence on all max_events events and the
   /// lowest converged cost wins (1 = the screen's winner alone).
-  int finalists = 1;
+  int finalists = 3;
   /// End points whose robust cost is within cheiral_tie units of the lowest,
   /// N (C - C_min) / C_min over the N events of the cost (a likelihood-ratio
   /// scale under Gaussian noise), are tied: among them the one whose
@@ -194,7 +196,7 @@ struct MlOptions {
   /// K (C - C_min) / C_min over the K clusters: a lead that the errors of a
   /// few impure clusters can make (docs/method.md, "celc_ml's answer in
   /// front of the camera"); 0 = off.
-  double cheiral_min = 0.0;       ///< [-] in [0, 1]
+  double cheiral_min = 0.9;       ///< [-] in [0, 1]
   double cheiral_clusters = 10.0;  ///< [-] clusters' share of the cost
   /// The Huber threshold of the joint cost becomes huber_scale times the
   /// robust scale (1.4826 MAD) of the residuals at the first start's end
@@ -220,7 +222,7 @@ struct MlOptions {
   /// pull at all, where under Cauchy many of them together still move v
   /// (docs/method.md, "celc_ml's last refinement under Tukey's biweight").
   /// cauchy_scale = 0 still turns the last refinement off.
-  double tukey_scale = 0.0;  ///< [-]
+  double tukey_scale = 3.0;  ///< [-]
   /// Also estimate a constant offset of the given angular velocity (a
   /// gyroscope bias) with v, kept where a likelihood-ratio test (p = 0.001)
   /// finds one (solver/rate_offset.hpp; docs/method.md): some 30-60 joint
@@ -268,7 +270,7 @@ struct UncertaintyOptions {
   /// 61.2 deg, the RMS angle of a random direction to a fixed one: the
   /// scene must lie in front of the camera, and such answers were measured
   /// wrong (docs/accuracy.md, "Answers behind the camera").
-  double cheiral_min = 0.0;  ///< [-] in [0, 1]
+  double cheiral_min = 0.9;  ///< [-] in [0, 1]
   int max_events = 2000;        ///< events used per window (regular stride; 0 = all)
   double scale_celc = 2.5;      ///< [-] factor for method celc
   double scale_celc_opt = 2.5;  ///< [-] for celc_opt
@@ -309,7 +311,22 @@ struct AccOptions {
   std::string validate() const;  ///< empty when valid
 };
 
+/// The options of every solver. The defaults suit clustered real or rendered
+/// events (`celc run`, `celc solve`, Python): global starts for the linear
+/// stage and the joint refinement, whose costs have local minima there; a
+/// large event budget for celc_ml, with its three lowest screened basins
+/// refined to convergence; Tukey's biweight in the linear stage and in
+/// celc_opt's and celc_ml's last refinements, for clusters that hold a few
+/// per cent of another edge's events; celc_opt started from celc on 4 random
+/// row subsets; celc_ml's answer kept in front of the camera (docs/method.md,
+/// "Library defaults and the paper's preset").
 struct SolverOptions {
+  /// The preset of the paper's simulation study (`celc simulate`) and the
+  /// peers' study: a single start, Huber losses, celc_ml on 5000 events, no
+  /// cheirality floor. Their scenes hold a few thousand clean events, where
+  /// the defaults' starts and redescending stages only cost time.
+  static SolverOptions paper();
+
   LinearOptions linear;
   RefineOptions refine;
   NptOptions npt;
