@@ -360,8 +360,10 @@ TEST(ConfigSchema, RangesOfTheSchemaValidate) {
   run.groundtruth.min_poses = 10;
   EXPECT_EQ(run.validate(),
             "motion.fixed_omega: every element must be finite, got nan; groundtruth.degree: must be in [1, 4], got 5");
-  EXPECT_EQ(RunConfig{}.validate(), "");
-  EXPECT_EQ(SimulateConfig{}.validate(), "");
+  const RunConfig run_defaults;
+  EXPECT_EQ(run_defaults.validate(), "");
+  const SimulateConfig simulate_defaults;
+  EXPECT_EQ(simulate_defaults.validate(), "");
   EXPECT_EQ(SolverOptions::paper().validate(), "");
 }
 
