@@ -31,7 +31,7 @@ std::vector<std::string> splitCsv(const std::string& line) {
 // The windows.csv lines as columns: text columns as str arrays, counts as
 // int64 (-1 where the cell is empty), the rest float64 (NaN where empty).
 pyb::dict columns(const std::vector<std::string>& lines) {
-  static const std::set<std::string> text{"method", "status", "reason", "sigma_rule"};
+  static const std::set<std::string> text{"method", "status", "reason", "sigma_rule", "model"};
   static const std::set<std::string> counts{"window",          "n_events", "n_clusters",    "n_lines",
                                             "impure_clusters", "edges",    "edges_complete"};
   const std::vector<std::string> names = splitCsv(windowsCsvHeader());

@@ -11,7 +11,9 @@ Per OUTDIR it writes
                        as points and lines, the others as x on the lower
                        edge), the ground truth dashed black, and a band of
                        +-sin(sigma_deg) around each component (clipped to
-                       [-1, 1]) where windows.csv has sigma_deg;
+                       [-1, 1]) where windows.csv has sigma_deg; an open
+                       square marks celc_acc's windows answered with the
+                       acceleration model (column model);
   OUTDIR/error.png     phi [deg] per window and method (log axis), the median
                        per method in the legend; only with ground truth (else
                        no error.png, and an old one is removed).
@@ -142,6 +144,9 @@ def plot_velocity(plt, outdir, name, rows):
         ok = [w for w in order if w in by_w and is_ok(by_w[w])]
         sig = sorted(num(by_w[w].get("sigma_deg")) for w in ok if not math.isnan(num(by_w[w].get("sigma_deg"))))
         title = "%s\nok %d of %d windows" % (label, len(ok), len(order))
+        n_acc = sum(1 for w in ok if by_w[w].get("model") == "acceleration")
+        if m == "celc_acc":
+            title += ", %d with acceleration" % n_acc
         if sig:
             title += ", median sigma %.3g deg" % statistics.median(sig)
         failed = {}
@@ -159,6 +164,12 @@ def plot_velocity(plt, outdir, name, rows):
             # NaN where not ok: the line breaks there, the markers show the ok windows.
             ys = [num(by_w[w][key]) if w in by_w and is_ok(by_w[w]) else float("nan") for w in order]
             ax.plot(times, ys, color=color, lw=1.0, marker="o", ms=ms, zorder=4)
+            # celc_acc's windows answered with the acceleration model: an open square.
+            acc_t = [t for w, t in zip(order, times) if w in by_w and by_w[w].get("model") == "acceleration"]
+            if acc_t:
+                ax.plot(acc_t, [num(by_w[w][key]) for w in order if w in by_w
+                                and by_w[w].get("model") == "acceleration"], "s", mfc="none",
+                        mec="k", ms=ms + 4, mew=1.0, zorder=6)
             band = [sigma_band(y, num(by_w[w].get("sigma_deg")) if w in by_w else float("nan"))
                     for w, y in zip(order, ys)]
             if any(not math.isnan(lo) for lo, _ in band):
@@ -184,14 +195,19 @@ def plot_velocity(plt, outdir, name, rows):
     labels = ["estimate (ok windows)", "window not ok",
               "+-sin(sigma_deg) per component, clipped to [-1, 1]" if "sigma_deg" in rows[0]
               else "no sigma_deg (windows.csv of the first format)"]
+    if any(r.get("model") == "acceleration" for r in rows):
+        handles.append(plt.Line2D([], [], color="k", marker="s", mfc="none", ms=8, lw=0))
+        labels.append("acceleration model chosen (celc_acc)")
     if with_gt:
         handles.append(plt.Line2D([], [], color="k", lw=1.4, ls="--"))
         labels.append("ground truth")
-    fig.legend(handles, labels, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
+    rows_of_legend = 1 if len(handles) <= 4 else 2
+    fig.legend(handles, labels, loc="lower center", ncol=-(-len(handles) // rows_of_legend), fontsize=9,
+               frameon=False)
     fig.suptitle("celc run %s: velocity direction per window, camera frame, estimates as written "
                  "(a sign flip mirrors all three)%s; t0 = %.6f s"
                  % (name, "" if with_gt else "; no ground truth", time_origin(rows)), fontsize=10)
-    fig.tight_layout(rect=(0, 0.045, 1, 1))
+    fig.tight_layout(rect=(0, 0.045 * rows_of_legend, 1, 1))
     save(fig, os.path.join(outdir, "velocity.png"))
     plt.close(fig)
 

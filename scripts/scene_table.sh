@@ -22,6 +22,7 @@ heldout=(
   "heldout_room_seed5_noise|e2e_davis346_room_fast|s/^seed: 1/seed: 5/;s/^duration: 0.41/duration: 0.6/;s/noise_rate: 0.1 /noise_rate: 1.0 /;s/v: \[3.2, -0.6, 2.4\]/v: [2.0, 0.4, 1.5]/"
   "heldout_handheld_seed7|handheld_fast_rotation|s/^seed: 3/seed: 7/;s/v: \[0.3, 0.1, 1.3\]/v: [0.6, -0.2, 1.0]/;s/w: \[0.4, -1.4, 0.6\]/w: [-0.8, 1.1, 0.3]/"
   "heldout_room_slow_rotating|e2e_davis346_room_fast|s/^seed: 1/seed: 9/;s/^duration: 0.41/duration: 0.8/;s/v: \[3.2, -0.6, 2.4\]/v: [1.2, 0.3, 0.9]/;s/w: \[0.1, -0.25, 0.15\]/w: [0.6, 0.9, -0.4]/"
+  "heldout_braking_room|accelerating_room|s/^seed: 11/seed: 12/;s/v: \[1.2, -0.2, 0.9\]/v: [1.6, -0.3, 1.2]/;s/acceleration: \[1.5, -0.3, 1.2\]/acceleration: [-1.5, 0.3, -1.2]/"
   "heldout_davis240_forward|davis240_rectangles|s/^seed: 2/seed: 6/;s/type: sinusoid /type: constant_twist /;s/v: \[0.4, 0.0, 0.1\]/v: [0.3, -0.2, 1.5]/;s/w: \[0.0, 0.0, 0.0\]/w: [0.3, 0.5, -0.2]/;/amplitude_v\|amplitude_w\|frequency/d"
 )
 scenes=()

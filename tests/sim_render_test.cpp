@@ -388,7 +388,11 @@ TEST(SimTrajectory, PoseDerivativesEqualTheTwist) {
   TrajectorySpec pw;
   pw.kind = TrajectoryKind::Piecewise;
   pw.segments = {{0.2, Vec3(1, 0, 0), Vec3(0, 0.5, 0)}, {0.3, Vec3(0, 1, 0.2), Vec3(0.2, 0, 0)}};
-  for (const TrajectorySpec& s : {sin, pw}) {
+  TrajectorySpec acc = twistSpec(Vec3(0.5, 0.0, 0.8), Vec3(0.4, -0.9, 0.3));
+  acc.kind = TrajectoryKind::ConstantAcceleration;
+  acc.acceleration = Vec3(1.5, -0.5, 2.0);
+  acc.initial.R = so3::exp(Vec3(0.2, 0.3, -0.1));
+  for (const TrajectorySpec& s : {sin, pw, acc}) {
     const Trajectory tr(s, 1.0);
     for (double t : {0.05, 0.13, 0.27, 0.44}) {
       const double h = 1e-5;
@@ -403,6 +407,27 @@ TEST(SimTrajectory, PoseDerivativesEqualTheTwist) {
     EXPECT_LT((a.p - b.p).norm(), 1e-8);
     EXPECT_LT((a.R - b.R).norm(), 1e-8);
   }
+}
+
+// A constant acceleration is world-fixed: the pose's second difference is
+// R0 a at every time, and linearVelocityRate is dv/dt of the camera-frame v.
+TEST(SimTrajectory, ConstantAccelerationIsFixedInTheWorld) {
+  TrajectorySpec s = twistSpec(Vec3(0.3, 0.1, 1.0), Vec3(0.5, 1.2, -0.4));
+  s.kind = TrajectoryKind::ConstantAcceleration;
+  s.acceleration = Vec3(-1.0, 2.0, 0.5);
+  s.initial.R = so3::exp(Vec3(-0.3, 0.1, 0.4));
+  const Trajectory tr(s, 1.0);
+  for (double t : {0.0, 0.21, 0.63}) {
+    const double h = 1e-3;
+    const Vec3 second = (tr.pose(t + h).p - 2.0 * tr.pose(t).p + tr.pose(t - h).p) / (h * h);
+    EXPECT_LT((second - s.initial.R * s.acceleration).norm(), 1e-6) << "t=" << t;
+    const Vec3 rate = (tr.linearVelocity(t + 1e-6) - tr.linearVelocity(t - 1e-6)) / 2e-6;
+    EXPECT_LT((rate - tr.linearVelocityRate(t)).norm(), 1e-6) << "t=" << t;
+  }
+  EXPECT_LT((tr.linearVelocity(0.0) - s.v).norm(), 1e-15);
+  EXPECT_EQ(parseTrajectoryKind("constant_acceleration"), TrajectoryKind::ConstantAcceleration);
+  s.acceleration.x() = NAN;
+  EXPECT_NE(s.validate().find("acceleration"), std::string::npos);
 }
 
 TEST(SimImu, GyroEqualsTheTwistInTheImuFrame) {

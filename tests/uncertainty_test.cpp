@@ -307,7 +307,13 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   deg.result.degeneracy = Degeneracy::NoParallax;
   deg.result.parallax = 1.1;
   deg.result.n_lines = 4;
-  rec.rows = {ok, deg};
+  MethodRow acc;
+  acc.method = Method::CelcAcc;
+  acc.result.status = SolveStatus::Ok;
+  acc.result.v = Vec3(0, 0, 1);
+  acc.result.acceleration = Vec3(0.5, -0.25, 0.125);
+  acc.result.acceleration_seen = true;
+  rec.rows = {ok, deg, acc};
   const fs::path d = test::freshTempDir("unc_csv");
   const std::string path = (d / "windows.csv").string();
   {
@@ -316,7 +322,12 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
     for (const auto& l : windowsCsvLines(rec)) f << l << "\n";
   }
   const auto rows = readWindowsCsv(path, false);
-  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].model, "");  // not celc_acc
+  EXPECT_FALSE(rows[0].has_acceleration);
+  EXPECT_EQ(rows[2].model, "acceleration");
+  ASSERT_TRUE(rows[2].has_acceleration);
+  EXPECT_NEAR((rows[2].acceleration - Vec3(0.5, -0.25, 0.125)).norm(), 0.0, 1e-6);
   EXPECT_EQ(rows[0].reason, "");
   EXPECT_DOUBLE_EQ(rows[0].sigma_deg, 2.5);
   EXPECT_DOUBLE_EQ(rows[0].parallax, 3.25);
@@ -341,7 +352,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(old_rows.size(), 1u);
   EXPECT_TRUE(std::isnan(old_rows[0].sigma_deg));
   EXPECT_EQ(old_rows[0].n_lines, -1);
-  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,," + ",,,,,,," + ",,,");
+  EXPECT_EQ(padWindowsCsvLine(old), old + ",,,,,,,," + ",,,,,,," + ",,," + ",,,,");
   // The second format (23 columns, before translation_px): read, padded by one.
   const std::string v2 = old + ",,2.5,3.25,4,0.1,-0.2,0.3";
   {
@@ -352,7 +363,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(v2_rows.size(), 1u);
   EXPECT_DOUBLE_EQ(v2_rows[0].sigma_deg, 2.5);
   EXPECT_TRUE(std::isnan(v2_rows[0].translation_px));
-  EXPECT_EQ(padWindowsCsvLine(v2), v2 + "," + ",,,,,,," + ",,,");
+  EXPECT_EQ(padWindowsCsvLine(v2), v2 + "," + ",,,,,,," + ",,," + ",,,,");
   // The third format (24 columns, before the truth columns): read, padded by seven.
   const std::string v3 = v2 + ",12.5";
   {
@@ -363,7 +374,7 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(v3_rows.size(), 1u);
   EXPECT_DOUBLE_EQ(v3_rows[0].translation_px, 12.5);
   EXPECT_FALSE(v3_rows[0].has_truth);
-  EXPECT_EQ(padWindowsCsvLine(v3), v3 + ",,,,,,," + ",,,");
+  EXPECT_EQ(padWindowsCsvLine(v3), v3 + ",,,,,,," + ",,," + ",,,,");
   // The fourth format (31 columns, before sigma_deg's parts): read, padded by three.
   const std::string v4 = v3 + ",0.99,1,4,3,0.95,0.01,0.02";
   {
@@ -374,7 +385,19 @@ TEST(Uncertainty, QualityColumnsRoundTripAndOldFilesRead) {
   ASSERT_EQ(v4_rows.size(), 1u);
   EXPECT_TRUE(v4_rows[0].has_truth);
   EXPECT_TRUE(std::isnan(v4_rows[0].sigma_fisher_deg));
-  EXPECT_EQ(padWindowsCsvLine(v4), v4 + ",,,");
+  EXPECT_EQ(padWindowsCsvLine(v4), v4 + ",,," + ",,,,");
+  // The fifth format (34 columns, before the motion model columns): read, padded by four.
+  const std::string v5 = v4 + ",1.5,2,disagreement";
+  {
+    std::ofstream f(path);
+    f << windowsCsvHeaderV5() << "\n" << v5 << "\n";
+  }
+  const auto v5_rows = readWindowsCsv(path, false);
+  ASSERT_EQ(v5_rows.size(), 1u);
+  EXPECT_EQ(v5_rows[0].sigma_rule, "disagreement");
+  EXPECT_EQ(v5_rows[0].model, "");
+  EXPECT_FALSE(v5_rows[0].has_acceleration);
+  EXPECT_EQ(padWindowsCsvLine(v5), v5 + ",,,,");
   // Summaries: NaN sigma is never kept.
   const auto s = summarize(old_rows, 5.0);
   EXPECT_EQ(s[0].ok, 1);

@@ -23,19 +23,22 @@ std::string windowsCsvHeaderV3() { return windowsCsvHeaderV2() + ",translation_p
 std::string windowsCsvHeaderV4() {
   return windowsCsvHeaderV3() + ",purity,impure_clusters,edges,edges_complete,coverage,noise_admitted,oracle_phi";
 }
-std::string windowsCsvHeader() { return windowsCsvHeaderV4() + ",sigma_fisher_deg,sigma_budget_deg,sigma_rule"; }
+std::string windowsCsvHeaderV5() { return windowsCsvHeaderV4() + ",sigma_fisher_deg,sigma_budget_deg,sigma_rule"; }
+std::string windowsCsvHeader() { return windowsCsvHeaderV5() + ",model,ax,ay,az"; }
 
 std::string padWindowsCsvLine(const std::string& line) {
   std::string l = line;
   if (!l.empty() && l.back() == '\r') l.pop_back();
   const auto commas = std::count(l.begin(), l.end(), ',');
-  if (l.empty() || (commas != 15 && commas != 22 && commas != 23 && commas != 30)) return line;
+  if (l.empty() || (commas != 15 && commas != 22 && commas != 23 && commas != 30 && commas != 33)) return line;
   const std::string truth = ",,,,,,,";  // the seven truth columns
   const std::string parts = ",,,";      // sigma_deg's three parts
-  return l + (commas == 15   ? ",,,,,,,," + truth + parts
-              : commas == 22 ? "," + truth + parts
-              : commas == 23 ? truth + parts
-                             : parts);
+  const std::string model = ",,,,";     // model,ax,ay,az
+  return l + (commas == 15   ? ",,,,,,,," + truth + parts + model
+              : commas == 22 ? "," + truth + parts + model
+              : commas == 23 ? truth + parts + model
+              : commas == 30 ? parts + model
+                             : model);
 }
 
 namespace {
@@ -78,7 +81,7 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     if (!l.empty() && l.back() == '\r') l.pop_back();
     const std::string where = path + ":" + std::to_string(no);
     if (no == 1) {
-      if (l != windowsCsvHeader() && l != windowsCsvHeaderV4() && l != windowsCsvHeaderV3() &&
+      if (l != windowsCsvHeader() && l != windowsCsvHeaderV5() && l != windowsCsvHeaderV4() && l != windowsCsvHeaderV3() &&
           l != windowsCsvHeaderV2() && l != windowsCsvHeaderV1())
         throw std::runtime_error(where + ": not a celc windows.csv header");
       continue;
@@ -87,8 +90,9 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
     const bool last = i + 1 == lines.size();
     const auto f = splitList(l, ',');
     try {
-      if (f.size() != 16 && f.size() != 23 && f.size() != 24 && f.size() != 31 && f.size() != 34)
-        throw std::runtime_error(where + ": expected 16, 23, 24, 31 or 34 columns, got " + std::to_string(f.size()));
+      if (f.size() != 16 && f.size() != 23 && f.size() != 24 && f.size() != 31 && f.size() != 34 &&
+          f.size() != 38)
+        throw std::runtime_error(where + ": expected 16, 23, 24, 31, 34 or 38 columns, got " + std::to_string(f.size()));
       WindowsCsvRow r;
       r.window = static_cast<std::int64_t>(toDouble(f[0], where, "window"));
       r.t_start = toDouble(f[1], where, "t_start");
@@ -129,10 +133,16 @@ std::vector<WindowsCsvRow> readWindowsCsv(const std::string& path, bool tolerate
         if (!f[29].empty()) r.noise_admitted = toDouble(f[29], where, "noise_admitted");
         if (!f[30].empty()) r.oracle_phi = toDouble(f[30], where, "oracle_phi");
       }
-      if (f.size() == 34) {
+      if (f.size() >= 34) {
         if (!f[31].empty()) r.sigma_fisher_deg = toDouble(f[31], where, "sigma_fisher_deg");
         if (!f[32].empty()) r.sigma_budget_deg = toDouble(f[32], where, "sigma_budget_deg");
         r.sigma_rule = f[33];
+      }
+      if (f.size() == 38) {
+        r.model = f[34];
+        r.has_acceleration = !f[35].empty();
+        if (r.has_acceleration)
+          r.acceleration = Vec3(toDouble(f[35], where, "ax"), toDouble(f[36], where, "ay"), toDouble(f[37], where, "az"));
       }
       rows.push_back(r);
     } catch (const std::runtime_error&) {

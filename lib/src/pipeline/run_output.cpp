@@ -85,6 +85,14 @@ std::vector<std::string> windowsCsvLines(const WindowRecord& rec) {
     o << ",";
     if (r.ok() && !std::isnan(r.sigma_budget_deg)) o << std::setprecision(4) << r.sigma_budget_deg;
     o << "," << (r.ok() ? r.sigma_rule : std::string());
+    // The motion model columns: model,ax,ay,az (celc_acc only).
+    o << ",";
+    if (row.method == Method::CelcAcc && r.ok()) o << (r.acceleration_seen ? "acceleration" : "constant_velocity");
+    if (row.method == Method::CelcAcc && r.ok() && r.acceleration.allFinite())
+      o << std::setprecision(6) << "," << r.acceleration.x() << "," << r.acceleration.y() << ","
+        << r.acceleration.z();
+    else
+      o << ",,,";
     lines.push_back(o.str());
   }
   return lines;

@@ -201,7 +201,8 @@ std::string twistYaml(const SynthConfig& c, const SynthSummary& s) {
     << "duration: " << num(c.duration) << "        # [s]\n"
     << "type: " << toString(t.kind) << "\n";
   if (t.kind != TrajectoryKind::Piecewise) {
-    y << "v: " << vec(t.v) << "     # [m/s]" << (t.kind == TrajectoryKind::Sinusoid ? " mean" : "")
+    y << "v: " << vec(t.v) << "     # [m/s]"
+      << (t.kind == TrajectoryKind::Sinusoid ? " mean" : t.kind == TrajectoryKind::ConstantAcceleration ? " at t = 0" : "")
       << "\n"
       << "w: " << vec(t.w) << "     # [rad/s]\n";
     if (t.kind == TrajectoryKind::ConstantTwist && t.v.norm() > 0.0)
@@ -211,6 +212,9 @@ std::string twistYaml(const SynthConfig& c, const SynthSummary& s) {
     y << "amplitude_v: " << vec(t.amplitude_v) << "   # v(t) = v + amplitude_v sin(2 pi f t)\n"
       << "amplitude_w: " << vec(t.amplitude_w) << "   # w(t) = w + amplitude_w sin(2 pi f t)\n"
       << "frequency: " << num(t.frequency) << "   # [Hz]\n";
+  if (t.kind == TrajectoryKind::ConstantAcceleration)
+    y << "acceleration: " << vec(t.acceleration)
+      << "   # [m/s^2], world-fixed, camera frame at t = 0: v(t) = exp(w^ t)^T (v + a t)\n";
   if (t.kind == TrajectoryKind::Piecewise) {
     y << "segments:\n";
     double t0 = 0.0;

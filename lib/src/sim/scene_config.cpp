@@ -71,7 +71,8 @@ void describePlane(FieldVisitor& v, PlaneSpec& s) {
 
 void describeTrajectory(FieldVisitor& v, TrajectorySpec& t) {
   v.enumeration({"type", "", "the camera's motion"}, t.kind,
-                {TrajectoryKind::ConstantTwist, TrajectoryKind::Piecewise, TrajectoryKind::Sinusoid});
+                {TrajectoryKind::ConstantTwist, TrajectoryKind::Piecewise, TrajectoryKind::Sinusoid,
+                  TrajectoryKind::ConstantAcceleration});
   v.field({"initial_position", "m", "camera position at t = 0 (world)"}, t.initial.p);
   Vec3 rotation = so3::log(t.initial.R);
   v.field({"initial_rotation", "rad", "axis-angle of the camera's orientation at t = 0"}, rotation);
@@ -87,7 +88,7 @@ void describeTrajectory(FieldVisitor& v, TrajectorySpec& t) {
             });
     if (v.reading() && t.segments.empty()) v.fail("segments", "expected a non-empty list");
   } else {
-    v.field({"v", "m/s", "linear velocity, camera frame (sinusoid: mean)"}, t.v);
+    v.field({"v", "m/s", "linear velocity, camera frame (sinusoid: mean; constant_acceleration: at t = 0)"}, t.v);
     v.field({"w", "rad/s", "angular velocity, camera frame (sinusoid: mean)"}, t.w);
   }
   if (t.kind == TrajectoryKind::Sinusoid) {
@@ -95,6 +96,8 @@ void describeTrajectory(FieldVisitor& v, TrajectorySpec& t) {
     v.field({"amplitude_w", "rad/s", "amplitude of w"}, t.amplitude_w);
     v.field({"frequency", "Hz", "frequency of both"}, t.frequency);
   }
+  if (t.kind == TrajectoryKind::ConstantAcceleration)
+    v.field({"acceleration", "m/s^2", "constant in the world, given in the camera frame at t = 0"}, t.acceleration);
   if (v.reading())
     if (const std::string err = t.validate(); !err.empty()) v.fail("", err);
 }

@@ -14,8 +14,9 @@ TrajectoryKind parseTrajectoryKind(const std::string& name) {
   if (name == "constant_twist") return TrajectoryKind::ConstantTwist;
   if (name == "piecewise") return TrajectoryKind::Piecewise;
   if (name == "sinusoid") return TrajectoryKind::Sinusoid;
+  if (name == "constant_acceleration") return TrajectoryKind::ConstantAcceleration;
   throw std::invalid_argument("unknown trajectory type '" + name +
-                              "' (expected constant_twist, piecewise or sinusoid)");
+                              "' (expected constant_twist, piecewise, sinusoid or constant_acceleration)");
 }
 
 std::string toString(TrajectoryKind kind) {
@@ -26,6 +27,8 @@ std::string toString(TrajectoryKind kind) {
       return "piecewise";
     case TrajectoryKind::Sinusoid:
       return "sinusoid";
+    case TrajectoryKind::ConstantAcceleration:
+      return "constant_acceleration";
   }
   return "constant_twist";
 }
@@ -45,6 +48,8 @@ std::string TrajectorySpec::validate() const {
     if (!amplitude_v.allFinite() || !amplitude_w.allFinite()) e << "amplitudes must be finite; ";
     if (!(frequency > 0.0) || !(frequency < 1e4)) e << "frequency must be in (0, 1e4) Hz; ";
   }
+  if (kind == TrajectoryKind::ConstantAcceleration && !acceleration.allFinite())
+    e << "acceleration must be finite; ";
   return e.str();
 }
 
@@ -102,6 +107,10 @@ RigidPose Trajectory::pose(double t) const {
       const double tm = t_k + 0.5 * tau;
       return knots_[k] * twistExp(linearVelocity(tm), angularVelocity(tm), tau);
     }
+    case TrajectoryKind::ConstantAcceleration: {
+      const RigidPose& T0 = spec_.initial;
+      return {T0.R * so3::exp(spec_.w * t), T0.p + T0.R * (spec_.v * t + 0.5 * t * t * spec_.acceleration)};
+    }
   }
   return spec_.initial;
 }
@@ -114,6 +123,8 @@ Vec3 Trajectory::linearVelocity(double t) const {
       return spec_.segments[segmentAt(t)].v;
     case TrajectoryKind::Sinusoid:
       return spec_.v + spec_.amplitude_v * std::sin(2.0 * M_PI * spec_.frequency * t);
+    case TrajectoryKind::ConstantAcceleration:
+      return so3::exp(spec_.w * t).transpose() * (spec_.v + spec_.acceleration * t);
   }
   return spec_.v;
 }
@@ -126,6 +137,8 @@ Vec3 Trajectory::angularVelocity(double t) const {
       return spec_.segments[segmentAt(t)].w;
     case TrajectoryKind::Sinusoid:
       return spec_.w + spec_.amplitude_w * std::sin(2.0 * M_PI * spec_.frequency * t);
+    case TrajectoryKind::ConstantAcceleration:
+      return spec_.w;
   }
   return spec_.w;
 }
@@ -136,11 +149,17 @@ double Trajectory::nextBreak(double t) const {
 }
 
 double Trajectory::smoothTime() const {
-  return spec_.kind == TrajectoryKind::Sinusoid ? 0.01 / spec_.frequency
-                                                : std::numeric_limits<double>::infinity();
+  if (spec_.kind == TrajectoryKind::Sinusoid) return 0.01 / spec_.frequency;
+  if (spec_.kind == TrajectoryKind::ConstantAcceleration && spec_.acceleration.norm() > 0.0)
+    return 0.01 * std::max(spec_.v.norm(), 0.05) / spec_.acceleration.norm();
+  return std::numeric_limits<double>::infinity();
 }
 
+/// Constant acceleration: d/dt of exp(w^ t)^T (v + a t) is
+/// exp(w^ t)^T a - w x v(t).
 Vec3 Trajectory::linearVelocityRate(double t) const {
+  if (spec_.kind == TrajectoryKind::ConstantAcceleration)
+    return so3::exp(spec_.w * t).transpose() * spec_.acceleration - spec_.w.cross(linearVelocity(t));
   if (spec_.kind != TrajectoryKind::Sinusoid) return Vec3::Zero();
   const double om = 2.0 * M_PI * spec_.frequency;
   return spec_.amplitude_v * om * std::cos(om * t);

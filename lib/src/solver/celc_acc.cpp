@@ -262,14 +262,28 @@ JointProblem::Result screenAccStarts(JointProblem& problem, const AccStarts& sta
   return best;
 }
 
-/// The end point's spread: the residuals' robust scale [px] as the noise's,
-/// the covariance of (v's tangent, a) with the lines eliminated (NaN where
-/// the information is singular) and a's largest std [1/s] (infinite there).
+/// The end point's spread: the residuals' robust scale [px] as the noise's;
+/// the covariance of (v's tangent, a) with the lines eliminated, from the
+/// Fisher information with independent events (cov) and from the clusters'
+/// scores (robust_cov, JointProblem::clusterRobustCovariance), NaN where
+/// singular; a's largest std [1/s] over both (infinite where cov is NaN);
+/// and the cluster-robust Wald statistic a^T robust_cov_aa^-1 a (NaN where
+/// robust_cov is).
 struct AccSpread {
   double scale = 0.0;
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(5, 5, NAN);
+  Eigen::MatrixXd robust_cov = Eigen::MatrixXd::Constant(5, 5, NAN);
   double sigma_a = INFINITY;
+  double robust_wald = NAN;
 };
+
+/// The largest standard deviation of a 3 x 3 covariance [its unit]; NaN
+/// where it is not finite.
+double largestStd(const Mat3& cov) {
+  if (!cov.allFinite()) return NAN;
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  return std::sqrt(std::max(0.0, es.eigenvalues()(2)));
+}
 
 /// The spread at s (AccSpread).
 AccSpread accelerationSpread(const JointProblem& problem, const JointProblem::State& s) {
@@ -280,9 +294,23 @@ AccSpread accelerationSpread(const JointProblem& problem, const JointProblem::St
   if (es.info() == Eigen::Success && es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(4), 1e-300)) {
     out.cov = out.scale * out.scale * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
               es.eigenvectors().transpose();
-    const Mat3 cov_a = out.cov.bottomRightCorner<3, 3>();
-    const Eigen::SelfAdjointEigenSolver<Mat3> ea(cov_a);
-    out.sigma_a = std::sqrt(std::max(0.0, ea.eigenvalues()(2)));
+    out.sigma_a = largestStd(out.cov.bottomRightCorner<3, 3>());
+  }
+  out.robust_cov = problem.clusterRobustCovariance(s);
+  const Mat3 robust_aa = out.robust_cov.bottomRightCorner<3, 3>();
+  const double robust_sigma_a = largestStd(robust_aa);
+  if (std::isfinite(robust_sigma_a)) out.sigma_a = std::max(out.sigma_a, robust_sigma_a);
+  if (robust_aa.allFinite()) {
+    // a^T C^-1 a over C's eigenvectors; a direction with no spread (noise-free
+    // clusters) and a part of a along it makes the statistic infinite.
+    const Eigen::SelfAdjointEigenSolver<Mat3> er(robust_aa);
+    const double tiny = 1e-15 * std::max(er.eigenvalues()(2), 1e-300);
+    out.robust_wald = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double along = er.eigenvectors().col(i).dot(s.a);
+      out.robust_wald += er.eigenvalues()(i) > tiny ? along * along / er.eigenvalues()(i)
+                                                    : (along != 0.0 ? INFINITY : 0.0);
+    }
   }
   return out;
 }
@@ -318,11 +346,16 @@ SolverResult acceleratingAnswer(const JointProblem::Result& best, const AccSprea
   result.iterations = best.iterations;
   result.rows_used = best.events;
   result.residual_px = spread.scale;
-  result.sigma_deg = std::sqrt(std::max(0.0, spread.cov.topLeftCorner<2, 2>().trace())) * 180.0 / M_PI;
+  // The larger of the Fisher and the cluster-robust spreads of v's tangent.
+  double var_v = spread.cov.topLeftCorner<2, 2>().trace();
+  const double robust_var_v = spread.robust_cov.topLeftCorner<2, 2>().trace();
+  if (std::isfinite(robust_var_v)) var_v = std::max(var_v, robust_var_v);
+  result.sigma_deg = std::sqrt(std::max(0.0, var_v)) * 180.0 / M_PI;
   if (!std::isfinite(result.sigma_deg)) result.sigma_deg = INFINITY;
   char text[240];
-  std::snprintf(text, sizeof text, "acceleration seen (likelihood ratio %.3g), |a|/|v| = %.3g 1/s", lr,
-                result.acceleration.norm());
+  std::snprintf(text, sizeof text,
+                "acceleration seen (likelihood ratio %.3g, cluster-robust Wald %.3g), |a|/|v| = %.3g 1/s", lr,
+                spread.robust_wald, result.acceleration.norm());
   result.message = text;
   return result;
 }
@@ -380,8 +413,13 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   }
   const double scale2 = std::max(spread.scale * spread.scale, 1e-300);
   const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / scale2 : INFINITY;
-  if (!(lr > acc.test_chi2)) {
-    std::snprintf(text, sizeof text, "no acceleration seen (likelihood ratio %.3g <= %g)", lr, acc.test_chi2);
+  // Seen only where both tests pass: the likelihood ratio (independent
+  // events) and the cluster-robust Wald statistic (clusters as samples;
+  // NaN with too few clusters, where the ratio decides alone).
+  if (!(lr > acc.test_chi2) || spread.robust_wald <= acc.test_chi2) {
+    std::snprintf(text, sizeof text,
+                  "no acceleration seen (likelihood ratio %.3g, cluster-robust Wald %.3g; both must exceed %g)", lr,
+                  spread.robust_wald, acc.test_chi2);
     SolverResult r = constantVelocity(ml, Degeneracy::None, text, before_us + microsecondsSince(start));
     r.acceleration = a_along_ml;
     return r;

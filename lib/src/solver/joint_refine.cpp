@@ -2,6 +2,7 @@
 #include "joint_refine.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -165,7 +166,8 @@ void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen:
         V(i, j) += sum_v[n];
         if (j != i) V(j, i) += sum_v[n];
       }
-    for (int i = 0; i < G; ++i) bv(i) += sum_bv[i];
+    for (int i = 0; i < G; ++i) k.bg(i) = sum_bv[i];
+    bv += k.bg;
     for (int i = 0, n = 0; i < 4; ++i)
       for (int j = i; j < 4; ++j, ++n) k.U(i, j) = k.U(j, i) = sum_u[n];
     for (int i = 0; i < G; ++i)
@@ -193,6 +195,38 @@ Eigen::MatrixXd JointProblem::information(const State& s) const {
     return 0.5 * (V + V.transpose());
   };
   return acceleration_ ? reduce(std::integral_constant<int, 5>{}) : reduce(std::integral_constant<int, 2>{});
+}
+
+Eigen::MatrixXd JointProblem::clusterRobustCovariance(const State& s) const {
+  const Mat32 Bv = tangentBasis(s.v);
+  auto sandwich = [&](auto g) -> Eigen::MatrixXd {
+    constexpr int G = decltype(g)::value;
+    const size_t K = begin_.size() - 1;
+    const Eigen::MatrixXd nan = Eigen::MatrixXd::Constant(G, G, NAN);
+    if (K <= static_cast<size_t>(G)) return nan;
+    std::vector<ClusterBlocks<G>> blocks(K);
+    Eigen::Matrix<double, G, G> V, B = Eigen::Matrix<double, G, G>::Zero();
+    Eigen::Matrix<double, G, 1> bv;
+    linearise<G>(s, 1, Bv, V, bv, blocks);
+    for (ClusterBlocks<G>& k : blocks) {
+      k.X.template leftCols<G>() = k.W.transpose();
+      k.X.col(G) = k.bc;
+      solveSpd4(k.U, k.X);
+      V.noalias() -= k.X.template leftCols<G>().transpose() * k.W.transpose();
+      // The efficient score: the gradient with the cluster's lines at their
+      // own optimum for the current global unknowns.
+      const Eigen::Matrix<double, G, 1> score = k.bg - k.X.template leftCols<G>().transpose() * k.bc;
+      if (score.allFinite()) B.noalias() += score * score.transpose();
+    }
+    const Eigen::Matrix<double, G, G> H = 0.5 * (V + V.transpose());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, G, G>> es(H);
+    if (es.info() != Eigen::Success || !(es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(G - 1), 1e-300)))
+      return nan;
+    const Eigen::Matrix<double, G, G> Hinv =
+        es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
+    return Hinv * B * Hinv * (static_cast<double>(K) / static_cast<double>(K - G));
+  };
+  return acceleration_ ? sandwich(std::integral_constant<int, 5>{}) : sandwich(std::integral_constant<int, 2>{});
 }
 
 JointProblem::Result JointProblem::refineConstantVelocity(State s, int max_iterations, double function_tolerance,

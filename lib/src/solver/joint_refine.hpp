@@ -76,6 +76,18 @@ class JointProblem {
   /// (tangentBasis(s.v)), with an acceleration 5 x 5, then a.
   Eigen::MatrixXd information(const State& s) const;
 
+  /// The cluster-robust (sandwich) covariance of the global unknowns at s
+  /// [unit^2, same order as information()]:
+  ///   H^-1 (sum_k g_k g_k^T) H^-1 K / (K - G),
+  /// H = information(s), g_k cluster k's gradient of the cost over the
+  /// global unknowns with its lines eliminated (g_k - W_k U_k^-1 b_k), K
+  /// clusters, G global unknowns. The events of one cluster share their
+  /// errors (the renderer's or the sensor's edge, the clustering), so the
+  /// clusters, not the events, are the independent samples; with
+  /// independent events of noise s it tends to s^2 H^-1. NaN where H is
+  /// singular or K <= G.
+  Eigen::MatrixXd clusterRobustCovariance(const State& s) const;
+
   /// Events in the problem.
   size_t events() const;
   /// Clusters in the problem.
@@ -98,6 +110,7 @@ class JointProblem {
     Eigen::Matrix4d U;
     Eigen::Matrix<double, G, 4> W;
     Eigen::Vector4d bc;
+    Eigen::Matrix<double, G, 1> bg;  ///< the cluster's part of the global gradient
     Eigen::Matrix<double, 3, 2> B1, B3;
     Eigen::Matrix<double, 4, G + 1> X;
   };

@@ -17,8 +17,11 @@ namespace celc {
 /// quality columns reason,sigma_deg,parallax,n_lines,wx,wy,wz,translation_px,
 /// then the truth columns purity,impure_clusters,edges,edges_complete,
 /// coverage,noise_admitted,oracle_phi, then sigma_deg's parts
-/// sigma_fisher_deg,sigma_budget_deg,sigma_rule (docs/running.md).
+/// sigma_fisher_deg,sigma_budget_deg,sigma_rule, then the motion model
+/// columns model,ax,ay,az (docs/running.md).
 std::string windowsCsvHeader();
+/// The header of files written without the motion model columns (still read).
+std::string windowsCsvHeaderV5();
 /// The header of files written without sigma_deg's parts (still read).
 std::string windowsCsvHeaderV4();
 /// The header of files written without the truth columns (still read).
@@ -27,8 +30,9 @@ std::string windowsCsvHeaderV3();
 std::string windowsCsvHeaderV2();
 /// The header of files written before the quality columns (still read).
 std::string windowsCsvHeaderV1();
-/// A row of an earlier format (16, 23, 24 or 31 columns) padded with empty
-/// quality, truth and sigma-part columns; other lines are returned as they are.
+/// A row of an earlier format (16, 23, 24, 31 or 34 columns) padded with
+/// empty quality, truth, sigma-part and model columns; other lines are
+/// returned as they are.
 std::string padWindowsCsvLine(const std::string& line);
 
 struct WindowsCsvRow {
@@ -46,6 +50,13 @@ struct WindowsCsvRow {
   double sigma_fisher_deg = NAN;  ///< its Fisher part (times the method's factor) [deg]
   double sigma_budget_deg = NAN;  ///< its model-error budget part [deg]
   std::string sigma_rule;         ///< the rule that raised it, empty when none
+  /// celc_acc's choice: "acceleration" or "constant_velocity"; empty for
+  /// the other methods and where it did not answer.
+  std::string model;
+  bool has_acceleration = false;
+  /// The fitted acceleration over the speed, a / |v| [1/s], reference frame
+  /// (celc_acc; also where the constant-velocity model was chosen).
+  Vec3 acceleration = Vec3::Zero();
   double parallax = NAN;        ///< the window's parallax ratio [-]; NaN: none
   int n_lines = -1;             ///< usable clusters; -1: none
   bool has_omega = false;

@@ -12,7 +12,11 @@
 ///    the last one continues after its end, the first one before 0;
 ///  - sinusoid: v(t) = v + A_v sin(2 pi f t), w(t) = w + A_w sin(2 pi f t),
 ///    integrated with the midpoint rule on a 0.1 ms grid (horizons up to 20 s;
-///    coarser beyond, at most 2e5 knots).
+///    coarser beyond, at most 2e5 knots);
+///  - constant acceleration: a constant w and a constant acceleration a
+///    [m/s^2] fixed in the world (given in the camera frame at t = 0):
+///    R = R0 exp(w^ t), p = p0 + R0 (v t + a t^2 / 2), so the camera-frame
+///    velocity is exp(w^ t)^T (v + a t); exact, for all t.
 #include <string>
 #include <vector>
 
@@ -20,8 +24,8 @@
 
 namespace celc {
 
-enum class TrajectoryKind { ConstantTwist, Piecewise, Sinusoid };
-/// "constant_twist" | "piecewise" | "sinusoid"; throws std::invalid_argument otherwise.
+enum class TrajectoryKind { ConstantTwist, Piecewise, Sinusoid, ConstantAcceleration };
+/// "constant_twist" | "piecewise" | "sinusoid" | "constant_acceleration"; throws std::invalid_argument otherwise.
 TrajectoryKind parseTrajectoryKind(const std::string& name);
 std::string toString(TrajectoryKind kind);
 
@@ -39,6 +43,7 @@ struct TrajectorySpec {
   Vec3 amplitude_v = Vec3::Zero();     ///< sinusoid [m/s]
   Vec3 amplitude_w = Vec3::Zero();     ///< sinusoid [rad/s]
   double frequency = 1.0;              ///< sinusoid [Hz]
+  Vec3 acceleration = Vec3::Zero();    ///< constant acceleration [m/s^2], camera frame at t = 0
   RigidPose initial;                   ///< T_world_cam(0)
   std::string validate() const;        ///< empty when valid
 };
@@ -55,7 +60,8 @@ class Trajectory {
   /// Piecewise: the first segment start after t (the twist jumps there); else +infinity.
   double nextBreak(double t) const;
   /// A time over which the twist changes little: 0.01 / frequency for the
-  /// sinusoid, +infinity otherwise [s].
+  /// sinusoid, 0.01 |v| / |a| (|v| at least 0.05 m/s) for a constant
+  /// acceleration, +infinity otherwise [s].
   double smoothTime() const;
 
  private:
