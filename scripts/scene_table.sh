@@ -35,8 +35,8 @@ done
 /usr/bin/python3 "$root/scripts/heldout_scenes.py" "$out/heldout" --count 16 > /dev/null
 for f in "$out"/heldout/*.yaml; do scenes+=("$(basename "$f" .yaml)|$f|"); done
 
-methods="celc celc_opt celc_ml ce3lc npt"
-printf '| scene | events | seconds | celc | celc_opt | celc_ml | ce3lc | npt |\n|---|---|---|---|---|---|---|---|\n'
+methods="celc celc_opt celc_ml ce3lc npt celc_acc"
+printf '| scene | events | seconds | celc | celc_opt | celc_ml | ce3lc | npt | celc_acc |\n|---|---|---|---|---|---|---|---|---|\n'
 for s in "${scenes[@]}"; do
   IFS='|' read -r name file edits <<<"$s"
   seq="$out/seq/$name"
@@ -71,17 +71,24 @@ for d in "$out"/run/*/; do
   printf '%s %s %s\n' "$d/windows.csv" "$(head -n 1 "$ev" | cut -d' ' -f1)" "$(tail -n 1 "$ev" | cut -d' ' -f1)" >>"$spans"
 done
 echo
-printf '| method | ok / windows | median phi [rad] | phi <= 0.05 | phi <= 0.1 | time within 0.1 rad |\n'
-printf '|---|---|---|---|---|---|\n'
+printf '| method | ok / windows | median phi [rad] | phi <= 0.05 | phi <= 0.1 | time within 0.1 rad | kept but wrong: all / hand-held |\n'
+printf '|---|---|---|---|---|---|---|\n'
 for m in $methods; do
   time_share=$(while read -r csv t_first t_last; do
       awk -F, -v m="$m" -v f="$t_first" -v l="$t_last" 'NR == 1 { print "span", l - f }
         $1 != "window" && $6 == m && $7 == "ok" && $15 != "" && $15 <= 0.1 {
           e = $3 < l ? $3 : l; print "in", e - $2 }' "$csv"
     done <"$spans" | awk '$1 == "span" { s += $2 } $1 == "in" { i += $2 } END { printf "%.3f", (s > 0 ? i / s : 0) }')
+  # Kept but wrong: ok windows with sigma_deg < 5 deg and phi > 0.1 rad; all
+  # scenes, then the hand-held ones (names with "hand").
+  kept_wrong=$(for d in "$out"/run/*/; do
+      awk -F, -v m="$m" -v hand="$(basename "$d" | grep -c hand)" '$1 != "window" && $6 == m && $7 == "ok" &&
+        $15 != "" && $18 != "" && $18 + 0 < 5 && $15 + 0 > 0.1 { n++; if (hand) h++ }
+        END { print n + 0, h + 0 }' "$d/windows.csv"
+    done | awk '{ n += $1; h += $2 } END { printf "%d / %d", n, h }')
   cat "$out"/run/*/windows.csv | awk -F, -v m="$m" '$1 != "window" && $6 == m { n++; if ($7 == "ok" && $15 != "") print $15 }
-    END { print "n", n }' | sort -g | awk -v m="$m" -v ts="$time_share" '
+    END { print "n", n }' | sort -g | awk -v m="$m" -v ts="$time_share" -v kw="$kept_wrong" '
     $1 == "n" { n = $2; next } { p[++k] = $1; if ($1 <= 0.05) a++; if ($1 <= 0.1) b++ }
     END { med = k ? (k % 2 ? p[(k + 1) / 2] : (p[k / 2] + p[k / 2 + 1]) / 2) : 0
-          printf "| %s | %d / %d | %.3f | %.2f | %.2f | %s |\n", m, k, n, med, k ? a / k : 0, k ? b / k : 0, ts }'
+          printf "| %s | %d / %d | %.3f | %.2f | %.2f | %s | %s |\n", m, k, n, med, k ? a / k : 0, k ? b / k : 0, ts, kw }'
 done

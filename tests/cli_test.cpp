@@ -206,8 +206,8 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
     return v;
   };
   const auto run = directions(out + "/windows.csv", true), alone = directions(solved, false);
-  ASSERT_EQ(run.size(), 5u);
-  ASSERT_EQ(alone.size(), 5u);
+  ASSERT_EQ(run.size(), 6u);
+  ASSERT_EQ(alone.size(), 6u);
   for (const auto& [method, v] : run) {
     ASSERT_TRUE(alone.count(method)) << method;
     EXPECT_LT(angleBetween(v, alone.at(method)), method == "ce3lc" ? 0.01 : 1e-6) << method;

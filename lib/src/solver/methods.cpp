@@ -25,6 +25,12 @@ const std::vector<Method>& defaultMethods() {
   return methods;
 }
 
+const std::vector<Method>& runMethods() {
+  static const std::vector<Method> methods{Method::Celc,  Method::CelcOpt, Method::CelcMl,
+                                           Method::Ce3lc, Method::Npt,     Method::CelcAcc};
+  return methods;
+}
+
 const std::vector<Method>& allMethods() {
   static const std::vector<Method> all{Method::Celc, Method::CelcOpt, Method::CelcMl,
                                        Method::Ce3lc, Method::Npt, Method::CelcAcc};

@@ -80,7 +80,7 @@ struct RunConfig {
   ObservationOptions observations;
   /// The solvers' defaults (solver/options.hpp): the library's and the tool's are one.
   SolverOptions solver;
-  std::vector<Method> methods = defaultMethods();
+  std::vector<Method> methods = runMethods();
   GtVelocityOptions groundtruth;
   std::uint64_t seed = 1;  ///< seeds the solvers' random row subsets (per window: seed + index)
   std::string validate() const;
