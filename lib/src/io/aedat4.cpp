@@ -275,7 +275,7 @@ class Aedat4Reader final : public EventReader {
       // The verifier checks the vector's length word to 4 bytes, not the 8
       // its structs' int64 time needs: each struct is read from a copy.
       fbs::PolarityEvent p;
-      std::memcpy(static_cast<void*>(&p), events_->Data() + sizeof(p) * cur_, sizeof(p));
+      std::memcpy(static_cast<void*>(&p), events_ + sizeof(p) * cur_, sizeof(p));
       const std::int64_t t = p.t_us();
       const std::int16_t x = p.x(), y = p.y();
       const bool on = p.on();
@@ -378,9 +378,10 @@ class Aedat4Reader final : public EventReader {
   /// Takes the decompressed packet in out_ (from byte `at`) as the current
   /// event packet; false when it holds no event. Throws FbError.
   bool loadEvents(std::uint64_t at) {
-    events_ = verifiedRoot<fbs::EventPacket>(out_.data(), out_.size(), "EVTS", FbKind::Packet)->events();
+    const auto* events = verifiedRoot<fbs::EventPacket>(out_.data(), out_.size(), "EVTS", FbKind::Packet)->events();
+    events_ = events ? events->Data() : nullptr;
     cur_ = 0;
-    count_ = events_ ? events_->size() : 0;
+    count_ = events ? events->size() : 0;
     pkt_byte_ = at;
     return count_ > 0;
   }
@@ -496,7 +497,7 @@ class Aedat4Reader final : public EventReader {
   std::vector<StreamInfo> streams_;
   int event_stream_ = -1, imu_stream_ = -1;
   std::vector<unsigned char> raw_, out_;
-  const flatbuffers::Vector<const fbs::PolarityEvent*>* events_ = nullptr;  ///< the current packet's, in out_
+  const unsigned char* events_ = nullptr;  ///< the current packet's fbs::PolarityEvent structs, in out_
   std::size_t cur_ = 0, count_ = 0;
   std::uint64_t pkt_byte_ = 0;
   bool table_loaded_ = false;
