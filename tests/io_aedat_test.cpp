@@ -354,13 +354,14 @@ TEST(IoAedatBad, Aedat4FlatbufferOffsetsChecked) {
   const std::uint32_t many = 0x10000000;
   std::memcpy(&v[payload + 36], &many, 4);
   celc::test::writeBytes(d.file("v.aedat4"), v);
-  EXPECT_IO_ERROR(celc::test::drain(d.file("v.aedat4")), "exceeds the buffer");
+  const std::string at = "byte " + std::to_string(payload - 8);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("v.aedat4")), at, "'EVTS' flatbuffer", "fails verification");
   // the root offset pointing outside
   std::string r = b;
   const std::uint32_t far = 0x00FFFFFF;
   std::memcpy(&r[payload + 4], &far, 4);
   celc::test::writeBytes(d.file("r.aedat4"), r);
-  EXPECT_IO_ERROR(celc::test::drain(d.file("r.aedat4")), "out of bounds");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("r.aedat4")), at, "fails verification");
   // a wrong identifier
   std::string i = b;
   i[payload + 8] = 'X';

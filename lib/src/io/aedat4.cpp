@@ -1,26 +1,28 @@
 // AEDAT 4.0 (DV): "#!AER-DAT4.0\r\n", an int32 size then the IOHeader flatbuffer
-// ("IOHE": 0 compression enum {0 none, 1 LZ4, 2 LZ4 high, 3 Zstd, 4 Zstd high},
-// 1 dataTablePosition int64 (-1 when absent), 2 infoNode string (XML stream
-// description)), then packets: int32 stream id, int32 size, size bytes of one
-// compressed frame holding a flatbuffer payload:
-//  - "EVTS" EventPacket: 0 elements [Event struct {int64 t [us]; int16 x; int16 y; bool on}] (16 bytes)
-//  - "IMUS" IMUPacket: 0 elements [IMU table {0 t int64 [us], 1 temperature,
-//    2..4 accel [g], 5..7 gyro [deg/s], 8..10 magnetometer}]
-// The file data table ("FTAB") at dataTablePosition, compressed like packets:
-// 0 Table [FileDataDefinition {0 ByteOffset int64 (of the packet's payload; its
-// 8-byte header precedes it), 1 PacketInfo struct {int32
-// stream, int32 size}, 2 NumElements int64, 3 TimestampStart, 4 TimestampEnd}].
+// ("IOHE": compression {0 none, 1 LZ4, 2 LZ4 high, 3 Zstd, 4 Zstd high}, the
+// data table's byte (-1 when absent), the XML stream description), then
+// packets: int32 stream id, int32 size, size bytes of one compressed frame
+// holding a flatbuffer payload ("EVTS" events, "IMUS" IMU samples [g, deg/s]),
+// and the file data table ("FTAB", compressed like packets) at its byte: per
+// packet its payload's byte (its 8-byte header precedes it), stream, size,
+// element count and time range. The tables, their field ids and types are in
+// aedat4.fbs; flatc generates the accessors, and every buffer passes
+// flatbuffers::Verifier before one field of it is read.
 #include <lz4frame.h>
 #include <zstd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <map>
 
+#include <flatbuffers/flatbuffers.h>
+
+#include "io/aedat4_generated.h"
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
-#include "io/flatbuf.hpp"
 
 namespace celc::detail {
 namespace {
@@ -78,12 +80,71 @@ std::vector<StreamInfo> parseStreams(const std::string& xml) {
   return out;
 }
 
-/// Root table of a packet payload, size-prefixed or not, with identifier check.
-FbBuf::Table payloadRoot(const FbBuf& b, const char* ident) {
-  b.need(0, 12, "payload header");
-  if (std::memcmp(b.data() + 4, ident, 4) == 0) return b.root(false, ident);
-  if (std::memcmp(b.data() + 8, ident, 4) == 0) return b.root(true, ident);
-  throw FbError(4, std::string("payload identifier is not '") + ident + "'");
+namespace fbs = celc::aedat4;
+
+/// Nesting of the tables in aedat4.fbs: a root table and the tables of its
+/// vector (IMU samples, data table entries); the verifier refuses deeper.
+constexpr flatbuffers::uoffset_t kFbMaxDepth = 4;
+
+/// A flatbuffer that cannot be read: `offset` is the byte within its buffer
+/// the message is about (0 for the buffer as a whole).
+struct FbError : std::runtime_error {
+  FbError(std::size_t at, const std::string& what) : std::runtime_error(what), offset(at) {}
+  std::size_t offset;
+};
+
+/// Which flatbuffer of the file: the IOHeader, or a packet payload / the data
+/// table (decompressed).
+enum class FbKind {
+  /// Size-prefixed. Its scalars may lie off their alignment (DV-derived files
+  /// hold the int64 data table position at 4 mod 8): they are read with
+  /// flatbuffers::ReadScalar, which the library makes safe for that; its
+  /// string must be 4-aligned.
+  Header,
+  /// Size-prefixed or not; every scalar, vector and struct field aligned (the
+  /// structs of a vector are copied before they are read).
+  Packet,
+};
+
+/// The root table T of the flatbuffer in `data[0, size)` (`data` allocated
+/// by new, so offsets and addresses share their alignment), after
+/// flatbuffers::Verifier has checked every offset, vtable, vector and string
+/// of it against the buffer, and their alignment for a packet, with at most
+/// kFbMaxDepth nested tables and one table per 8 bytes. The buffer is
+/// size-prefixed (its identifier at byte 8, its size prefix at most the bytes
+/// there) or, for a packet, not (identifier at byte 4); the identifier must
+/// be `ident`. Throws FbError naming what failed.
+template <typename T>
+const T* verifiedRoot(const unsigned char* data, std::size_t size, const char* ident, FbKind kind) {
+  const bool prefix_required = kind == FbKind::Header;
+  const std::string id(ident);
+  if (size < 12)
+    throw FbError(0, "a flatbuffer of " + std::to_string(size) + " bytes, shorter than its 12-byte header");
+  if (size >= FLATBUFFERS_MAX_BUFFER_SIZE)
+    throw FbError(0, "a flatbuffer of " + std::to_string(size) + " bytes, beyond the format's 2 GB");
+  const bool prefixed = prefix_required || !flatbuffers::BufferHasIdentifier(data, ident, false);
+  if (!flatbuffers::BufferHasIdentifier(data, ident, prefixed))
+    throw FbError(prefixed ? 8 : 4, (prefix_required ? "flatbuffer" : "payload") +
+                                        std::string(" identifier is not '") + id + "'");
+  std::size_t len = size;
+  if (prefixed) {
+    const auto declared = flatbuffers::ReadScalar<flatbuffers::uoffset_t>(data);
+    if (std::uint64_t(declared) + 4 > size)
+      throw FbError(0, "flatbuffer size prefix " + std::to_string(declared) + " exceeds the buffer of " +
+                           std::to_string(size) + " bytes");
+    len = std::size_t(declared) + 4;
+  }
+  flatbuffers::Verifier::Options limits;
+  limits.max_depth = kFbMaxDepth;
+  limits.max_tables = flatbuffers::uoffset_t(1 + len / 8);
+  limits.check_alignment = kind == FbKind::Packet;
+  flatbuffers::Verifier v(data, len, limits);
+  if (!(prefixed ? v.VerifySizePrefixedBuffer<T>(ident) : v.VerifyBuffer<T>(ident)))
+    throw FbError(0, "the '" + id + "' flatbuffer of " + std::to_string(len) +
+                         " bytes fails verification (an offset, vtable, vector or string outside it" +
+                         (kind == FbKind::Packet ? " or misaligned" : "") +
+                         ", or tables nested or shared beyond the limits)");
+  return prefixed ? flatbuffers::GetSizePrefixedRoot<T>(data) : flatbuffers::GetRoot<T>(data);
 }
 
 struct TableEntry {
@@ -115,11 +176,14 @@ class Aedat4Reader final : public EventReader {
     data_start_ = f_.tell();
     std::string xml;
     try {
-      FbBuf b(hb.data(), hb.size());
-      auto t = b.root(true, "IOHE");
-      compression_ = b.scalar<std::int32_t>(t, 0, 0);
-      table_pos_ = b.scalar<std::int64_t>(t, 1, -1);
-      xml = b.string(t, 2);
+      const auto* h = verifiedRoot<fbs::IoHeader>(hb.data(), hb.size(), "IOHE", FbKind::Header);
+      compression_ = std::int32_t(h->compression());
+      table_pos_ = h->data_table_position();
+      const flatbuffers::String* info = h->info_node();
+      if (info && reinterpret_cast<std::uintptr_t>(info) % alignof(flatbuffers::uoffset_t) != 0)
+        throw FbError(std::size_t(reinterpret_cast<const unsigned char*>(info) - hb.data()),
+                      "the stream description (string) is not 4-aligned");
+      if (info) xml = info->str();
     } catch (const FbError& e) {
       f_.fail(hdr_at + e.offset, std::string("IOHeader: ") + e.what());
     }
@@ -208,11 +272,13 @@ class Aedat4Reader final : public EventReader {
 
   void drain(std::vector<Event>& batch, std::size_t max) {
     for (; cur_ < count_ && batch.size() < max; ++cur_) {
-      const unsigned char* p = events_ + 16 * cur_;
-      const auto t = loadLE<std::int64_t>(p);
-      const auto x = loadLE<std::int16_t>(p + 8);
-      const auto y = loadLE<std::int16_t>(p + 10);
-      const bool on = p[12] != 0;
+      // The verifier checks the vector's length word to 4 bytes, not the 8
+      // its structs' int64 time needs: each struct is read from a copy.
+      fbs::PolarityEvent p;
+      std::memcpy(static_cast<void*>(&p), events_ + sizeof(p) * cur_, sizeof(p));
+      const std::int64_t t = p.t_us();
+      const std::int16_t x = p.x(), y = p.y();
+      const bool on = p.on();
       auto where = [&] {
         return path_ + ": byte " + std::to_string(pkt_byte_) + " (packet), event " + std::to_string(cur_);
       };
@@ -309,6 +375,34 @@ class Aedat4Reader final : public EventReader {
     out_.resize(used);
   }
 
+  /// Takes the decompressed packet in out_ (from byte `at`) as the current
+  /// event packet; false when it holds no event. Throws FbError.
+  bool loadEvents(std::uint64_t at) {
+    const auto* events = verifiedRoot<fbs::EventPacket>(out_.data(), out_.size(), "EVTS", FbKind::Packet)->events();
+    events_ = events ? events->Data() : nullptr;
+    cur_ = 0;
+    count_ = events ? events->size() : 0;
+    pkt_byte_ = at;
+    return count_ > 0;
+  }
+
+  /// Appends the samples of the decompressed IMU packet in out_ (from byte
+  /// `at`) to `imu`. Throws FbError, or IoError for a non-finite value.
+  void appendImu(std::uint64_t at, std::vector<ImuSample>& imu) {
+    const auto* samples = verifiedRoot<fbs::ImuPacket>(out_.data(), out_.size(), "IMUS", FbKind::Packet)->samples();
+    if (!samples) return;
+    for (flatbuffers::uoffset_t i = 0; i < samples->size(); ++i) {
+      const fbs::ImuSample* it = samples->Get(i);
+      ImuSample s;
+      s.t = double(it->t_us()) / 1e6;
+      s.accel = Vec3(it->accel_x_g(), it->accel_y_g(), it->accel_z_g()) * kGravity;
+      s.gyro = Vec3(it->gyro_x_dps(), it->gyro_y_dps(), it->gyro_z_dps()) * kDegToRad;
+      if (!s.accel.allFinite() || !s.gyro.allFinite())
+        f_.fail(at, "non-finite IMU value in sample " + std::to_string(i));
+      imu.push_back(s);
+    }
+  }
+
   /// Reads packets until an event packet is loaded (want_events) or, for IMU
   /// collection, through every packet. Returns false at the end.
   bool nextPacket(bool want_events, std::vector<ImuSample>* imu) {
@@ -344,36 +438,13 @@ class Aedat4Reader final : public EventReader {
       f_.readExact(raw_.data(), raw_.size(), "packet");
       decompress(raw_, at);
       try {
-        FbBuf b(out_.data(), out_.size());
         if (is_events) {
-          auto t = payloadRoot(b, "EVTS");
-          std::size_t first = 0, count = 0;
-          if (!b.vector(t, 0, 16, first, count)) count = 0;
-          events_ = out_.data() + first;
-          cur_ = 0;
-          count_ = count;
-          pkt_byte_ = at;
-          if (count_ > 0) return true;
+          if (loadEvents(at)) return true;
           continue;
         }
-        auto t = payloadRoot(b, "IMUS");
-        std::size_t first = 0, count = 0;
-        if (!b.vector(t, 0, 4, first, count)) continue;
-        for (std::size_t i = 0; i < count; ++i) {
-          auto it = b.table(b.deref(first + 4 * i));
-          ImuSample s;
-          s.t = double(b.scalar<std::int64_t>(it, 0, 0)) / 1e6;
-          float v[6];
-          for (int k = 0; k < 6; ++k) v[k] = b.scalar<float>(it, 2 + k, 0.0f);
-          s.accel = Vec3(v[0], v[1], v[2]) * kGravity;
-          s.gyro = Vec3(v[3], v[4], v[5]) * kDegToRad;
-          if (!s.accel.allFinite() || !s.gyro.allFinite())
-            f_.fail(at, "non-finite IMU value in sample " + std::to_string(i));
-          imu->push_back(s);
-        }
+        appendImu(at, *imu);
       } catch (const FbError& e) {
-        f_.fail(at, std::string("packet payload (decompressed offset ") + std::to_string(e.offset) +
-                        "): " + e.what());
+        f_.fail(at, std::string("packet payload: ") + e.what());
       }
     }
   }
@@ -390,24 +461,19 @@ class Aedat4Reader final : public EventReader {
     f_.readExact(raw.data(), raw.size(), "data table");
     decompress(raw, std::uint64_t(table_pos_));
     try {
-      FbBuf b(out_.data(), out_.size());
-      auto t = payloadRoot(b, "FTAB");
-      std::size_t first = 0, count = 0;
-      if (b.vector(t, 0, 4, first, count)) {
-        for (std::size_t i = 0; i < count; ++i) {
-          auto d = b.table(b.deref(first + 4 * i));
-          TableEntry e;
-          e.offset = b.scalar<std::int64_t>(d, 0, -1);
-          const std::size_t ph = b.field(d, 1, 8);
-          e.stream = ph ? b.get<std::int32_t>(ph) : -1;
-          e.size = ph ? b.get<std::int32_t>(ph + 4) : 0;
-          e.n = b.scalar<std::int64_t>(d, 2, 0);
-          e.t0 = b.scalar<std::int64_t>(d, 3, 0);
-          e.t1 = b.scalar<std::int64_t>(d, 4, 0);
-          if (e.offset < std::int64_t(data_start_) + 8 || std::uint64_t(e.offset) > end_of_packets())
-            throw FbError(first + 4 * i, "data table entry offset " + std::to_string(e.offset) + " outside the packets");
-          table_.push_back(e);
-        }
+      const auto* entries = verifiedRoot<fbs::DataTable>(out_.data(), out_.size(), "FTAB", FbKind::Packet)->entries();
+      for (flatbuffers::uoffset_t i = 0; entries && i < entries->size(); ++i) {
+        const fbs::DataTableEntry* d = entries->Get(i);
+        TableEntry e;
+        e.offset = d->payload_byte();
+        e.stream = d->packet() ? d->packet()->stream_id() : -1;
+        e.size = d->packet() ? d->packet()->size() : 0;
+        e.n = d->elements();
+        e.t0 = d->t_start_us();
+        e.t1 = d->t_end_us();
+        if (e.offset < std::int64_t(data_start_) + 8 || std::uint64_t(e.offset) > end_of_packets())
+          throw FbError(0, "data table entry offset " + std::to_string(e.offset) + " outside the packets");
+        table_.push_back(e);
       }
     } catch (const FbError& e) {
       f_.fail(std::uint64_t(table_pos_), std::string("data table: ") + e.what());
@@ -431,7 +497,7 @@ class Aedat4Reader final : public EventReader {
   std::vector<StreamInfo> streams_;
   int event_stream_ = -1, imu_stream_ = -1;
   std::vector<unsigned char> raw_, out_;
-  const unsigned char* events_ = nullptr;
+  const unsigned char* events_ = nullptr;  ///< the current packet's fbs::PolarityEvent structs, in out_
   std::size_t cur_ = 0, count_ = 0;
   std::uint64_t pkt_byte_ = 0;
   bool table_loaded_ = false;

@@ -1,11 +1,14 @@
 #pragma once
 // Checks of HDF5 object headers made before the HDF5 C library reads them.
-// The library sizes its metadata-cache buffers from fields of the file (an
-// object header's chunk sizes, a continuation message's length) before it
-// compares them with the file's end: a 14 KB file whose continuation message
-// claims 4 GB made it reserve 4 GB (found by the hdf5 fuzz target). The reader
-// checks every object header it is about to open with these functions: every
-// chunk of the header must lie inside the file.
+// The library (1.10.8) uses fields of the file before it compares them with
+// the file's end, and no API call can look at them first (docs/decisions.md):
+//  - a continuation message's length sizes a metadata-cache buffer: 4 GB
+//    allocated for a 14 KB file;
+//  - an old-style group's local heap sizes its data segment the same way
+//    (88 TB), and a heap at the undefined address is read through NULL;
+//  - a chunked layout of rank 0 is divided by (SIGFPE in H5Dopen2).
+// The reader checks every object header it is about to open with these
+// functions: every chunk of the header, its local heap and its layout.
 //
 // Format facts (HDF5 file format specification, version 3.0): the superblock
 // sits at byte 0, 512, 1024, 2048, ... and every file address is relative to
