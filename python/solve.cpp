@@ -148,7 +148,7 @@ camera schema (width, height, fx, fy, cx, cy, distortion_model, distortion); or
 normalized=True for normalised coordinates (focal [px] scales thresholds).
 config: run configuration (YAML path or dict: its lines, observations,
 solver, methods, seed); set: overrides {"key.path": value};
-methods: list or "celc,celc_opt" (default: the configuration's, all five).
+methods: list or "celc,celc_opt" (default: the configuration's, all six).
 
 Returns {method: {"status", "reason", "message", "v" (unit direction,
 reference camera frame; None unless ok), "sigma_deg" (nan when not

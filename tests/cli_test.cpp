@@ -110,7 +110,7 @@ TEST(Cli, SolveOnLabelledEventsRecoversVelocity) {
     // than the paper's noise setting; CE3LC's one middle line is the weakest.
     EXPECT_LT(angleBetween(v, tr.true_direction), method == "ce3lc" ? 0.5 : 0.15) << line;
   }
-  EXPECT_EQ(rows, 5);  // celc, celc_opt, celc_ml, ce3lc, npt
+  EXPECT_EQ(rows, 6);  // celc, celc_opt, celc_ml, ce3lc, npt, celc_acc (runMethods)
   fs::remove_all(d);
 }
 

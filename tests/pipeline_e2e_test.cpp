@@ -13,6 +13,7 @@
 
 #include "celc/cluster/cluster.hpp"
 #include "celc/eval/run_tables.hpp"
+#include "celc/solver/methods.hpp"
 #include "cli_util.hpp"
 
 namespace fs = std::filesystem;

@@ -33,7 +33,7 @@ def test_run_matches_cli(synth_seq, tmp_path):
             if key == "runtime_ms":  # wall time: differs from run to run
                 continue
             value = py[key][i]
-            if key in ("method", "status", "reason", "sigma_rule"):
+            if key in ("method", "status", "reason", "sigma_rule", "model"):
                 assert value == row[key], (i, key)
             elif key in ("window", "n_events", "n_clusters", "n_lines"):
                 assert value == (int(row[key]) if row[key] else -1), (i, key)
