@@ -128,6 +128,9 @@ def cmd_summary(d):
         sc = scenes[m]
         within = "%d%%" % round(100 * float(sc[4]))
         print("| `%s` | %s | %s (%s) | %s | %s |" % (m, mean_phi, median, ratio, sc[2], within))
+    if "celc_acc" in scenes:  # not in the paper's nor the peers' study
+        sc = scenes["celc_acc"]
+        print("| `celc_acc` | - | - | %s | %d%% |" % (sc[2], round(100 * float(sc[4]))))
 
 
 def cmd_readme(readme, path):
