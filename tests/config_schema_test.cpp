@@ -231,10 +231,10 @@ TEST(ConfigSchema, ErrorsNameFileLineAndKey) {
   // Raw bytes of a hostile file never reach the message.
   EXPECT_EQ(apply("a: \"\\\xA4\"\n"), "b.yaml:1: YAML syntax: unknown escape character: <0xA4>");
   EXPECT_EQ(apply("cluster:\n  conf\xB5: 1\n").rfind("b.yaml:2: unknown key 'cluster.conf<0xB5>' (allowed", 0), 0u);
-  EXPECT_NE(apply("cluster:\n  smoothness_deg: 200\n").find("smoothness_deg must be"), std::string::npos);
-  EXPECT_NE(apply("cluster:\n  smoothness_noise_factor: -1\n").find("smoothness_noise_factor must be"),
+  EXPECT_NE(apply("cluster:\n  smoothness_deg: 200\n").find("smoothness_deg: must be"), std::string::npos);
+  EXPECT_NE(apply("cluster:\n  smoothness_noise_factor: -1\n").find("smoothness_noise_factor: must be"),
             std::string::npos);
-  EXPECT_NE(apply("cluster:\n  smoothness_min_deg: 0\n").find("smoothness_min_deg must be"), std::string::npos);
+  EXPECT_NE(apply("cluster:\n  smoothness_min_deg: 0\n").find("smoothness_min_deg: must be"), std::string::npos);
   EXPECT_NE(apply("lines:\n  min_events: 1\n").find("min_events"), std::string::npos);
   // A failed apply leaves the configuration as it was.
   EXPECT_EQ(c.cluster.c_px_per_s, ClusterOptions{}.c_px_per_s);

@@ -38,41 +38,10 @@ std::string toString(ClusterStatus status) {
 }
 
 std::string ClusterOptions::validate() const {
-  std::ostringstream err;
-  if (!(c_px_per_s >= 0.0) || !std::isfinite(c_px_per_s)) err << "c_px_per_s must be >= 0 (0 = auto); ";
-  if (!(c_min_px_per_s > 0.0 && c_max_px_per_s >= c_min_px_per_s && std::isfinite(c_max_px_per_s)))
-    err << "need 0 < c_min_px_per_s <= c_max_px_per_s; ";
-  if (!(c_speed_factor >= 0.1 && c_speed_factor <= 100.0)) err << "c_speed_factor must be in [0.1, 100]; ";
-  if (neighbours < 3 || neighbours > 1000) err << "neighbours must be in [3, 1000]; ";
-  if (!(pcl_normal_radius_px >= 0.0 && pcl_normal_radius_px <= 50.0))
-    err << "pcl_normal_radius_px must be in [0, 50]; ";
-  if (grid_radius_px < 1 || grid_radius_px > 5) err << "grid_radius_px must be in [1, 5]; ";
-  if (grow_radius_px < 1 || grow_radius_px > 5) err << "grow_radius_px must be in [1, 5]; ";
-  if (!(time_radius_px > 0.0 && time_radius_px <= 100.0)) err << "time_radius_px must be in (0, 100]; ";
-  if (!(grow_time_radius_px > 0.0 && grow_time_radius_px <= 100.0))
-    err << "grow_time_radius_px must be in (0, 100]; ";
-  if (!(normal_reuse_px >= 0.0 && normal_reuse_px <= 2.0)) err << "normal_reuse_px must be in [0, 2]; ";
-  if (min_neighbours < 3) err << "min_neighbours must be >= 3; ";
-  if (!(smoothness_deg > 0.0 && smoothness_deg <= 90.0)) err << "smoothness_deg must be in (0, 90]; ";
-  if (!(smoothness_noise_factor >= 0.0) || !std::isfinite(smoothness_noise_factor))
-    err << "smoothness_noise_factor must be finite and >= 0; ";
-  if (!(smoothness_min_deg > 0.0 && smoothness_min_deg <= 90.0)) err << "smoothness_min_deg must be in (0, 90]; ";
-  if (!(curvature_threshold > 0.0 && curvature_threshold <= 1.0))
-    err << "curvature_threshold must be in (0, 1]; ";
-  if (min_cluster_size < 3) err << "min_cluster_size must be >= 3; ";
-  if (max_cluster_size < min_cluster_size) err << "max_cluster_size must be >= min_cluster_size; ";
-  if (!(max_plane_rms_px > 0.0)) err << "max_plane_rms_px must be > 0; ";
-  if (!(ransac_threshold_px > 0.0)) err << "ransac_threshold_px must be > 0; ";
-  if (max_split < 1 || max_split > 64) err << "max_split must be in [1, 64]; ";
-  if (!(line_split_px >= 0.0 && line_split_px <= 50.0)) err << "line_split_px must be in [0, 50]; ";
-  if (!(motion_reassign_px >= 0.0 && motion_reassign_px <= 50.0)) err << "motion_reassign_px must be in [0, 50]; ";
-  if (motion_redraw_rounds < 1 || motion_redraw_rounds > 10) err << "motion_redraw_rounds must be in [1, 10]; ";
-  if (!(motion_join_px >= 0.0 && motion_join_px <= 50.0)) err << "motion_join_px must be in [0, 50]; ";
-  if (!(min_time_span_s >= 0.0)) err << "min_time_span_s must be >= 0; ";
-  if (!(min_extent_px >= 0.0)) err << "min_extent_px must be >= 0; ";
-  if (!(min_density_per_px2 >= 0.0)) err << "min_density_per_px2 must be >= 0; ";
-  if (threads < 1 || threads > 256) err << "threads must be in [1, 256]; ";
-  return err.str();
+  std::string e = rangeProblemsOf(*this);
+  if (!(c_max_px_per_s >= c_min_px_per_s)) e += "c_max_px_per_s: must be >= c_min_px_per_s; ";
+  if (max_cluster_size < min_cluster_size) e += "max_cluster_size: must be >= min_cluster_size; ";
+  return e;
 }
 
 namespace {

@@ -7,53 +7,53 @@ namespace celc {
 void describe(FieldVisitor& v, ClusterOptions& o) {
   v.enumeration({"method", "", "grid: own region grower (fast); pcl: PCL region growing"}, o.method,
                 {ClusterMethod::Grid, ClusterMethod::Pcl});
-  v.field({"c_px_per_s", "px/s", "time scale of (x, y, c*t); 0 = estimated per window"}, o.c_px_per_s);
-  v.field({"c_speed_factor", "", "automatic c = this factor x the median normal-flow speed"}, o.c_speed_factor);
-  v.field({"c_min_px_per_s", "px/s", "lower clamp of the estimated time scale"}, o.c_min_px_per_s);
-  v.field({"c_max_px_per_s", "px/s", "upper clamp of the estimated time scale"}, o.c_max_px_per_s);
+  v.field({"c_px_per_s", "px/s", "time scale of (x, y, c*t); 0 = estimated per window", atLeast(0)}, o.c_px_per_s);
+  v.field({"c_speed_factor", "", "automatic c = this factor x the median normal-flow speed", within(0.1, 100)}, o.c_speed_factor);
+  v.field({"c_min_px_per_s", "px/s", "lower clamp of the estimated time scale", above(0)}, o.c_min_px_per_s);
+  v.field({"c_max_px_per_s", "px/s", "upper clamp of the estimated time scale", above(0)}, o.c_max_px_per_s);
   v.field({"separate_polarity", "", "cluster ON and OFF events separately (paper)"}, o.separate_polarity);
-  v.field({"neighbours", "events", "pcl: k nearest neighbours"}, o.neighbours);
-  v.field({"pcl_normal_radius_px", "px", "pcl: normals from this radius in (x, y, c*t); 0 = k nearest"},
+  v.field({"neighbours", "events", "pcl: k nearest neighbours", within(3, 1000)}, o.neighbours);
+  v.field({"pcl_normal_radius_px", "px", "pcl: normals from this radius in (x, y, c*t); 0 = k nearest", within(0, 50)},
           o.pcl_normal_radius_px);
-  v.field({"grid_radius_px", "px", "grid: normals from a (2r+1)^2 pixel window"}, o.grid_radius_px);
-  v.field({"grow_radius_px", "px", "grid: growing visits a (2r+1)^2 pixel window"}, o.grow_radius_px);
-  v.field({"time_radius_px", "px", "grid, normals: time range in c*t units"}, o.time_radius_px);
-  v.field({"grow_time_radius_px", "px", "grid, growing: time range in c*t units"}, o.grow_time_radius_px);
-  v.field({"normal_reuse_px", "px", "grid: reuse a pixel's normal within this c*t distance (0 = never)"},
+  v.field({"grid_radius_px", "px", "grid: normals from a (2r+1)^2 pixel window", within(1, 5)}, o.grid_radius_px);
+  v.field({"grow_radius_px", "px", "grid: growing visits a (2r+1)^2 pixel window", within(1, 5)}, o.grow_radius_px);
+  v.field({"time_radius_px", "px", "grid, normals: time range in c*t units", withinAbove(0, 100)}, o.time_radius_px);
+  v.field({"grow_time_radius_px", "px", "grid, growing: time range in c*t units", withinAbove(0, 100)}, o.grow_time_radius_px);
+  v.field({"normal_reuse_px", "px", "grid: reuse a pixel's normal within this c*t distance (0 = never)", within(0, 2)},
           o.normal_reuse_px);
-  v.field({"min_neighbours", "events", "grid: fewer neighbours -> no normal"}, o.min_neighbours);
-  v.field({"smoothness_deg", "deg", "max angle between neighbouring normals"}, o.smoothness_deg);
+  v.field({"min_neighbours", "events", "grid: fewer neighbours -> no normal", atLeast(3)}, o.min_neighbours);
+  v.field({"smoothness_deg", "deg", "max angle between neighbouring normals", withinAbove(0, 90)}, o.smoothness_deg);
   v.field({"smoothness_noise_factor", "-",
            "grid: the angle is this times the window's median angle between neighbouring normals, within "
-           "[smoothness_min_deg, smoothness_deg] (0 = smoothness_deg)"},
+           "[smoothness_min_deg, smoothness_deg] (0 = smoothness_deg)", atLeast(0)},
           o.smoothness_noise_factor);
-  v.field({"smoothness_min_deg", "deg", "grid: ... at least this"}, o.smoothness_min_deg);
-  v.field({"curvature_threshold", "-", "max curvature of a point grown from (0..1/3)"}, o.curvature_threshold);
-  v.field({"min_cluster_size", "events", "smaller clusters are dropped"}, o.min_cluster_size);
+  v.field({"smoothness_min_deg", "deg", "grid: ... at least this", withinAbove(0, 90)}, o.smoothness_min_deg);
+  v.field({"curvature_threshold", "-", "max curvature of a point grown from (0..1/3)", withinAbove(0, 1)}, o.curvature_threshold);
+  v.field({"min_cluster_size", "events", "smaller clusters are dropped", atLeast(3)}, o.min_cluster_size);
   v.field({"max_cluster_size", "events", "larger regions are not clusters"}, o.max_cluster_size);
-  v.field({"max_plane_rms_px", "px", "max RMS distance to the cluster's plane"}, o.max_plane_rms_px);
-  v.field({"ransac_threshold_px", "px", "inlier distance when splitting a region"}, o.ransac_threshold_px);
-  v.field({"max_split", "", "planes extracted from one region at most"}, o.max_split);
+  v.field({"max_plane_rms_px", "px", "max RMS distance to the cluster's plane", above(0)}, o.max_plane_rms_px);
+  v.field({"ransac_threshold_px", "px", "inlier distance when splitting a region", above(0)}, o.ransac_threshold_px);
+  v.field({"max_split", "", "planes extracted from one region at most", within(1, 64)}, o.max_split);
   v.field({"line_split_px", "px",
            "cut each cluster to the events one moving line explains within this distance (sequential RANSAC); "
-           "0 = not cut"},
+           "0 = not cut", within(0, 50)},
           o.line_split_px);
   v.field({"motion_reassign_px", "px",
            "after a first solve, each event joins the one cluster whose line under the window's estimated motion "
-           "passes within this distance (kept where the first method still answers and 95% of the events stay "
-           "clustered); 0 = not redrawn"},
+           "passes within this distance (kept where the first method still answers and the window's cost per "
+           "event falls); 0 = not redrawn", within(0, 50)},
           o.motion_reassign_px);
   v.field({"motion_redraw_rounds", "",
-           "redraws at most, each from the answer on the last kept clusters (stops at the first not kept)"},
+           "redraws at most, each from the answer on the last kept clusters (stops at the first not kept)", within(1, 10)},
           o.motion_redraw_rounds);
   v.field({"motion_join_px", "px",
            "clusters both within this median distance of their joint line under the estimated motion join "
-           "(fragments of one edge); 0 = none join"},
+           "(fragments of one edge); 0 = none join", within(0, 50)},
           o.motion_join_px);
-  v.field({"min_time_span_s", "s", "shortest cluster duration"}, o.min_time_span_s);
-  v.field({"min_extent_px", "px", "smallest spatial extent"}, o.min_extent_px);
-  v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane"}, o.min_density_per_px2);
-  v.field({"threads", "", "worker threads inside one window's clustering"}, o.threads);
+  v.field({"min_time_span_s", "s", "shortest cluster duration", atLeast(0)}, o.min_time_span_s);
+  v.field({"min_extent_px", "px", "smallest spatial extent", atLeast(0)}, o.min_extent_px);
+  v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane", atLeast(0)}, o.min_density_per_px2);
+  v.field({"threads", "", "worker threads inside one window's clustering", within(1, 256)}, o.threads);
   v.field({"seed", "", "RANSAC seed"}, o.seed);
 }
 
