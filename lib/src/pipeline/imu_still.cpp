@@ -17,17 +17,18 @@ std::string format(const char* f, double a, double b = 0.0, double c = 0.0, doub
 
 }  // namespace
 
-std::string StillOptions::validate() const {
-  std::string e;
-  if (!(span_s > 0.0) || !std::isfinite(span_s)) e += "span_s must be > 0; ";
-  if (!(step_s > 0.0) || !std::isfinite(step_s)) e += "step_s must be > 0; ";
-  if (!(max_gyro_std >= 0.0)) e += "max_gyro_std must be >= 0; ";
-  if (!(max_accel_turn >= 0.0)) e += "max_accel_turn must be >= 0; ";
-  if (!(max_accel_rel_std >= 0.0)) e += "max_accel_rel_std must be >= 0; ";
-  if (!(max_mean_rate >= 0.0)) e += "max_mean_rate must be >= 0; ";
-  if (min_samples < 10) e += "min_samples must be >= 10; ";
-  return e;
+void describe(FieldVisitor& v, StillOptions& o) {
+  v.field({"span_s", "s", "length of the span", above(0)}, o.span_s);
+  v.field({"step_s", "s", "between candidate starts", above(0)}, o.step_s);
+  v.field({"max_gyro_std", "rad/s", "largest gyro std per axis", atLeast(0)}, o.max_gyro_std);
+  v.field({"max_accel_turn", "rad", "largest turn of the accelerometer direction over the span", atLeast(0)},
+          o.max_accel_turn);
+  v.field({"max_accel_rel_std", "-", "largest std / mean of |accel|", atLeast(0)}, o.max_accel_rel_std);
+  v.field({"max_mean_rate", "rad/s", "largest norm of the mean gyro rate", atLeast(0)}, o.max_mean_rate);
+  v.field({"min_samples", "samples", "a span needs this many", atLeast(10)}, o.min_samples);
 }
+
+std::string StillOptions::validate() const { return rangeProblemsOf(*this); }
 
 bool StillSpan::significant(double z, double min_rate) const {
   if (!found || samples <= 0 || gyro_mean.norm() < min_rate) return false;

@@ -76,9 +76,13 @@ std::vector<PeerCell> peerStudyCells() {
   return cells;
 }
 
+void describe(FieldVisitor& v, PeerStudyConfig& c) {
+  v.field({"trials", "", "trials per cell", atLeast(1)}, c.trials);
+  v.field({"seed", "", "the trials' seed"}, c.seed);
+}
+
 std::string PeerStudyConfig::validate() const {
-  std::string e = scene.validate() + inSection("solver", solver.validate());
-  if (trials < 1) e += "trials must be >= 1; ";
+  std::string e = scene.validate() + inSection("solver", solver.validate()) + rangeProblemsOf(*this);
   if (methods.empty()) e += "no methods; ";
   return e;
 }

@@ -16,21 +16,29 @@ CameraModel PeerSceneOptions::defaultCamera() {
   return c;
 }
 
+void describe(FieldVisitor& v, PeerSceneOptions& o) {
+  v.field({"n_lines", "", "3D segments (clusters)", atLeast(1)}, o.n_lines);
+  v.field({"events_per_line", "events", "events per segment, outliers included", atLeast(2)}, o.events_per_line);
+  v.field({"duration", "s", "window length, centred on t_ref", above(0)}, o.duration);
+  v.field({"t_ref", "s", "reference time", anyFinite()}, o.t_ref);
+  v.field({"speed", "m/s", "|v|", atLeast(0)}, o.speed);
+  v.field({"omega_deg_s", "deg/s", "|w|", atLeast(0)}, o.omega_deg_s);
+  v.field({"event_noise_px", "px", "event pixel noise per axis", atLeast(0)}, o.event_noise_px);
+  v.field({"omega_error_deg_s", "deg/s", "error of the given angular velocity", atLeast(0)}, o.omega_error_deg_s);
+  v.field({"outlier_fraction", "-", "share of events replaced by uniform pixels", withinBelow(0, 1)},
+          o.outlier_fraction);
+  v.field({"acceleration", "m/s^2", "|a| of a constant acceleration", atLeast(0)}, o.acceleration);
+  v.field({"min_separation_px", "px", "endpoint distance at t_ref", atLeast(0)}, o.min_separation_px);
+  v.field({"depth_range", "m", "endpoint depths", above(0)}, o.depth_range);
+  v.field({"max_attempts", "", "segment draws per line", atLeast(1)}, o.max_attempts);
+  v.field({"max_motion_draws", "", "motion draws before giving up", atLeast(1)}, o.max_motion_draws);
+  v.field({"integer_pixels", "", "event pixels rounded to integers"}, o.integer_pixels);
+}
+
 std::string PeerSceneOptions::validate() const {
-  std::ostringstream e;
-  if (n_lines < 1) e << "n_lines must be >= 1; ";
-  if (events_per_line < 2) e << "events_per_line must be >= 2; ";
-  if (!(duration > 0.0) || !std::isfinite(t_ref)) e << "duration must be > 0 and t_ref finite; ";
-  if (!(speed >= 0.0) || !std::isfinite(speed)) e << "speed must be >= 0; ";
-  if (!(omega_deg_s >= 0.0) || !std::isfinite(omega_deg_s)) e << "omega_deg_s must be >= 0; ";
-  if (!(event_noise_px >= 0.0) || !(omega_error_deg_s >= 0.0)) e << "noise levels must be >= 0; ";
-  if (!(outlier_fraction >= 0.0 && outlier_fraction < 1.0)) e << "outlier_fraction must be in [0, 1); ";
-  if (!(acceleration >= 0.0) || !std::isfinite(acceleration)) e << "acceleration must be >= 0; ";
-  if (!(min_separation_px >= 0.0)) e << "min_separation_px must be >= 0; ";
-  if (!(depth_range[0] > 0.0 && depth_range[1] >= depth_range[0])) e << "depth_range must be 0 < min <= max; ";
-  if (max_attempts < 1 || max_motion_draws < 1) e << "max_attempts and max_motion_draws must be >= 1; ";
-  e << camera.validate() << line_fit.validate();
-  return e.str();
+  std::string e = rangeProblemsOf(*this);
+  if (!(depth_range[1] >= depth_range[0])) e += "depth_range: must be min <= max; ";
+  return e + camera.validate() + line_fit.validate();
 }
 
 namespace {

@@ -196,32 +196,6 @@ std::string toString(TextureKind kind) {
   return "chessboard";
 }
 
-std::string PlaneSpec::validate() const {
-  std::ostringstream e;
-  auto in01 = [](double x) { return x >= 0.0 && x <= 1.0; };
-  if (!position.allFinite() || !rotation.allFinite()) e << "position/rotation must be finite; ";
-  if (texture == TextureKind::Chessboard) {
-    if (!(square > 0.0) || !std::isfinite(square)) e << "square must be > 0; ";
-    if (columns < 1 || rows < 1 || columns > 100000 || rows > 100000)
-      e << "squares must be in [1, 100000]; ";
-    if (!in01(dark) || !in01(light)) e << "dark/light must be in [0, 1]; ";
-  } else {
-    if (!(width > 0.0) || !(height > 0.0) || !std::isfinite(width) || !std::isfinite(height))
-      e << "size must be > 0; ";
-    if (!in01(base)) e << "base must be in [0, 1]; ";
-    if (count < 0 || count > 5000) e << "count must be in [0, 5000]; ";
-    if (!(size_range.x() > 0.0) || !(size_range.y() >= size_range.x()) || !size_range.allFinite())
-      e << "size_range must be 0 < min <= max; ";
-    if (!(width_range.x() > 0.0) || !(width_range.y() >= width_range.x()) ||
-        !width_range.allFinite())
-      e << "width_range must be 0 < min <= max; ";
-    if (!in01(intensity_range.x()) || !in01(intensity_range.y()) ||
-        intensity_range.y() < intensity_range.x())
-      e << "intensity_range must be 0 <= min <= max <= 1; ";
-  }
-  return e.str();
-}
-
 int ScenePlane::edgeCount() const {
   return texture == TextureKind::Chessboard ? (columns + 1) + (rows + 1)
                                             : 4 + 4 * static_cast<int>(rects.size());

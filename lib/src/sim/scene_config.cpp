@@ -12,6 +12,16 @@ namespace celc {
 
 namespace {
 
+/// Fails the read with validate()'s first problem, "key: what; ...", under
+/// its key (v.fail names the file, the line and the section).
+void failOnFirstProblem(FieldVisitor& v, const std::string& problems) {
+  if (problems.empty()) return;
+  const std::string first = problems.substr(0, problems.find("; "));
+  const auto colon = first.find(": ");
+  if (colon == std::string::npos) v.fail("", first);
+  v.fail(first.substr(0, colon).c_str(), first.substr(colon + 2));
+}
+
 bool isRotation(const Mat3& R) {
   return (R.transpose() * R - Mat3::Identity()).norm() <= 1e-6 && R.determinant() > 0.0;
 }
@@ -35,74 +45,93 @@ void describePlane(FieldVisitor& v, PlaneSpec& s) {
   v.require("texture");
   v.enumeration({"texture", "", "what is printed on the plane"}, s.texture,
                 {TextureKind::Chessboard, TextureKind::Rectangles, TextureKind::Segments});
-  v.field({"position", "m", "plane centre in the world"}, s.position);
-  v.field({"rotation", "rad", "axis-angle of R_world_plane"}, s.rotation);
+  v.field({"position", "m", "plane centre in the world", anyFinite()}, s.position);
+  v.field({"rotation", "rad", "axis-angle of R_world_plane", anyFinite()}, s.rotation);
   if (s.texture == TextureKind::Chessboard) {
-    v.field({"square", "m", "side of a square"}, s.square);
+    v.field({"square", "m", "side of a square", above(0)}, s.square);
     std::vector<double> squares{double(s.columns), double(s.rows)};
-    v.field({"squares", "", "squares along u and v"}, squares, {2});
+    v.field({"squares", "", "squares along u and v", within(1, 100000)}, squares, {2});
     for (double q : squares)
       if (q != std::floor(q) || std::abs(q) > 1e6) v.fail("squares", "expected two integers");
     s.columns = static_cast<int>(squares[0]);
     s.rows = static_cast<int>(squares[1]);
-    v.field({"dark", "-", "intensity of the dark squares, [0, 1]"}, s.dark);
-    v.field({"light", "-", "intensity of the light squares, [0, 1]"}, s.light);
+    v.field({"dark", "-", "intensity of the dark squares", within(0, 1)}, s.dark);
+    v.field({"light", "-", "intensity of the light squares", within(0, 1)}, s.light);
   } else {
     std::vector<double> size{s.width, s.height};
-    v.field({"size", "m", "plane extent along u and v"}, size, {2});
+    v.field({"size", "m", "plane extent along u and v", above(0)}, size, {2});
     s.width = size[0];
     s.height = size[1];
-    v.field({"base", "-", "intensity under the shapes, [0, 1]"}, s.base);
-    v.field({"count", "", "number of shapes, [0, 5000]"}, s.count);
-    if (s.count < 0 || s.count > 5000) v.fail("count", "must be in [0, 5000]");
-    v.field({"intensity_range", "-", "shape intensities drawn from this range"}, s.intensity_range);
+    v.field({"base", "-", "intensity under the shapes", within(0, 1)}, s.base);
+    v.field({"count", "", "number of shapes", within(0, 5000)}, s.count);
+    v.field({"intensity_range", "-", "shape intensities drawn from this range", within(0, 1)}, s.intensity_range);
     v.field({"seed", "", "shape layout seed (< 0: from the scene seed)"}, s.seed);
     if (s.texture == TextureKind::Rectangles) {
-      v.field({"size_range", "m", "rectangle sides drawn from this range"}, s.size_range);
+      v.field({"size_range", "m", "rectangle sides drawn from this range", above(0)}, s.size_range);
       v.field({"random_angle", "", "rotate each rectangle by a uniform angle"}, s.random_angle);
     } else {
-      v.field({"length_range", "m", "segment lengths drawn from this range"}, s.size_range);
-      v.field({"width_range", "m", "segment thickness drawn from this range"}, s.width_range);
+      v.field({"length_range", "m", "segment lengths drawn from this range", above(0)}, s.size_range);
+      v.field({"width_range", "m", "segment thickness drawn from this range", above(0)}, s.width_range);
     }
   }
-  if (v.reading())
-    if (const std::string err = s.validate(); !err.empty()) v.fail("", err);
+  if (v.reading()) failOnFirstProblem(v, s.validate());
 }
 
 void describeTrajectory(FieldVisitor& v, TrajectorySpec& t) {
   v.enumeration({"type", "", "the camera's motion"}, t.kind,
                 {TrajectoryKind::ConstantTwist, TrajectoryKind::Piecewise, TrajectoryKind::Sinusoid,
                   TrajectoryKind::ConstantAcceleration});
-  v.field({"initial_position", "m", "camera position at t = 0 (world)"}, t.initial.p);
+  v.field({"initial_position", "m", "camera position at t = 0 (world)", anyFinite()}, t.initial.p);
   Vec3 rotation = so3::log(t.initial.R);
-  v.field({"initial_rotation", "rad", "axis-angle of the camera's orientation at t = 0"}, rotation);
+  v.field({"initial_rotation", "rad", "axis-angle of the camera's orientation at t = 0", anyFinite()}, rotation);
   t.initial.R = so3::exp(rotation);
   if (t.kind == TrajectoryKind::Piecewise) {
     v.require("segments");
     v.items({"segments", "", "constant twists one after the other"}, t.segments,
             [](FieldVisitor& s, TwistSegment& seg) {
               s.require("duration");
-              s.field({"duration", "s", "segment length"}, seg.duration);
-              s.field({"v", "m/s", "linear velocity, camera frame"}, seg.v);
-              s.field({"w", "rad/s", "angular velocity, camera frame"}, seg.w);
+              s.field({"duration", "s", "segment length", above(0)}, seg.duration);
+              s.field({"v", "m/s", "linear velocity, camera frame", anyFinite()}, seg.v);
+              s.field({"w", "rad/s", "angular velocity, camera frame", anyFinite()}, seg.w);
             });
     if (v.reading() && t.segments.empty()) v.fail("segments", "expected a non-empty list");
   } else {
-    v.field({"v", "m/s", "linear velocity, camera frame (sinusoid: mean; constant_acceleration: at t = 0)"}, t.v);
-    v.field({"w", "rad/s", "angular velocity, camera frame (sinusoid: mean)"}, t.w);
+    v.field({"v", "m/s", "linear velocity, camera frame (sinusoid: mean; constant_acceleration: at t = 0)",
+             anyFinite()},
+            t.v);
+    v.field({"w", "rad/s", "angular velocity, camera frame (sinusoid: mean)", anyFinite()}, t.w);
   }
   if (t.kind == TrajectoryKind::Sinusoid) {
-    v.field({"amplitude_v", "m/s", "amplitude of v"}, t.amplitude_v);
-    v.field({"amplitude_w", "rad/s", "amplitude of w"}, t.amplitude_w);
-    v.field({"frequency", "Hz", "frequency of both"}, t.frequency);
+    v.field({"amplitude_v", "m/s", "amplitude of v", anyFinite()}, t.amplitude_v);
+    v.field({"amplitude_w", "rad/s", "amplitude of w", anyFinite()}, t.amplitude_w);
+    v.field({"frequency", "Hz", "frequency of both", withinAbove(0, 1e4)}, t.frequency);
   }
   if (t.kind == TrajectoryKind::ConstantAcceleration)
-    v.field({"acceleration", "m/s^2", "constant in the world, given in the camera frame at t = 0"}, t.acceleration);
-  if (v.reading())
-    if (const std::string err = t.validate(); !err.empty()) v.fail("", err);
+    v.field({"acceleration", "m/s^2", "constant in the world, given in the camera frame at t = 0", anyFinite()},
+            t.acceleration);
+  if (v.reading()) failOnFirstProblem(v, t.validate());
 }
 
 }  // namespace
+
+std::string PlaneSpec::validate() const {
+  PlaneSpec copy = *this;
+  std::string e = rangeProblems(Describe([&](FieldVisitor& v) { describePlane(v, copy); }));
+  if (texture == TextureKind::Chessboard) return e;
+  if (!(size_range.y() >= size_range.x())) e += "size_range: must be min <= max; ";
+  if (texture == TextureKind::Segments && !(width_range.y() >= width_range.x()))
+    e += "width_range: must be min <= max; ";
+  if (!(intensity_range.y() >= intensity_range.x())) e += "intensity_range: must be min <= max; ";
+  return e;
+}
+
+std::string TrajectorySpec::validate() const {
+  TrajectorySpec copy = *this;
+  std::string e = rangeProblems(Describe([&](FieldVisitor& v) { describeTrajectory(v, copy); }));
+  if (!initial.R.allFinite()) e += "initial_rotation: must be finite; ";
+  if (kind == TrajectoryKind::Piecewise && segments.empty()) e += "segments: at least one; ";
+  return e;
+}
 
 void describe(FieldVisitor& v, RenderOptions& o) {
   v.field({"contrast_on", "log I", "ON threshold C+", above(0)}, o.contrast_on);

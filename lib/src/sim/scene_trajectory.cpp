@@ -33,26 +33,6 @@ std::string toString(TrajectoryKind kind) {
   return "constant_twist";
 }
 
-std::string TrajectorySpec::validate() const {
-  std::ostringstream e;
-  if (!v.allFinite() || !w.allFinite()) e << "v and w must be finite; ";
-  if (!initial.R.allFinite() || !initial.p.allFinite()) e << "initial pose must be finite; ";
-  if (kind == TrajectoryKind::Piecewise) {
-    if (segments.empty()) e << "piecewise trajectory needs at least one segment; ";
-    for (size_t i = 0; i < segments.size(); ++i)
-      if (!(segments[i].duration > 0.0) || !std::isfinite(segments[i].duration) ||
-          !segments[i].v.allFinite() || !segments[i].w.allFinite())
-        e << "segment " << i << " needs a positive duration and finite v, w; ";
-  }
-  if (kind == TrajectoryKind::Sinusoid) {
-    if (!amplitude_v.allFinite() || !amplitude_w.allFinite()) e << "amplitudes must be finite; ";
-    if (!(frequency > 0.0) || !(frequency < 1e4)) e << "frequency must be in (0, 1e4) Hz; ";
-  }
-  if (kind == TrajectoryKind::ConstantAcceleration && !acceleration.allFinite())
-    e << "acceleration must be finite; ";
-  return e.str();
-}
-
 RigidPose twistExp(const Vec3& v, const Vec3& w, double tau) {
   const Vec3 phi = w * tau;
   return {so3::exp(phi), so3::leftJacobian(phi) * v * tau};

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "celc/core/fields.hpp"
 #include "celc/core/types.hpp"
 
 namespace celc {
@@ -54,6 +55,9 @@ struct StillOptions {
   int min_samples = 20;                 ///< a span needs this many samples
   std::string validate() const;         ///< "" when usable, else what is wrong
 };
+/// StillOptions' fields with their units and ranges (core/fields.hpp);
+/// validate() is their range check.
+void describe(FieldVisitor& v, StillOptions& options);
 
 struct StillSpan {
   bool found = false;

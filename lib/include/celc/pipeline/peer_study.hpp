@@ -69,6 +69,9 @@ struct PeerStudyConfig {
   std::uint64_t seed = 1;
   std::string validate() const;
 };
+/// PeerStudyConfig's own scalar fields with their ranges (core/fields.hpp);
+/// the scene and the solver have their own.
+void describe(FieldVisitor& v, PeerStudyConfig& config);
 
 /// Runs the cells with `threads` workers (0 = all cores).
 std::vector<PeerCellResult> runPeerStudy(const std::vector<PeerCell>& cells,

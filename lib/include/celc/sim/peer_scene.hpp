@@ -63,6 +63,10 @@ struct PeerSceneOptions {
 
   static CameraModel defaultCamera();  ///< 640 x 480, f = 320 px, (cx, cy) = (320, 240)
 };
+/// PeerSceneOptions' scalar fields with their units and ranges
+/// (core/fields.hpp); validate() checks them, the relations between them,
+/// the camera and the line fit.
+void describe(FieldVisitor& v, PeerSceneOptions& options);
 
 /// One generated trial.
 struct PeerSceneTrial {
