@@ -89,7 +89,7 @@ TEST(IoCalibrationBad, UnknownKeysWrongTypesAndValues) {
   check("camera: {width: 240, height: 180, fx: 200, fy: 200, cx: 120, cy: 90, distortion_model: equidistant, "
         "distortion: [1, 2, 3]}\n",
         {"camera.distortion", "found 3"});
-  check("camera: {width: 240, height: 180, fx: -200, fy: 200, cx: 120, cy: 90}\n", {"key 'camera'", "focal lengths"});
+  check("camera: {width: 240, height: 180, fx: -200, fy: 200, cx: 120, cy: 90}\n", {"key 'camera.fx'", "must be > 0"});
   check("camera: [1, 2\n", {"YAML syntax"});
   check("- 1\n- 2\n", {"expected a map"});
   EXPECT_THROW(loadCalibrationYaml(d.file("missing.yaml")), celc::ConfigError);

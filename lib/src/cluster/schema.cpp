@@ -58,8 +58,11 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
 }
 
 void describe(FieldVisitor& v, ObservationOptions& o) {
-  v.field({"min_events", "events", "clusters with fewer usable events are skipped"}, o.min_events);
-  v.field({"merge_px", "px", "clusters within this median distance of each other's moving line become one (fragments of one edge); 0 = off"},
+  v.field({"min_events", "events", "clusters with fewer usable events are skipped", atLeast(2)}, o.min_events);
+  v.field({"merge_px", "px",
+           "clusters within this median distance of each other's moving line become one (fragments of one edge); "
+           "0 = off",
+           within(0, 20)},
           o.merge_px);
 }
 

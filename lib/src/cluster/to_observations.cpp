@@ -69,13 +69,7 @@ void mergeFragments(std::vector<ClusterObservation>& built, std::vector<ClusterL
 
 }  // namespace
 
-std::string ObservationOptions::validate() const {
-  std::ostringstream err;
-  err << lines.validate();
-  if (min_events < 2) err << "min_events must be >= 2; ";
-  if (!(merge_px >= 0.0 && merge_px <= 20.0)) err << "merge_px must be in [0, 20]; ";
-  return err.str();
-}
+std::string ObservationOptions::validate() const { return lines.validate() + rangeProblemsOf(*this); }
 
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,

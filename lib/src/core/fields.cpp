@@ -126,4 +126,12 @@ std::string inSection(const std::string& section, const std::string& problems) {
   return out;
 }
 
+void failOnFirstProblem(FieldVisitor& v, const std::string& problems) {
+  if (problems.empty()) return;
+  const std::string first = problems.substr(0, problems.find("; "));
+  const auto colon = first.find(": ");
+  if (colon == std::string::npos) v.fail("", first);
+  v.fail(first.substr(0, colon).c_str(), first.substr(colon + 2));
+}
+
 }  // namespace celc

@@ -74,15 +74,6 @@ Vec3 CameraModel::bearing(const Vec2& pixel) const {
   return {xu.x(), xu.y(), 1.0};
 }
 
-std::string CameraModel::validate() const {
-  std::ostringstream err;
-  if (width <= 0 || height <= 0) err << "resolution must be positive; ";
-  if (!(fx > 0.0) || !(fy > 0.0) || !std::isfinite(fx) || !std::isfinite(fy))
-    err << "focal lengths must be positive and finite; ";
-  if (!std::isfinite(cx) || !std::isfinite(cy)) err << "principal point must be finite; ";
-  for (double c : coeffs)
-    if (!std::isfinite(c)) err << "distortion coefficients must be finite; ";
-  return err.str();
-}
+std::string CameraModel::validate() const { return rangeProblemsOf(*this); }
 
 }  // namespace celc

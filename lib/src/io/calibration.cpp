@@ -43,7 +43,7 @@ void describeCalibration(FieldVisitor& v, Calibration& c) {
       s.fail("distortion", "non-zero coefficients with distortion_model none");
     if (c.camera.distortion == DistortionModel::Equidistant && k[4] != 0.0)
       s.fail("distortion", "expected 4 numbers for equidistant");
-    if (const std::string err = c.camera.validate(); !err.empty()) s.fail("", err);
+    failOnFirstProblem(s, c.camera.validate());
   });
   c.has_imu = v.has("imu");
   v.section({"imu", "", "the IMU relative to the camera"}, [&](FieldVisitor& s) {

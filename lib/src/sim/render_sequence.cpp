@@ -23,26 +23,6 @@ std::string ImuOptions::validate() const { return rangeProblemsOf(*this); }
 
 std::string GroundTruthOptions::validate() const { return rangeProblemsOf(*this); }
 
-std::string SynthConfig::validate() const {
-  std::string e;
-  if (!(duration > 0.0) || !(duration <= 3600.0)) e += "duration must be in (0, 3600] s; ";
-  if (!(background >= 0.0 && background <= 1.0)) e += "background must be in [0, 1]; ";
-  if (planes.empty()) e += "the scene needs at least one plane; ";
-  if (planes.size() > 16) e += "at most 16 planes; ";
-  for (size_t i = 0; i < planes.size(); ++i) {
-    const std::string p = planes[i].validate();
-    if (!p.empty()) e += "planes[" + std::to_string(i) + "]: " + p;
-  }
-  const std::string c = camera.validate();
-  if (!c.empty()) e += "camera: " + c;
-  const std::string t = trajectory.validate();
-  if (!t.empty()) e += "trajectory: " + t;
-  const std::string r = events.validate();
-  if (!r.empty()) e += "events: " + r;
-  e += inSection("imu", imu.validate());
-  e += inSection("groundtruth", groundtruth.validate());
-  return e;
-}
 
 CameraModel cameraPreset(const std::string& name) {
   CameraModel c;

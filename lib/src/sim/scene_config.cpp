@@ -12,16 +12,6 @@ namespace celc {
 
 namespace {
 
-/// Fails the read with validate()'s first problem, "key: what; ...", under
-/// its key (v.fail names the file, the line and the section).
-void failOnFirstProblem(FieldVisitor& v, const std::string& problems) {
-  if (problems.empty()) return;
-  const std::string first = problems.substr(0, problems.find("; "));
-  const auto colon = first.find(": ");
-  if (colon == std::string::npos) v.fail("", first);
-  v.fail(first.substr(0, colon).c_str(), first.substr(colon + 2));
-}
-
 bool isRotation(const Mat3& R) {
   return (R.transpose() * R - Mat3::Identity()).norm() <= 1e-6 && R.determinant() > 0.0;
 }
@@ -184,12 +174,43 @@ void describe(FieldVisitor& v, GroundTruthOptions& o) {
     if (const std::string err = o.validate(); !err.empty()) v.fail("", err);
 }
 
-void describe(FieldVisitor& v, SynthConfig& c) {
+namespace {
+/// The scene's own scalars (the sections have their own describe()).
+void describeSceneScalars(FieldVisitor& v, SynthConfig& c) {
   v.field({"seed", "", "seed of the textures, thresholds and noise"}, c.seed);
-  v.field({"duration", "s", "length of the sequence, (0, 3600]"}, c.duration);
-  if (!(c.duration > 0.0) || c.duration > 3600.0) v.fail("duration", "must be in (0, 3600] s");
-  v.field({"background", "-", "intensity where no plane is seen, [0, 1]"}, c.background);
-  if (!(c.background >= 0.0 && c.background <= 1.0)) v.fail("background", "must be in [0, 1]");
+  v.field({"duration", "s", "length of the sequence", withinAbove(0, 3600)}, c.duration);
+  v.field({"background", "-", "intensity where no plane is seen", within(0, 1)}, c.background);
+}
+
+/// describeSceneScalars' range problems of c.
+std::string sceneScalarProblems(const SynthConfig& c) {
+  SynthConfig copy = c;
+  return rangeProblems(Describe([&](FieldVisitor& v) { describeSceneScalars(v, copy); }));
+}
+}  // namespace
+
+std::string SynthConfig::validate() const {
+  std::string e = sceneScalarProblems(*this);
+  if (planes.empty()) e += "the scene needs at least one plane; ";
+  if (planes.size() > 16) e += "at most 16 planes; ";
+  for (size_t i = 0; i < planes.size(); ++i) {
+    const std::string p = planes[i].validate();
+    if (!p.empty()) e += "planes[" + std::to_string(i) + "]: " + p;
+  }
+  const std::string c = camera.validate();
+  if (!c.empty()) e += "camera: " + c;
+  const std::string t = trajectory.validate();
+  if (!t.empty()) e += "trajectory: " + t;
+  const std::string r = events.validate();
+  if (!r.empty()) e += "events: " + r;
+  e += inSection("imu", imu.validate());
+  e += inSection("groundtruth", groundtruth.validate());
+  return e;
+}
+
+void describe(FieldVisitor& v, SynthConfig& c) {
+  describeSceneScalars(v, c);
+  if (v.reading()) failOnFirstProblem(v, sceneScalarProblems(c));
   v.section({"camera", "", "the event camera"}, [&](FieldVisitor& s) { describeCamera(s, c); });
   v.require("planes");
   v.items({"planes", "", "textured planes of the scene (1 to 16)"}, c.planes, describePlane);

@@ -175,6 +175,11 @@ std::string rangeProblemsOf(const Options& options) {
   return rangeProblems(Describe([&](FieldVisitor& v) { describe(v, copy); }));
 }
 
+/// Fails a read (FieldVisitor::fail: the file, the line, the section) with
+/// the first of validate()'s problems, "key: what; ...", under its key; does
+/// nothing when there are none.
+void failOnFirstProblem(FieldVisitor& v, const std::string& problems);
+
 /// "key: what; key: what; " of one section's validate() with "section." put
 /// before every key.
 std::string inSection(const std::string& section, const std::string& problems);
