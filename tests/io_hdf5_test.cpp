@@ -1,4 +1,4 @@
-// HDF5 input, DSEC and MVSEC layouts: the fixtures (tests/fixtures/make_fixtures.py)
+// HDF5 input, DSEC and MVSEC layouts: the fixtures (tests/fixtures/make_fixtures.cpp)
 // hold the sequence `celc synth` rendered as text, and must read back as it.
 #include <gtest/gtest.h>
 
@@ -32,7 +32,8 @@ TEST(IoHdf5, DsecLayoutReadsAsTheText) {
 
 TEST(IoHdf5, BloscCompressedDsecReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
-  if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
+  ASSERT_TRUE(fs::exists(fixture("seq_blosc.h5")))
+      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
   auto r = openEventSource(fixture("seq_blosc.h5"));
   celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
 }
@@ -136,7 +137,8 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
 // A compressed dataset whose filter plugin cannot be found: the error names the filter and the package.
 TEST(IoHdf5, MissingFilterPluginIsNamed) {
   CELC_REQUIRE_IO_FIXTURES();
-  if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
+  ASSERT_TRUE(fs::exists(fixture("seq_blosc.h5")))
+      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
   const fs::path d = celc::test::freshTempDir("io_hdf5_filter");
   const auto r = celc::test::runCelc("info '" + fixture("seq_blosc.h5") + "'", d);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -1,4 +1,4 @@
-// ROS bag input: the fixtures of tests/fixtures/make_fixtures.py hold the
+// ROS bag input: the fixtures of tests/fixtures/make_fixtures.cpp hold the
 // sequence `celc synth` rendered as text, so every bag must read back as the
 // text does, bit for bit.
 #include <gtest/gtest.h>
