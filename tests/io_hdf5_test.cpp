@@ -127,7 +127,7 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
     });
     EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-    // cut inside the root group's header (at byte 96 of h5py's files): said before the library reads it
+    // cut inside the root group's header (at byte 96 of the fixtures): said before the library reads it
     if (keep == 100) {
       EXPECT_NE(m.find(": object header of /: the file ends inside it (truncated?)"), std::string::npos) << m;
     }
@@ -200,7 +200,7 @@ TEST(IoHdf5, HeaderChunksPastTheFileAreRefusedBeforeTheLibraryReadsThem) {
     const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     celc::detail::BinFile raw(fixture(name));
     const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
-    const int version = sb.version <= 1 ? 1 : 2;  // h5py: the earliest versions, or the newest
+    const int version = sb.version <= 1 ? 1 : 2;  // the fixtures: the earliest versions, or the newest
     for (const std::string object : {"/", "/events", "/events/y"}) {
       const std::uint64_t address =
           object == "/" ? sb.root_header : celc::detail::hdf5LinkAddress(fixture(name), object);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <random>
 
 #include "celc/core/yaml.hpp"
@@ -18,6 +19,8 @@
 #include "celc/pipeline/batch.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/render_sequence.hpp"
+#include "bag_writer.hpp"
+#include "h5_writer.hpp"
 #include "io/ros_messages.hpp"
 #include "io_test_util.hpp"
 
@@ -51,16 +54,21 @@ void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
 }
 
-/// Writes `path` with a Python script (its sys.argv[1]) run by Debian's
-/// python3; false when it fails (a module such as python3-h5py missing).
-bool writeWithPython(const TempDir& d, const std::string& path, const std::string& script) {
-  const std::string py = d.file("write.py");
-  writeBytes(py, script);
-  return std::system(("/usr/bin/python3 '" + py + "' '" + path + "' 2>/dev/null").c_str()) == 0;
+/// `n` values first, first + step, ... of type T.
+template <class T>
+std::vector<T> range(std::size_t n, T first = T(0), T step = T(1)) {
+  std::vector<T> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = T(first + T(i) * step);
+  return v;
 }
-/// The same with h5py (`f`, the file open for writing) and numpy (`np`).
-bool writeWithH5py(const TempDir& d, const std::string& path, const std::string& body) {
-  return writeWithPython(d, path, "import sys, numpy as np, h5py\nwith h5py.File(sys.argv[1], 'w') as f:\n" + body);
+/// MVSEC events, n x 4 doubles: x = y = 0, t = t0 + i dt, polarity 1.
+std::vector<double> mvsecEvents(std::size_t n, double t0, double dt) {
+  std::vector<double> ev(n * 4, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    ev[4 * i + 2] = t0 + double(i) * dt;
+    ev[4 * i + 3] = 1.0;
+  }
+  return ev;
 }
 
 /// Which place of a pattern patchBytes() edits.
@@ -467,15 +475,17 @@ TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
 
 TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
   // An MVSEC file whose events are stored in unfiltered chunks of 16 x 4 doubles
-  // (512 bytes each), written by h5py; then the layout message's chunk rows
+  // (512 bytes each), written by libhdf5; then the layout message's chunk rows
   // 16 -> 199 (the fuzzer's change): the HDF5 library used to copy 6368 bytes
   // out of each 512-byte chunk buffer (a heap overflow inside libhdf5).
   TempDir d;
   const std::string h5 = d.file("m.h5");
-  if (!writeWithH5py(d, h5,
-                     "    ev = np.zeros((60, 4)); ev[:, 2] = 1.0 + np.arange(60) * 1e-5; ev[:, 3] = 1.0\n"
-                     "    f.create_dataset('davis/left/events', data=ev, chunks=(16, 4))\n"))
-    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  {
+    celc::test::h5::File f(h5);
+    celc::test::h5::DatasetOptions chunked;
+    chunked.chunks = {16, 4};
+    f.write("davis/left/events", mvsecEvents(60, 1.0, 1e-5), {60, 4}, chunked);
+  }
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the layout message's dimensions: chunk rows, columns, then the element size (uint32 each)
   ASSERT_TRUE(patchBytes(h5, std::string("\x10\x00\x00\x00\x04\x00\x00\x00\x08\x00\x00\x00", 12), 0, "\xC7"));
@@ -485,21 +495,21 @@ TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
 
 TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
   // A DSEC file whose /events/x is stored compact (in its object header, 60
-  // uint16 = 120 bytes), written by h5py; then the layout message's compact size
+  // uint16 = 120 bytes), written by libhdf5; then the layout message's compact size
   // 120 -> 0 (the fuzzer turned a chunked layout into a compact one of no
   // bytes): the HDF5 library used to copy the values from a null buffer.
   TempDir d;
   const std::string h5 = d.file("c.h5");
-  if (!writeWithH5py(d, h5,
-                     "    n = 60\n"
-                     "    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)\n"
-                     "    dcpl.set_layout(h5py.h5d.COMPACT)\n"
-                     "    g = f.create_group('events')\n"
-                     "    x = np.arange(n, dtype=np.uint16) + 0x4100\n"
-                     "    h5py.h5d.create(g.id, b'x', h5py.h5t.STD_U16LE, h5py.h5s.create_simple((n,)), dcpl=dcpl)"
-                     ".write(h5py.h5s.ALL, h5py.h5s.ALL, x)\n"
-                     "    g['y'] = np.zeros(n, np.uint16); g['t'] = np.arange(n, dtype=np.uint32); g['p'] = np.ones(n, np.uint8)\n"))
-    GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  {
+    const std::size_t n = 60;
+    celc::test::h5::File f(h5);
+    celc::test::h5::DatasetOptions compact;
+    compact.compact = true;
+    f.write("events/x", range<std::uint16_t>(n, 0x4100), {}, compact);
+    f.write("events/y", std::vector<std::uint16_t>(n, 0));
+    f.write("events/t", range<std::uint32_t>(n));
+    f.write("events/p", std::vector<std::uint8_t>(n, 1));
+  }
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
   ASSERT_TRUE(patchBytes(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, std::string(1, '\0')));
@@ -509,26 +519,29 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
 
 TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
   // A DSEC file whose /events/x is stored in gzip chunks of 32 values, written
-  // by h5py; then the chunk index's stored size of chunk 0 (a uint32 followed
+  // by libhdf5; then the chunk index's stored size of chunk 0 (a uint32 followed
   // by the filter mask and the chunk's offsets, all 0) -> 0x745F0000 (found by
   // the CI fuzz run): the HDF5 library allocated 1.9 GB to read it.
   TempDir d;
   const std::string h5 = d.file("z.h5");
-  if (!writeWithPython(d, h5,
-                       "import sys, struct, numpy as np, h5py\n"
-                       "n = 60\n"
-                       "with h5py.File(sys.argv[1], 'w') as f:\n"
-                       "    f.create_dataset('events/x', data=np.arange(n, dtype=np.uint16), chunks=(32,), compression='gzip')\n"
-                       "    f['events/y'] = np.zeros(n, np.uint16); f['events/t'] = np.arange(n, dtype=np.uint32)\n"
-                       "    f['events/p'] = np.ones(n, np.uint8)\n"
-                       "    size = f['events/x'].id.get_chunk_info(0).size\n"
-                       "data = bytearray(open(sys.argv[1], 'rb').read())\n"
-                       "key = struct.pack('<II', size, 0) + bytes(16)\n"
-                       "assert data.count(key) == 1\n"
-                       "at = data.index(key)\n"
-                       "data[at:at + 4] = struct.pack('<I', 0x745F0000)\n"
-                       "open(sys.argv[1], 'wb').write(data)\n"))
-    GTEST_SKIP() << "python3-h5py missing, or its chunk index is not where this test patches it";
+  unsigned long long size = 0;
+  {
+    const std::size_t n = 60;
+    celc::test::h5::File f(h5);
+    celc::test::h5::DatasetOptions gzip;
+    gzip.chunks = {32};
+    gzip.gzip = 4;
+    f.write("events/x", range<std::uint16_t>(n), {}, gzip);
+    f.write("events/y", std::vector<std::uint16_t>(n, 0));
+    f.write("events/t", range<std::uint32_t>(n));
+    f.write("events/p", std::vector<std::uint8_t>(n, 1));
+    size = f.chunkStoredSize("events/x", 0);
+  }
+  // the chunk index entry: stored size, filter mask 0, offsets 0 (two uint64)
+  std::string key(24, '\0');
+  const auto size32 = std::uint32_t(size);
+  std::memcpy(&key[0], &size32, 4);
+  ASSERT_TRUE(patchBytes(h5, key, 0, "\x00\x00\x5F\x74"));
   EXPECT_IO_ERROR(celc::test::drain(h5), "z.h5: dataset /events/x: compressed chunk 0 at byte",
                   "claims 1952382976 bytes, more than the file's");
 }
@@ -536,19 +549,17 @@ TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
 // ---- found by fuzz_rosbag: a connection header whose field length runs past its data ---
 
 TEST(IoRobustness, BagConnectionHeaderFieldBeyondItsDataIsAnError) {
-  // A bag with one std_msgs/String message (python3-rosbag); then, in the index
+  // A bag with one std_msgs/String message (the test tree's bag writer); then, in the index
   // section, the length of the connection header's `topic=/t` field 8 ->
   // 0x7FFFFFF0: the bag library copied that many bytes out of its buffer while
   // opening the bag (a heap overflow inside librosbag-storage).
   TempDir d;
   const std::string bag = d.file("c.bag");
-  if (!writeWithPython(d, bag,
-                       "import sys, genpy, genpy.dynamic, rosbag\n"
-                       "S = genpy.dynamic.generate_dynamic('std_msgs/String', 'string data\\n')['std_msgs/String']\n"
-                       "with rosbag.Bag(sys.argv[1], 'w') as b:\n"
-                       "    m = S(); m.data = 'hello'\n"
-                       "    b.write('/t', m, genpy.Time(1, 0))\n"))
-    GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
+  {
+    namespace rb = celc::test::bag;
+    rb::Writer b(bag, rb::Compression::None);
+    b.write("/t", rb::messageType("std_msgs/String"), rb::string("hello"), rb::Time{1, 0});
+  }
   EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
   // the index section's copy of the field (the chunk holds the other)
   ASSERT_TRUE(patchBytes(bag, std::string("\x08\x00\x00\x00topic=/t", 12), 0, "\xF0\xFF\xFF\x7F", Place::LastOfSeveral));
@@ -585,7 +596,7 @@ TEST(IoRobustness, Bag12RecordHeaderLongerThanTheFileIsAnError) {
 // ---- a bag's index against its messages ------------------------------------------
 
 TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
-  // A bag of two std_msgs/String topics in several chunks (python3-rosbag),
+  // A bag of two std_msgs/String topics in several chunks (the test tree's bag writer),
   // then three copies: the connection id of the first index data record after
   // the second chunk swapped for the other topic's (the library decoded those
   // messages as the other topic's type) or for an id no connection declares
@@ -593,40 +604,47 @@ TEST(IoRobustness, BagIndexConnectionMustBeItsMessagesConnection) {
   // library's "wanted 4 bytes").
   TempDir d;
   const std::string bag = d.file("c.bag");
-  if (!writeWithPython(d, bag,
-                       "import sys, struct, genpy, genpy.dynamic, rosbag\n"
-                       "S = genpy.dynamic.generate_dynamic('std_msgs/String', 'string data\\n')['std_msgs/String']\n"
-                       "out = sys.argv[1]\n"
-                       "with rosbag.Bag(out, 'w', chunk_threshold=300) as b:\n"
-                       "    for i in range(12):\n"
-                       "        m = S(); m.data = 'x' * 64\n"
-                       "        b.write('/a', m, genpy.Time(1 + i, 0)); b.write('/b', m, genpy.Time(1 + i, 5))\n"
-                       "data = bytearray(open(out, 'rb').read())\n"
-                       "recs, p = [], 13\n"
-                       "while p < len(data):\n"
-                       "    hl = struct.unpack_from('<I', data, p)[0]; q, f = p + 4, {}\n"
-                       "    while q < p + 4 + hl:\n"
-                       "        n = struct.unpack_from('<I', data, q)[0]; k = bytes(data[q + 4:q + 4 + n]).split(b'=')[0]\n"
-                       "        f[k] = q + 4 + len(k) + 1; q += 4 + n\n"
-                       "    recs.append((p, data[f[b'op']], f, q + 4)); p = q + 4 + struct.unpack_from('<I', data, q)[0]\n"
-                       "chunks = [i for i, r in enumerate(recs) if r[1] == 5]\n"
-                       "assert len(chunks) >= 3\n"
-                       "ix = recs[chunks[1] + 1]; assert ix[1] == 4\n"
-                       "at = ix[2][b'conn']; conn = struct.unpack_from('<I', data, at)[0]\n"
-                       "for name, value in (('mis', 1 - conn), ('unk', 7)):\n"
-                       "    c = bytearray(data); struct.pack_into('<I', c, at, value); open(out + '.' + name, 'wb').write(c)\n"
-                       "info = [r for r in recs if r[1] == 6][0]\n"
-                       "c = bytearray(data); struct.pack_into('<I', c, info[2][b'count'], 0x7FFFFFFF)\n"
-                       "open(out + '.ci', 'wb').write(c)\n"
-                       "q = recs[chunks[0]][3] + 4 + struct.unpack_from('<I', data, recs[chunks[0]][3])[0] + 4\n"
-                       "at_msg = data.index(b'conn=', q) + 5\n"
-                       "c = bytearray(data); struct.pack_into('<I', c, at_msg, 7); open(out + '.msg', 'wb').write(c)\n"
-                       "open(out + '.at', 'w').write('%d %d %d %d' % (ix[0], conn, info[0], recs[chunks[0]][0]))\n"))
-    GTEST_SKIP() << "python3-rosbag missing (scripts/setup.sh installs it)";
+  namespace rb = celc::test::bag;
+  {
+    rb::Writer b(bag, rb::Compression::None, 300);
+    const auto& type = rb::messageType("std_msgs/String");
+    for (std::uint32_t i = 0; i < 12; ++i) {
+      b.write("/a", type, rb::string(std::string(64, 'x')), rb::Time{1 + i, 0});
+      b.write("/b", type, rb::string(std::string(64, 'x')), rb::Time{1 + i, 5});
+    }
+  }
+  const std::string data = readBytes(bag);
+  const auto recs = rb::records(data);
+  std::vector<std::size_t> chunks;
+  for (std::size_t i = 0; i < recs.size(); ++i)
+    if (recs[i].op == 5) chunks.push_back(i);
+  ASSERT_GE(chunks.size(), 3u);
+  const rb::Record& ix = recs[chunks[1] + 1];
+  ASSERT_EQ(ix.op, 4);
+  const std::uint64_t conn = rb::readU32(data, ix.at("conn"));
+  for (const auto& [ext, value] : {std::pair<const char*, std::uint32_t>{".mis", std::uint32_t(1 - conn)}, {".unk", 7u}}) {
+    std::string c = data;
+    rb::writeU32(c, ix.at("conn"), value);
+    writeBytes(bag + ext, c);
+  }
+  const rb::Record* info = nullptr;
+  for (const auto& r : recs)
+    if (r.op == 6 && !info) info = &r;
+  ASSERT_NE(info, nullptr);
+  {
+    std::string c = data;
+    rb::writeU32(c, info->at("count"), 0x7FFFFFFF);
+    writeBytes(bag + ".ci", c);
+  }
+  {  // the first message data record of the first chunk: after the /a connection record that opens it
+    const rb::Record& chunk = recs[chunks[0]];
+    const std::size_t first_data = chunk.data_at + 4 + rb::readU32(data, chunk.data_at) + 4;
+    std::string c = data;
+    rb::writeU32(c, data.find("conn=", first_data) + 5, 7);
+    writeBytes(bag + ".msg", c);
+  }
+  const std::uint64_t index_at = ix.start, info_at = info->start, chunk_at = recs[chunks[0]].start;
   EXPECT_IO_ERROR(celc::test::drain(bag), "no dvs_msgs/EventArray topic");  // the file as written opens
-  std::istringstream at(readBytes(bag + ".at"));
-  std::uint64_t index_at = 0, conn = 0, info_at = 0, chunk_at = 0;
-  ASSERT_TRUE(at >> index_at >> conn >> info_at >> chunk_at);
   const std::string other = std::to_string(1 - conn);
   // the first entry of the index data record: its data follows the header
   EXPECT_IO_ERROR(celc::test::drain(bag + ".mis"), "c.bag.mis: byte ",
@@ -758,16 +776,22 @@ TEST(IoRobustness, BackwardsToleranceIsCumulativeNotPerStep) {
 
 TEST(IoRobustness, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
   TempDir d;
-  auto dsec = [&](const std::string& name, const std::string& x, const std::string& y, const std::string& t,
-                  const std::string& p) {
-    return writeWithH5py(d, d.file(name),
-                         "    n = 6\n"
-                         "    f['events/x'] = " + x + "\n    f['events/y'] = " + y + "\n    f['events/t'] = " + t +
-                             "\n    f['events/p'] = " + p + "\n");
+  // one DSEC column: writes its values into the named dataset
+  using Column = std::function<void(celc::test::h5::File&, const std::string&)>;
+  const auto column = [](auto values) -> Column {
+    return [values](celc::test::h5::File& f, const std::string& name) { f.write(name, values); };
   };
-  const std::string x = "np.arange(6, dtype=np.uint16)", y = "np.arange(6, dtype=np.int32)",
-                    t = "np.arange(6, dtype=np.int64) * 10", p = "np.array([0, 1, 1, 0, 1, 0], np.uint8)";
-  if (!dsec("ok.h5", x, y, t, p)) GTEST_SKIP() << "python3-h5py missing (scripts/setup.sh installs it)";
+  auto dsec = [&](const std::string& name, const Column& x, const Column& y, const Column& t, const Column& p) {
+    celc::test::h5::File f(d.file(name));
+    x(f, "events/x");
+    y(f, "events/y");
+    t(f, "events/t");
+    p(f, "events/p");
+    return true;
+  };
+  const Column x = column(range<std::uint16_t>(6)), y = column(range<std::int32_t>(6)),
+               t = column(range<std::int64_t>(6, 0, 10)), p = column(std::vector<std::uint8_t>{0, 1, 1, 0, 1, 0});
+  ASSERT_TRUE(dsec("ok.h5", x, y, t, p));
   {
     auto r = openEventSource(d.file("ok.h5"));
     const auto ev = readAllEvents(*r);
@@ -777,27 +801,35 @@ TEST(IoRobustness, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
     EXPECT_TRUE(ev[1].on);
     EXPECT_FALSE(ev[3].on);
   }
-  ASSERT_TRUE(dsec("tf.h5", x, y, "np.arange(6) * 0.01", p));  // float64 seconds
+  ASSERT_TRUE(dsec("tf.h5", x, y, column(range<double>(6, 0.0, 0.01)), p));  // float64 seconds
   EXPECT_IO_ERROR(openEventSource(d.file("tf.h5")), "tf.h5: dataset /events/t: type float64, expected integers",
                   "microseconds as integers");
-  ASSERT_TRUE(dsec("yn.h5", x, "np.array([0, 1, 2, -5, 4, 5], np.int32)", t, p));
+  ASSERT_TRUE(dsec("yn.h5", x, column(std::vector<std::int32_t>{0, 1, 2, -5, 4, 5}), t, p));
   EXPECT_IO_ERROR(celc::test::drain(d.file("yn.h5")), "yn.h5: dataset /events/y: row 3: value -5 outside [0, 65535]");
-  ASSERT_TRUE(dsec("yb.h5", x, "np.array([0, 1, 70000, 3, 4, 5], np.int32)", t, p));
+  ASSERT_TRUE(dsec("yb.h5", x, column(std::vector<std::int32_t>{0, 1, 70000, 3, 4, 5}), t, p));
   EXPECT_IO_ERROR(celc::test::drain(d.file("yb.h5")), "yb.h5: dataset /events/y: row 2: value 70000 outside");
-  ASSERT_TRUE(dsec("pf.h5", x, y, t, "np.array([0, 0.9, 1, 0, 1, 0], np.float32)"));
+  ASSERT_TRUE(dsec("pf.h5", x, y, t, column(std::vector<float>{0, 0.9f, 1, 0, 1, 0})));
   EXPECT_IO_ERROR(openEventSource(d.file("pf.h5")), "pf.h5: dataset /events/p: type float32, expected integers");
-  ASSERT_TRUE(dsec("p7.h5", x, y, t, "np.array([0, 1, 7, 0, 1, 0], np.uint8)"));
+  ASSERT_TRUE(dsec("p7.h5", x, y, t, column(std::vector<std::uint8_t>{0, 1, 7, 0, 1, 0})));
   EXPECT_IO_ERROR(celc::test::drain(d.file("p7.h5")), "p7.h5: dataset /events/p: row 2: polarity 7 (expected 0 or 1)");
-  ASSERT_TRUE(dsec("xs.h5", "np.array(['1', '2', '3', '4', '5', '6'], dtype=h5py.string_dtype())", y, t, p));
+  const Column strings = [](celc::test::h5::File& f, const std::string& name) {
+    f.writeStrings(name, {"1", "2", "3", "4", "5", "6"});
+  };
+  ASSERT_TRUE(dsec("xs.h5", strings, y, t, p));
   EXPECT_IO_ERROR(openEventSource(d.file("xs.h5")),
                   "xs.h5: dataset /events/x: type variable-length string, expected integers");
   // MVSEC: N x 4 numbers, polarity -1 / 1 (0 read as OFF); 0.9 is not a polarity.
-  ASSERT_TRUE(writeWithH5py(d, d.file("mp.h5"),
-                            "    ev = np.zeros((5, 4)); ev[:, 2] = 1.0 + np.arange(5) * 1e-3; ev[:, 3] = 1.0\n"
-                            "    ev[3, 3] = 0.9\n"
-                            "    f['davis/left/events'] = ev\n"));
+  {
+    auto ev = mvsecEvents(5, 1.0, 1e-3);
+    ev[4 * 3 + 3] = 0.9;
+    celc::test::h5::File f(d.file("mp.h5"));
+    f.write("davis/left/events", ev, {5, 4});
+  }
   EXPECT_IO_ERROR(celc::test::drain(d.file("mp.h5")), "mp.h5: dataset /davis/left/events, event 3: polarity 0.9");
-  ASSERT_TRUE(writeWithH5py(d, d.file("ms.h5"), "    f['davis/left/events'] = np.array([b'a', b'b'])\n"));
+  {
+    celc::test::h5::File f(d.file("ms.h5"));
+    f.writeFixedStrings("davis/left/events", {"a", "b"}, 1);
+  }
   EXPECT_IO_ERROR(openEventSource(d.file("ms.h5")), "ms.h5: dataset /davis/left/events: type string of 1 bytes");
 }
 
