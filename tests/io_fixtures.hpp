@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "celc/io/event_reader.hpp"
+#include "io_test_util.hpp"
 
 namespace celc::test {
 
@@ -49,21 +50,6 @@ inline void expectSameEvents(const std::vector<Event>& a, const std::vector<Even
       return;
     }
   }
-}
-
-/// The message of the IoError `f` throws ("" and a failure when it does not throw one).
-template <class F>
-std::string ioErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const IoError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not an IoError: " << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "no error";
-  return {};
 }
 
 }  // namespace celc::test
