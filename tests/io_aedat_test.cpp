@@ -136,10 +136,14 @@ TEST(IoAedat, Aedat31SourceFilter) {
   EXPECT_EQ(readAllEvents(*r1).size(), 1000u);
 }
 
-TEST(IoAedat, Aedat4RoundTripEveryCompression) {
+// The parameter: the packets' compression.
+class IoAedat4Compression : public ::testing::TestWithParam<Aedat4Compression> {};
+
+TEST_P(IoAedat4Compression, Aedat4RoundTripEveryCompression) {
   TempDir d;
   auto f = fixture(30000, 320, 240);
-  for (auto c : {Aedat4Compression::None, Aedat4Compression::Lz4, Aedat4Compression::Zstd}) {
+  {
+    const Aedat4Compression c = GetParam();
     const std::string p = d.file("a" + std::to_string(int(c)) + ".aedat4");
     writeAedat4(p, f.ev, f.imu, 320, 240, c, 4096, true);
     auto r = openEventSource(p);
@@ -155,6 +159,13 @@ TEST(IoAedat, Aedat4RoundTripEveryCompression) {
     }
   }
 }
+INSTANTIATE_TEST_SUITE_P(Packets, IoAedat4Compression,
+                         ::testing::Values(Aedat4Compression::None, Aedat4Compression::Lz4, Aedat4Compression::Zstd),
+                         [](const ::testing::TestParamInfo<Aedat4Compression>& i) {
+                           return std::string(i.param == Aedat4Compression::None ? "none"
+                                              : i.param == Aedat4Compression::Lz4 ? "lz4"
+                                                                                  : "zstd");
+                         });
 
 TEST(IoAedat, Aedat4SeekWithDataTable) {
   TempDir d;
@@ -601,7 +612,10 @@ TEST(IoRobustness, Aedat2OneTimestampAllOnesIsAnOutlierNotAWrap) {
 
 // ---- truncated binary files: the complete packets, a warning ---------------------
 
-TEST(IoRobustness, TruncatedBinaryFilesYieldTheirCompletePackets) {
+// The parameter: the file written, by format (and AEDAT 4.0 compression).
+class IoRobustnessTruncated : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(IoRobustnessTruncated, TruncatedBinaryFilesYieldTheirCompletePackets) {
   TempDir d;
   const auto ev = celc::test::randomEvents(3000, 240, 180, 4, 2.0);
   const auto imu = celc::test::randomImu(ev.front().t, ev.back().t, 5);
@@ -614,7 +628,8 @@ TEST(IoRobustness, TruncatedBinaryFilesYieldTheirCompletePackets) {
   writeAedat4(d.file("n.aedat4"), ev, imu, 240, 180, Aedat4Compression::None, 500, true);
   writeAedat4(d.file("l.aedat4"), ev, imu, 240, 180, Aedat4Compression::Lz4, 500, true);
   writeAedat4(d.file("z.aedat4"), ev, imu, 240, 180, Aedat4Compression::Zstd, 500, false);
-  for (const char* name : {"a.aedat2", "a.aedat31", "n.aedat4", "l.aedat4", "z.aedat4"}) {
+  {
+    const char* name = GetParam();
     SCOPED_TRACE(name);
     const std::string b = readBytes(d.file(name));
     // cut at 60% of the file: inside an event packet (or the data table)
@@ -633,6 +648,12 @@ TEST(IoRobustness, TruncatedBinaryFilesYieldTheirCompletePackets) {
                     "byte " + std::to_string(cut));
   }
 }
+INSTANTIATE_TEST_SUITE_P(Formats, IoRobustnessTruncated,
+                         ::testing::Values("a.aedat2", "a.aedat31", "n.aedat4", "l.aedat4", "z.aedat4"),
+                         [](const ::testing::TestParamInfo<const char*>& i) {
+                           const std::string f = i.param;
+                           return f[0] == 'a' ? f.substr(2) : "aedat4_" + std::string(f[0] == 'n' ? "none" : f[0] == 'l' ? "lz4" : "zstd");
+                         });
 
 // ---- found by fuzz_aedat4_zstd: a Zstd frame asking for a huge window -------------
 

@@ -116,24 +116,29 @@ TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
 
 // ---- HDF5: dataset types and values checked as stored ----------------------------
 
+namespace {
+
+// One DSEC column: writes its values into the named dataset.
+using Column = std::function<void(celc::test::h5::File&, const std::string&)>;
+template <class T>
+Column column(std::vector<T> values) {
+  return [values](celc::test::h5::File& f, const std::string& name) { f.write(name, values); };
+}
+const Column kX = column(range<std::uint16_t>(6)), kY = column(range<std::int32_t>(6)),
+             kT = column(range<std::int64_t>(6, 0, 10)), kP = column(std::vector<std::uint8_t>{0, 1, 1, 0, 1, 0});
+void writeDsec(const std::string& path, const Column& x, const Column& y, const Column& t, const Column& p) {
+  celc::test::h5::File f(path);
+  x(f, "events/x");
+  y(f, "events/y");
+  t(f, "events/t");
+  p(f, "events/p");
+}
+
+}  // namespace
+
 TEST(IoRobustness, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
   TempDir d;
-  // one DSEC column: writes its values into the named dataset
-  using Column = std::function<void(celc::test::h5::File&, const std::string&)>;
-  const auto column = [](auto values) -> Column {
-    return [values](celc::test::h5::File& f, const std::string& name) { f.write(name, values); };
-  };
-  auto dsec = [&](const std::string& name, const Column& x, const Column& y, const Column& t, const Column& p) {
-    celc::test::h5::File f(d.file(name));
-    x(f, "events/x");
-    y(f, "events/y");
-    t(f, "events/t");
-    p(f, "events/p");
-    return true;
-  };
-  const Column x = column(range<std::uint16_t>(6)), y = column(range<std::int32_t>(6)),
-               t = column(range<std::int64_t>(6, 0, 10)), p = column(std::vector<std::uint8_t>{0, 1, 1, 0, 1, 0});
-  ASSERT_TRUE(dsec("ok.h5", x, y, t, p));
+  writeDsec(d.file("ok.h5"), kX, kY, kT, kP);
   {
     auto r = openEventSource(d.file("ok.h5"));
     const auto ev = readAllEvents(*r);
@@ -143,34 +148,75 @@ TEST(IoRobustness, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
     EXPECT_TRUE(ev[1].on);
     EXPECT_FALSE(ev[3].on);
   }
-  ASSERT_TRUE(dsec("tf.h5", x, y, column(range<double>(6, 0.0, 0.01)), p));  // float64 seconds
-  EXPECT_IO_ERROR(openEventSource(d.file("tf.h5")), "tf.h5: dataset /events/t: type float64, expected integers",
-                  "microseconds as integers");
-  ASSERT_TRUE(dsec("yn.h5", x, column(std::vector<std::int32_t>{0, 1, 2, -5, 4, 5}), t, p));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("yn.h5")), "yn.h5: dataset /events/y: row 3: value -5 outside [0, 65535]");
-  ASSERT_TRUE(dsec("yb.h5", x, column(std::vector<std::int32_t>{0, 1, 70000, 3, 4, 5}), t, p));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("yb.h5")), "yb.h5: dataset /events/y: row 2: value 70000 outside");
-  ASSERT_TRUE(dsec("pf.h5", x, y, t, column(std::vector<float>{0, 0.9f, 1, 0, 1, 0})));
-  EXPECT_IO_ERROR(openEventSource(d.file("pf.h5")), "pf.h5: dataset /events/p: type float32, expected integers");
-  ASSERT_TRUE(dsec("p7.h5", x, y, t, column(std::vector<std::uint8_t>{0, 1, 7, 0, 1, 0})));
-  EXPECT_IO_ERROR(celc::test::drain(d.file("p7.h5")), "p7.h5: dataset /events/p: row 2: polarity 7 (expected 0 or 1)");
-  const Column strings = [](celc::test::h5::File& f, const std::string& name) {
-    f.writeStrings(name, {"1", "2", "3", "4", "5", "6"});
-  };
-  ASSERT_TRUE(dsec("xs.h5", strings, y, t, p));
-  EXPECT_IO_ERROR(openEventSource(d.file("xs.h5")),
-                  "xs.h5: dataset /events/x: type variable-length string, expected integers");
-  // MVSEC: N x 4 numbers, polarity -1 / 1 (0 read as OFF); 0.9 is not a polarity.
-  {
-    auto ev = mvsecEvents(5, 1.0, 1e-3);
-    ev[4 * 3 + 3] = 0.9;
-    celc::test::h5::File f(d.file("mp.h5"));
-    f.write("davis/left/events", ev, {5, 4});
-  }
-  EXPECT_IO_ERROR(celc::test::drain(d.file("mp.h5")), "mp.h5: dataset /davis/left/events, event 3: polarity 0.9");
-  {
-    celc::test::h5::File f(d.file("ms.h5"));
-    f.writeFixedStrings("davis/left/events", {"a", "b"}, 1);
-  }
-  EXPECT_IO_ERROR(openEventSource(d.file("ms.h5")), "ms.h5: dataset /davis/left/events: type string of 1 bytes");
 }
+
+// A file the readers refuse: its name, how it is written, whether opening it
+// (a dataset's type) or reading it (a value) fails, and the message's fragments.
+struct Hdf5Refusal {
+  const char* label;
+  const char* file;
+  std::function<void(const std::string& path)> write;
+  bool on_open;
+  std::vector<std::string> fragments;
+};
+class IoRobustnessHdf5Types : public ::testing::TestWithParam<Hdf5Refusal> {};
+
+TEST_P(IoRobustnessHdf5Types, Hdf5DatasetTypesAndValuesAreCheckedBeforeConversion) {
+  TempDir d;
+  const Hdf5Refusal& c = GetParam();
+  c.write(d.file(c.file));
+  if (c.on_open) {
+    EXPECT_IO_ERROR(openEventSource(d.file(c.file)), c.fragments);
+  } else {
+    EXPECT_IO_ERROR(celc::test::drain(d.file(c.file)), c.fragments);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Datasets, IoRobustnessHdf5Types,
+    ::testing::Values(
+        Hdf5Refusal{"t_float64_seconds", "tf.h5",
+                    [](const std::string& f) { writeDsec(f, kX, kY, column(range<double>(6, 0.0, 0.01)), kP); }, true,
+                    {"tf.h5: dataset /events/t: type float64, expected integers", "microseconds as integers"}},
+        Hdf5Refusal{"y_negative", "yn.h5",
+                    [](const std::string& f) {
+                      writeDsec(f, kX, column(std::vector<std::int32_t>{0, 1, 2, -5, 4, 5}), kT, kP);
+                    },
+                    false, {"yn.h5: dataset /events/y: row 3: value -5 outside [0, 65535]"}},
+        Hdf5Refusal{"y_beyond_uint16", "yb.h5",
+                    [](const std::string& f) {
+                      writeDsec(f, kX, column(std::vector<std::int32_t>{0, 1, 70000, 3, 4, 5}), kT, kP);
+                    },
+                    false, {"yb.h5: dataset /events/y: row 2: value 70000 outside"}},
+        Hdf5Refusal{"p_float32", "pf.h5",
+                    [](const std::string& f) { writeDsec(f, kX, kY, kT, column(std::vector<float>{0, 0.9f, 1, 0, 1, 0})); },
+                    true, {"pf.h5: dataset /events/p: type float32, expected integers"}},
+        Hdf5Refusal{"p_seven", "p7.h5",
+                    [](const std::string& f) {
+                      writeDsec(f, kX, kY, kT, column(std::vector<std::uint8_t>{0, 1, 7, 0, 1, 0}));
+                    },
+                    false, {"p7.h5: dataset /events/p: row 2: polarity 7 (expected 0 or 1)"}},
+        Hdf5Refusal{"x_strings", "xs.h5",
+                    [](const std::string& f) {
+                      const Column strings = [](celc::test::h5::File& h, const std::string& name) {
+                        h.writeStrings(name, {"1", "2", "3", "4", "5", "6"});
+                      };
+                      writeDsec(f, strings, kY, kT, kP);
+                    },
+                    true, {"xs.h5: dataset /events/x: type variable-length string, expected integers"}},
+        // MVSEC: N x 4 numbers, polarity -1 / 1 (0 read as OFF); 0.9 is not a polarity.
+        Hdf5Refusal{"mvsec_polarity_fraction", "mp.h5",
+                    [](const std::string& f) {
+                      auto ev = mvsecEvents(5, 1.0, 1e-3);
+                      ev[4 * 3 + 3] = 0.9;
+                      celc::test::h5::File h(f);
+                      h.write("davis/left/events", ev, {5, 4});
+                    },
+                    false, {"mp.h5: dataset /davis/left/events, event 3: polarity 0.9"}},
+        Hdf5Refusal{"mvsec_strings", "ms.h5",
+                    [](const std::string& f) {
+                      celc::test::h5::File h(f);
+                      h.writeFixedStrings("davis/left/events", {"a", "b"}, 1);
+                    },
+                    true, {"ms.h5: dataset /davis/left/events: type string of 1 bytes"}}),
+    [](const ::testing::TestParamInfo<Hdf5Refusal>& i) { return std::string(i.param.label); });

@@ -20,23 +20,23 @@ using celc::test::fixture;
 using celc::test::fixtureSequence;
 using celc::test::ioErrorOf;
 
-TEST(IoHdf5, DsecLayoutReadsAsTheText) {
+// A DSEC file, uncompressed or blosc-compressed (the parameter), reads as the text.
+class IoHdf5Dsec : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(IoHdf5Dsec, DsecLayoutReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
-  auto r = openEventSource(fixture("seq_dsec.h5"));
+  const std::string name = std::string(GetParam()) == "blosc" ? "seq_blosc.h5" : "seq_dsec.h5";
+  ASSERT_TRUE(fs::exists(fixture(name)))
+      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
+  auto r = openEventSource(fixture(name));
   EXPECT_EQ(r->format(), Format::Hdf5);
   celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
   EXPECT_EQ(r->warnings().total(), 0u);
   EXPECT_TRUE(r->readImu().empty());
   EXPECT_TRUE(r->readPoses().empty());
 }
-
-TEST(IoHdf5, BloscCompressedDsecReadsAsTheText) {
-  CELC_REQUIRE_IO_FIXTURES();
-  ASSERT_TRUE(fs::exists(fixture("seq_blosc.h5")))
-      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
-  auto r = openEventSource(fixture("seq_blosc.h5"));
-  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
-}
+INSTANTIATE_TEST_SUITE_P(Storage, IoHdf5Dsec, ::testing::Values("uncompressed", "blosc"),
+                         [](const ::testing::TestParamInfo<const char*>& i) { return std::string(i.param); });
 
 TEST(IoHdf5, MvsecLayoutEventsImuPoses) {
   CELC_REQUIRE_IO_FIXTURES();
