@@ -149,41 +149,67 @@ TEST(IoText, PosesWithAndWithoutId) {
 
 // ---- bad input -------------------------------------------------------------
 
-TEST(IoTextBad, NonNumericFieldNamesFileAndLine) {
+// A text file a reader refuses: its name and content, the reader (events,
+// IMU or poses), and the fragments of the one-line error (with the file's
+// path when `names_path`).
+struct TextRefusal {
+  const char* label;
+  const char* file;
+  const char* content;
+  enum Reader { Events, Imu, Poses } reader;
+  std::vector<std::string> fragments;
+  bool names_path = false;
+};
+class IoTextBadFile : public ::testing::TestWithParam<TextRefusal> {};
+
+TEST_P(IoTextBadFile, RefusedWithItsLineAndReason) {
   TempDir d;
-  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), d.file("e.txt"), "line 3", "non-numeric x");
-  celc::test::writeBytes(d.file("t.txt"), "0.1 1 2 1\n0.2x 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("t.txt")), "line 2", "timestamp");
-  celc::test::writeBytes(d.file("n.txt"), "nan 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("n.txt")), "line 1", "timestamp");
+  const TextRefusal& c = GetParam();
+  celc::test::writeBytes(d.file(c.file), c.content);
+  std::vector<std::string> fragments = c.fragments;
+  if (c.names_path) fragments.insert(fragments.begin(), d.file(c.file));
+  switch (c.reader) {
+    case TextRefusal::Events:
+      EXPECT_IO_ERROR(celc::test::drain(d.file(c.file)), fragments);
+      break;
+    case TextRefusal::Imu:
+      EXPECT_IO_ERROR(readImuText(d.file(c.file)), fragments);
+      break;
+    case TextRefusal::Poses:
+      EXPECT_IO_ERROR(readPosesText(d.file(c.file)), fragments);
+      break;
+  }
 }
 
-TEST(IoTextBad, WrongColumnCounts) {
-  TempDir d;
-  celc::test::writeBytes(d.file("a.txt"), "0.1 1 2 1\n0.2 1 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("a.txt")), "line 2", "expected 4 columns, found 3");
-  celc::test::writeBytes(d.file("b.txt"), "0.1 1 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("b.txt")), "line 1", "unsupported column count 3");
-  celc::test::writeBytes(d.file("c.txt"), "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("c.txt")), "line 1", "column count");
-  celc::test::writeBytes(d.file("imu.txt"), "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n");
-  EXPECT_IO_ERROR(readImuText(d.file("imu.txt")), "imu.txt: line 2", "expected 7 columns");
-  celc::test::writeBytes(d.file("gt.txt"), "0.1 1 2 3 0 0 0\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("gt.txt")), "gt.txt: line 1", "column count 7");
-}
-
-TEST(IoTextBad, BadPolarityHeaderAndQuaternion) {
-  TempDir d;
-  celc::test::writeBytes(d.file("p.txt"), "0.1 1 2 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("p.txt")), "line 1", "polarity");
-  celc::test::writeBytes(d.file("h.txt"), "time col row sign\n0.1 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("h.txt")), "line 1", "header");
-  celc::test::writeBytes(d.file("q.txt"), "0.1 0 0 0 0 0 0 0\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("q.txt")), "line 1", "zero quaternion");
-  celc::test::writeBytes(d.file("qt.txt"), "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("qt.txt")), "line 2", "increase");
-}
+INSTANTIATE_TEST_SUITE_P(
+    IoTextBad, IoTextBadFile,
+    ::testing::Values(
+        // non-numeric fields name the file and the line
+        TextRefusal{"non_numeric_x", "e.txt", "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n", TextRefusal::Events,
+                    {"line 3", "non-numeric x"}, true},
+        TextRefusal{"non_numeric_time", "t.txt", "0.1 1 2 1\n0.2x 1 2 1\n", TextRefusal::Events,
+                    {"line 2", "timestamp"}},
+        TextRefusal{"nan_time", "n.txt", "nan 1 2 1\n", TextRefusal::Events, {"line 1", "timestamp"}},
+        // wrong column counts
+        TextRefusal{"short_row", "a.txt", "0.1 1 2 1\n0.2 1 2\n", TextRefusal::Events,
+                    {"line 2", "expected 4 columns, found 3"}},
+        TextRefusal{"three_columns", "b.txt", "0.1 1 2\n", TextRefusal::Events,
+                    {"line 1", "unsupported column count 3"}},
+        TextRefusal{"eighteen_columns", "c.txt", "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n",
+                    TextRefusal::Events, {"line 1", "column count"}},
+        TextRefusal{"imu_short_row", "imu.txt", "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n", TextRefusal::Imu,
+                    {"imu.txt: line 2", "expected 7 columns"}},
+        TextRefusal{"poses_seven_columns", "gt.txt", "0.1 1 2 3 0 0 0\n", TextRefusal::Poses,
+                    {"gt.txt: line 1", "column count 7"}},
+        // polarity, header, quaternion
+        TextRefusal{"polarity_two", "p.txt", "0.1 1 2 2\n", TextRefusal::Events, {"line 1", "polarity"}},
+        TextRefusal{"unknown_header", "h.txt", "time col row sign\n0.1 1 2 1\n", TextRefusal::Events,
+                    {"line 1", "header"}},
+        TextRefusal{"zero_quaternion", "q.txt", "0.1 0 0 0 0 0 0 0\n", TextRefusal::Poses,
+                    {"line 1", "zero quaternion"}},
+        TextRefusal{"poses_backwards", "qt.txt", "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n", TextRefusal::Poses,
+                    {"line 2", "increase"}}),
+    [](const ::testing::TestParamInfo<TextRefusal>& i) { return std::string(i.param.label); });
 
 TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   TempDir d;
