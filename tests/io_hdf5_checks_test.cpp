@@ -109,7 +109,7 @@ TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
   std::string key(24, '\0');
   const auto size32 = std::uint32_t(size);
   std::memcpy(&key[0], &size32, 4);
-  ASSERT_TRUE(patchBytes(h5, key, 0, "\x00\x00\x5F\x74"));
+  ASSERT_TRUE(patchBytes(h5, key, 0, std::string("\x00\x00\x5F\x74", 4)));
   EXPECT_IO_ERROR(celc::test::drain(h5), "z.h5: dataset /events/x: compressed chunk 0 at byte",
                   "claims 1952382976 bytes, more than the file's");
 }
