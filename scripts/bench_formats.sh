@@ -13,8 +13,8 @@
 # directory (or a folder holding an old celc and its libcelc_*.so): each case
 # then also runs it, alternating with this build, adds its events/s and the
 # ratio, and checks that both give the same windows.csv (scripts/same_windows.py).
-# The bag and HDF5 files are written with Debian's python3-rosbag and
-# python3-h5py (tests/fixtures/make_fixtures.py), AEDAT 4 with the Python module.
+# The bag and HDF5 files are written by celc_make_fixtures (the test tree's
+# bag writer and libhdf5), AEDAT 4 with the Python module.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${CELC_BUILD_DIR:-$root/build}"
@@ -24,18 +24,17 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
 "$build/celc" synth "$root/config/scenes/davis346_chessboard.yaml" -o "$work/seq" --duration "$seconds" -q
-PYTHONPATH="$build/python:$root/tests/fixtures" /usr/bin/python3 - "$work/seq" "$work" <<'PY'
+PYTHONPATH="$build/python" /usr/bin/python3 - "$work/seq" "$work" <<'PY'
 import sys
 import celc
-import make_fixtures as mf
 seq, out = sys.argv[1], sys.argv[2]
 ev = celc.read_events(seq)
 imu = celc.read_imu(seq)
 celc.write_events(out + "/seq.aedat4", ev, format="aedat4", imu=imu, width=346, height=260, compression="lz4")
-s = mf.load_sequence(seq)
-mf.write_bag(out + "/seq.bag", s, "lz4")
-mf.write_mvsec(out + "/seq.h5", s)
 PY
+"$build/celc_make_fixtures" "$work/seq" "$work" seq_lz4.bag seq_mvsec.h5
+mv "$work/seq_lz4.bag" "$work/seq.bag"
+mv "$work/seq_mvsec.h5" "$work/seq.h5"
 
 extra=(--calib "$work/seq/calib.yaml" --groundtruth "$work/seq/groundtruth.txt")
 # run BUILD INPUT OUT ARGS...: prints "wall_s rss_kb" and leaves OUT/log.

@@ -13,6 +13,7 @@
 
 #include "celc/config/config.hpp"
 #include "celc/core/yaml.hpp"
+#include "celc/io/event_reader.hpp"
 #include "celc/pipeline/batch.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/shipped_configs.hpp"
@@ -411,6 +412,15 @@ TEST(ConfigSchema, BatchFile) {
   write("sequences:\n  - {label: a}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()), ":2: key 'sequences[0]': missing key 'sequences[0].path'");
   std::filesystem::remove_all(dir);
+}
+
+// ---- the readers' time checks in the schema ---------------------------------------
+
+TEST(IoRobustness, ReaderOptionsSchemaHasTheTimeChecks) {
+  ReaderOptions o;
+  const auto yaml = writeYaml([&](FieldVisitor& v) { describe(v, o); });
+  for (const char* key : {"max_time_jump", "backwards_tolerance", "backwards", "max_outside_share"})
+    EXPECT_NE(yaml.find(key), std::string::npos) << key;
 }
 
 }  // namespace

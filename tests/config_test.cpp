@@ -2,10 +2,19 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 
 #include "celc/config/config.hpp"
+#include "celc/io/calibration.hpp"
+#include "celc/pipeline/batch.hpp"
+#include "celc/pipeline/run_config.hpp"
+#include "celc/sim/render_sequence.hpp"
+#include "io_test_util.hpp"
 
 using namespace celc;
+using celc::test::readBytes;
+using celc::test::TempDir;
+using celc::test::writeBytes;
 
 TEST(Config, ShippedFileEqualsDefaults) {
   const auto cfg = loadSimulateConfig(CELC_SOURCE_DIR "/config/simulate.yaml");
@@ -60,4 +69,35 @@ TEST(Config, InvalidValuesAndSyntax) {
   EXPECT_THROW(parseSimulateConfig("solver:\n  refine:\n    huber_px: 0\n", "h.yaml"), ConfigError);
   EXPECT_THROW(parseSimulateConfig("scene: {n_lines: [\n", "syntax.yaml"), ConfigError);
   EXPECT_THROW(loadSimulateConfig("/nonexistent/celc.yaml"), ConfigError);
+}
+
+// ---- YAML files of every kind ---------------------------------------------------
+
+// ---- YAML: a key or section given twice names both lines ------------------------
+
+TEST(IoRobustness, DuplicatedSectionsInCalibrationSceneAndBatchNameBothLines) {
+  TempDir d;
+  auto configError = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no ConfigError";
+    return {};
+  };
+  writeBytes(d.file("c.yaml"), "camera:\n  width: 240\n  height: 180\n  fx: 200\n  fy: 200\n  cx: 120\n  cy: 90\n"
+                               "imu:\n  time_offset: 0.1\nimu:\n  time_offset: 0.2\n");
+  std::string m = configError([&] { (void)loadCalibration(d.file("c.yaml")); });
+  EXPECT_NE(m.find("c.yaml:10"), std::string::npos) << m;
+  EXPECT_NE(m.find("given twice (first at line 8)"), std::string::npos) << m;
+  const std::string scene = readBytes(std::string(CELC_SOURCE_DIR) + "/config/scenes/davis240_rectangles.yaml");
+  writeBytes(d.file("s.yaml"), scene + "duration: 2.0\n");
+  m = configError([&] { (void)loadSynthConfig(d.file("s.yaml")); });
+  EXPECT_NE(m.find("s.yaml:"), std::string::npos) << m;
+  EXPECT_NE(m.find("'duration': given twice (first at line 7)"), std::string::npos) << m;
+  writeBytes(d.file("b.yaml"), "sequences:\n  - label: a\n    path: x\n    path: y\n");
+  m = configError([&] { (void)readBatch(d.file("b.yaml"), [](const std::string&) { return RunConfig{}; }); });
+  EXPECT_NE(m.find("b.yaml:4"), std::string::npos) << m;
+  EXPECT_NE(m.find("given twice (first at line 3)"), std::string::npos) << m;
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "celc/geometry/undistort.hpp"
+#include "celc/io/event_reader.hpp"
 
 using namespace celc;
 
@@ -59,4 +60,24 @@ TEST(GeometryUndistort, InvalidCameraThrows) {
   CameraModel c;
   c.fx = -1.0;
   EXPECT_THROW(UndistortLut{c}, std::invalid_argument);
+}
+
+// ---- sizes bounded before allocation ------------------------------------------
+
+TEST(IoRobustness, UndistortTableRefusesHugeSensorsAndReaderOptionsAreBounded) {
+  CameraModel c;
+  c.width = 30000;
+  c.height = 30000;
+  c.fx = c.fy = 300;
+  c.cx = c.cy = 100;
+  try {
+    UndistortLut lut(c);
+    ADD_FAILURE() << "built a 30000x30000 table";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds 4096x4096"), std::string::npos) << e.what();
+  }
+  ReaderOptions o;
+  o.width = 5000;
+  o.height = 10;
+  EXPECT_NE(o.validate().find("4096"), std::string::npos);
 }

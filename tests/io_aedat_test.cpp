@@ -11,7 +11,14 @@
 
 using namespace celc;
 using namespace celc;
+using celc::test::Place;
+using celc::test::putBE32;
+using celc::test::putLE32;
+using celc::test::readBytes;
+using celc::test::strictOptions;
 using celc::test::TempDir;
+using celc::test::writeBytes;
+using celc::test::patchBytes;
 
 namespace {
 
@@ -129,10 +136,14 @@ TEST(IoAedat, Aedat31SourceFilter) {
   EXPECT_EQ(readAllEvents(*r1).size(), 1000u);
 }
 
-TEST(IoAedat, Aedat4RoundTripEveryCompression) {
+// The parameter: the packets' compression.
+class IoAedat4Compression : public ::testing::TestWithParam<Aedat4Compression> {};
+
+TEST_P(IoAedat4Compression, Aedat4RoundTripEveryCompression) {
   TempDir d;
   auto f = fixture(30000, 320, 240);
-  for (auto c : {Aedat4Compression::None, Aedat4Compression::Lz4, Aedat4Compression::Zstd}) {
+  {
+    const Aedat4Compression c = GetParam();
     const std::string p = d.file("a" + std::to_string(int(c)) + ".aedat4");
     writeAedat4(p, f.ev, f.imu, 320, 240, c, 4096, true);
     auto r = openEventSource(p);
@@ -148,6 +159,13 @@ TEST(IoAedat, Aedat4RoundTripEveryCompression) {
     }
   }
 }
+INSTANTIATE_TEST_SUITE_P(Packets, IoAedat4Compression,
+                         ::testing::Values(Aedat4Compression::None, Aedat4Compression::Lz4, Aedat4Compression::Zstd),
+                         [](const ::testing::TestParamInfo<Aedat4Compression>& i) {
+                           return std::string(i.param == Aedat4Compression::None ? "none"
+                                              : i.param == Aedat4Compression::Lz4 ? "lz4"
+                                                                                  : "zstd");
+                         });
 
 TEST(IoAedat, Aedat4SeekWithDataTable) {
   TempDir d;
@@ -526,4 +544,147 @@ TEST(IoAedat, LargeFilesCrossBufferBoundaries) {
     ASSERT_EQ(got[i].y, ev[i].y) << i;
     ASSERT_EQ(got[i].on, ev[i].on) << i;
   }
+}
+
+// ---- malformed and hostile inputs (docs/robustness.md's table) -------------------
+
+// ---- AEDAT 3.1: signed overflow in the packet header check ----------------------
+
+TEST(IoRobustness, Aedat31TimestampOffsetInt32MaxIsAnErrorNotOverflow) {
+  TempDir d;
+  writeAedat31(d.file("a.aedat31"), celc::test::randomEvents(50, 240, 180, 1), {}, "DAVIS240C", 50);
+  std::string b = readBytes(d.file("a.aedat31"));
+  const std::size_t data = b.find("#!END-HEADER\r\n") + 14;
+  putLE32(b, data + 8, 0x7FFFFFFF);  // eventTSOffset: tsoff + 4 overflowed int before
+  writeBytes(d.file("o.aedat31"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.aedat31")), "byte " + std::to_string(data), "invalid packet header");
+  // The largest overflow counter fits in int64 but puts the times near 4.6e12 s,
+  // where a double in seconds resolves about 1 ms: an error naming the packet.
+  b = readBytes(d.file("a.aedat31"));
+  putLE32(b, data + 12, 0x7FFFFFFF);
+  writeBytes(d.file("v.aedat31"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("v.aedat31")), "v.aedat31: byte " + std::to_string(data),
+                  "eventTSOverflow 2147483647", "beyond 2^33 s");
+  // Just below 2^33 s (overflow 3,999,999) every microsecond still has its own double.
+  b = readBytes(d.file("a.aedat31"));
+  putLE32(b, data + 12, 3999999);
+  writeBytes(d.file("w.aedat31"), b);
+  auto r = openEventSource(d.file("w.aedat31"));
+  const auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 50u);
+  EXPECT_GT(ev.front().t, 8.589e9);
+  EXPECT_LE(std::nextafter(ev.front().t, 1e300) - ev.front().t, 1e-6);
+  putLE32(b, data + 12, 4000000);
+  writeBytes(d.file("w.aedat31"), b);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("w.aedat31")), "eventTSOverflow 4000000");
+}
+
+TEST(IoRobustness, Aedat4HeaderHugeSensorRefusedBeforeAnyTable) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(100, 240, 180, 2);
+  writeAedat4(d.file("a.aedat4"), ev, {}, 6000, 6000, Aedat4Compression::Lz4, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14", "6000x6000", "4096");
+  writeAedat4(d.file("b.aedat4"), ev, {}, 4096, 4096, Aedat4Compression::None, 50, true);
+  EXPECT_NO_THROW(celc::test::drain(d.file("b.aedat4")));
+}
+
+// ---- AEDAT 2.0: one corrupt timestamp no longer shifts the rest ------------------
+
+TEST(IoRobustness, Aedat2OneTimestampAllOnesIsAnOutlierNotAWrap) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(2000, 240, 180, 3, 1.0);
+  writeAedat2(d.file("a.aedat"), ev, {});
+  std::string b = readBytes(d.file("a.aedat"));
+  const std::size_t data = b.size() - 8 * ev.size();
+  const std::size_t k = 1000;
+  putBE32(b, data + 8 * k + 4, 0xFFFFFFFFu);
+  writeBytes(d.file("o.aedat"), b);
+  auto r = openEventSource(d.file("o.aedat"));
+  const auto got = readAllEvents(*r);
+  ASSERT_EQ(got.size(), ev.size() - 1);  // the outlier dropped
+  EXPECT_NEAR(got.back().t, ev.back().t, 1e-9);  // nothing shifted by 2^32 us
+  EXPECT_EQ(r->warnings().time_jumps, 1u);
+  ASSERT_FALSE(r->warnings().messages.empty());
+  EXPECT_NE(r->warnings().messages[0].find("byte " + std::to_string(data + 8 * k)), std::string::npos)
+      << r->warnings().messages[0];
+  EXPECT_IO_ERROR(celc::test::drain(d.file("o.aedat"), strictOptions()), "byte " + std::to_string(data + 8 * k),
+                  "outlier");
+}
+
+// ---- truncated binary files: the complete packets, a warning ---------------------
+
+// The parameter: the file written, by format (and AEDAT 4.0 compression).
+class IoRobustnessTruncated : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(IoRobustnessTruncated, TruncatedBinaryFilesYieldTheirCompletePackets) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(3000, 240, 180, 4, 2.0);
+  const auto imu = celc::test::randomImu(ev.front().t, ev.back().t, 5);
+  struct Case {
+    std::string name;
+    std::size_t min_events;
+  };
+  writeAedat2(d.file("a.aedat2"), ev, imu);
+  writeAedat31(d.file("a.aedat31"), ev, imu, "DAVIS240C", 500);
+  writeAedat4(d.file("n.aedat4"), ev, imu, 240, 180, Aedat4Compression::None, 500, true);
+  writeAedat4(d.file("l.aedat4"), ev, imu, 240, 180, Aedat4Compression::Lz4, 500, true);
+  writeAedat4(d.file("z.aedat4"), ev, imu, 240, 180, Aedat4Compression::Zstd, 500, false);
+  {
+    const char* name = GetParam();
+    SCOPED_TRACE(name);
+    const std::string b = readBytes(d.file(name));
+    // cut at 60% of the file: inside an event packet (or the data table)
+    const std::size_t cut = b.size() * 6 / 10 + 3;
+    writeBytes(d.file(std::string("t_") + name), b.substr(0, cut));
+    auto r = openEventSource(d.file(std::string("t_") + name));
+    const auto got = readAllEvents(*r);
+    EXPECT_GT(got.size(), 1000u);
+    EXPECT_LT(got.size(), ev.size());
+    for (std::size_t i = 0; i < got.size(); ++i) ASSERT_NEAR(got[i].t, ev[i].t, 1e-9);
+    EXPECT_GE(r->warnings().truncated, 1u);  // with a data table past the cut: the table too
+    ASSERT_FALSE(r->warnings().messages.empty());
+    EXPECT_NE(r->warnings().messages.back().find("byte " + std::to_string(cut)), std::string::npos)
+        << r->warnings().messages.back();
+    EXPECT_IO_ERROR(celc::test::drain(d.file(std::string("t_") + name), strictOptions()), "truncated",
+                    "byte " + std::to_string(cut));
+  }
+}
+INSTANTIATE_TEST_SUITE_P(Formats, IoRobustnessTruncated,
+                         ::testing::Values("a.aedat2", "a.aedat31", "n.aedat4", "l.aedat4", "z.aedat4"),
+                         [](const ::testing::TestParamInfo<const char*>& i) {
+                           const std::string f = i.param;
+                           return f[0] == 'a' ? f.substr(2) : "aedat4_" + std::string(f[0] == 'n' ? "none" : f[0] == 'l' ? "lz4" : "zstd");
+                         });
+
+// ---- found by fuzz_aedat4_zstd: a Zstd frame asking for a huge window -------------
+
+TEST(IoRobustness, Aedat4ZstdFrameWithAHugeWindowIsAnErrorNotAnAllocation) {
+  // The first Zstd frame with a 2-byte content size (header 0x60) is given a
+  // header without one and the window descriptor 0xA0 (2^30 bytes): zstd used
+  // to allocate the window (the fuzzer's frame: 98 MB from a 1.4 KB file).
+  TempDir d;
+  auto ev = celc::test::randomEvents(600, 240, 180, 6, 3.0);
+  writeAedat4(d.file("z.aedat4"), ev, {}, 240, 180, Aedat4Compression::Zstd, 200, false);
+  EXPECT_EQ(celc::test::drain(d.file("z.aedat4")), 600u);
+  ASSERT_TRUE(patchBytes(d.file("z.aedat4"), "\x28\xb5\x2f\xfd\x60", 4, std::string("\x00\xA0", 2), Place::First));
+  EXPECT_IO_ERROR(celc::test::drain(d.file("z.aedat4")), "z.aedat4: byte ",
+                  "corrupt Zstd frame: Frame requires too much memory for decoding");
+}
+
+// ---- AEDAT 4.0: a size of any number of digits is bounded ------------------------
+
+TEST(IoRobustness, Aedat4SevenDigitSensorSizeIsRefusedLikeAnyHugeSize) {
+  TempDir d;
+  const auto ev = celc::test::randomEvents(100, 240, 180, 2);
+  writeAedat4(d.file("a.aedat4"), ev, {}, 1234567, 180, Aedat4Compression::None, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("a.aedat4")), "a.aedat4: byte 14: stream 0 declares a 1234567x180 sensor (at most 4096x4096)");
+  writeAedat4(d.file("b.aedat4"), ev, {}, 30000, 180, Aedat4Compression::None, 50, true);
+  EXPECT_IO_ERROR(openEventSource(d.file("b.aedat4")), "b.aedat4: byte 14: stream 0 declares a 30000x180 sensor (at most 4096x4096)");
+  // the digits are the value: leading zeros do not make a size unknown
+  std::string b = readBytes(d.file("b.aedat4"));
+  const std::size_t at = b.find(">30000<");
+  ASSERT_NE(at, std::string::npos);
+  b.replace(at + 1, 5, "00240");
+  writeBytes(d.file("c.aedat4"), b);
+  EXPECT_EQ(openEventSource(d.file("c.aedat4"))->width(), 240);
 }

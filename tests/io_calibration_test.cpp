@@ -6,7 +6,9 @@
 
 using namespace celc;
 using namespace celc;
+using celc::test::expectPrintable;
 using celc::test::TempDir;
+using celc::test::writeBytes;
 
 namespace {
 const char* kGood = R"(camera:
@@ -123,4 +125,40 @@ TEST(IoCalibrationConformance, EcdCalibTxt) {
   EXPECT_GT(c.camera.fx, 150.0);
   EXPECT_LT(c.camera.fx, 250.0);
   EXPECT_TRUE(c.camera.validate().empty());
+}
+
+// ---- malformed and hostile inputs (docs/robustness.md's table) -------------------
+
+// ---- sizes from headers bounded before allocation -------------------------------
+
+TEST(IoRobustness, CalibrationYamlHugeSensorRefusedWithFileAndKey) {
+  TempDir d;
+  for (const char* size : {"65535", "4097"}) {
+    writeBytes(d.file("c.yaml"), std::string("camera:\n  width: ") + size + "\n  height: 180\n  fx: 200\n  fy: 200\n"
+                                 "  cx: 120\n  cy: 90\n");
+    try {
+      (void)loadCalibration(d.file("c.yaml"));
+      ADD_FAILURE() << "accepted width " << size;
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("c.yaml"), std::string::npos) << m;
+      EXPECT_NE(m.find("width"), std::string::npos) << m;
+      EXPECT_NE(m.find("4096"), std::string::npos) << m;
+    }
+  }
+}
+
+// ---- found by fuzz_calibration: a YAML syntax error quoting a raw byte ------------
+
+TEST(IoRobustness, CalibrationYamlSyntaxErrorIsPrintable) {
+  TempDir d;
+  writeBytes(d.file("c.yaml"), std::string("camera: \"\\\xcd\xdf\"\n"));  // an unknown escape: a byte >= 0x80
+  try {
+    (void)loadCalibration(d.file("c.yaml"));
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    expectPrintable(m);
+    EXPECT_NE(m.find("c.yaml:1"), std::string::npos) << m;
+  }
 }

@@ -1,8 +1,8 @@
 #pragma once
 // The bag / HDF5 fixtures of the io tests: written into the build tree by
-// tests/fixtures/make_fixtures.sh (celc synth, then make_fixtures.py with
-// Debian's python3-rosbag and python3-h5py). CTest runs it once as the setup
-// test `io_fixtures`; a test binary run directly makes them when missing.
+// tests/fixtures/make_fixtures.sh (celc synth, then celc_make_fixtures: the
+// test tree's bag writer and libhdf5). CTest runs it once as the setup test
+// `io_fixtures`; a test binary run directly makes them when missing.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -11,16 +11,17 @@
 #include <vector>
 
 #include "celc/io/event_reader.hpp"
+#include "io_test_util.hpp"
 
 namespace celc::test {
 
-/// The fixture folder (see make_fixtures.py for its files); "" when they cannot be made.
+/// The fixture folder (tests/fixtures/make_fixtures.cpp lists its files); "" when they cannot be made.
 inline const std::string& ioFixtureDir() {
   static const std::string dir = [] {
     const std::string d = CELC_FIXTURE_DIR;
     if (!std::filesystem::exists(d + "/complete")) {
       const std::string cmd = "sh '" CELC_SOURCE_DIR "/tests/fixtures/make_fixtures.sh' '" CELC_BINARY
-                              "' '" CELC_SOURCE_DIR "' '" + d + "' > '" + d + ".log' 2>&1";
+                              "' '" CELC_MAKE_FIXTURES "' '" CELC_SOURCE_DIR "' '" + d + "' > '" + d + ".log' 2>&1";
       if (std::system(cmd.c_str()) != 0) return std::string();
     }
     return d;
@@ -49,21 +50,6 @@ inline void expectSameEvents(const std::vector<Event>& a, const std::vector<Even
       return;
     }
   }
-}
-
-/// The message of the IoError `f` throws ("" and a failure when it does not throw one).
-template <class F>
-std::string ioErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const IoError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not an IoError: " << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "no error";
-  return {};
 }
 
 }  // namespace celc::test

@@ -1,7 +1,7 @@
 // One sequence in every input format gives the same windows.csv rows: the
 // text directory `celc synth` wrote, AEDAT 4.0 (the project's writer), a ROS
 // bag with lz4 chunks (camera and ground truth from the bag) and HDF5 in the
-// DSEC and MVSEC layouts (fixtures: tests/fixtures/make_fixtures.py).
+// DSEC and MVSEC layouts (fixtures: tests/fixtures/make_fixtures.cpp).
 #include <gtest/gtest.h>
 
 #include <filesystem>

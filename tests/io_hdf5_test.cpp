@@ -1,4 +1,4 @@
-// HDF5 input, DSEC and MVSEC layouts: the fixtures (tests/fixtures/make_fixtures.py)
+// HDF5 input, DSEC and MVSEC layouts: the fixtures (tests/fixtures/make_fixtures.cpp)
 // hold the sequence `celc synth` rendered as text, and must read back as it.
 #include <gtest/gtest.h>
 
@@ -20,22 +20,23 @@ using celc::test::fixture;
 using celc::test::fixtureSequence;
 using celc::test::ioErrorOf;
 
-TEST(IoHdf5, DsecLayoutReadsAsTheText) {
+// A DSEC file, uncompressed or blosc-compressed (the parameter), reads as the text.
+class IoHdf5Dsec : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(IoHdf5Dsec, DsecLayoutReadsAsTheText) {
   CELC_REQUIRE_IO_FIXTURES();
-  auto r = openEventSource(fixture("seq_dsec.h5"));
+  const std::string name = std::string(GetParam()) == "blosc" ? "seq_blosc.h5" : "seq_dsec.h5";
+  ASSERT_TRUE(fs::exists(fixture(name)))
+      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
+  auto r = openEventSource(fixture(name));
   EXPECT_EQ(r->format(), Format::Hdf5);
   celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
   EXPECT_EQ(r->warnings().total(), 0u);
   EXPECT_TRUE(r->readImu().empty());
   EXPECT_TRUE(r->readPoses().empty());
 }
-
-TEST(IoHdf5, BloscCompressedDsecReadsAsTheText) {
-  CELC_REQUIRE_IO_FIXTURES();
-  if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
-  auto r = openEventSource(fixture("seq_blosc.h5"));
-  celc::test::expectSameEvents(readAllEvents(*r), celc::test::fixtureTextEvents());
-}
+INSTANTIATE_TEST_SUITE_P(Storage, IoHdf5Dsec, ::testing::Values("uncompressed", "blosc"),
+                         [](const ::testing::TestParamInfo<const char*>& i) { return std::string(i.param); });
 
 TEST(IoHdf5, MvsecLayoutEventsImuPoses) {
   CELC_REQUIRE_IO_FIXTURES();
@@ -126,7 +127,7 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
     });
     EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-    // cut inside the root group's header (at byte 96 of h5py's files): said before the library reads it
+    // cut inside the root group's header (at byte 96 of the fixtures): said before the library reads it
     if (keep == 100) {
       EXPECT_NE(m.find(": object header of /: the file ends inside it (truncated?)"), std::string::npos) << m;
     }
@@ -136,7 +137,8 @@ TEST(IoHdf5, MissingDatasetsAndDamagedFilesGiveOneLineErrors) {
 // A compressed dataset whose filter plugin cannot be found: the error names the filter and the package.
 TEST(IoHdf5, MissingFilterPluginIsNamed) {
   CELC_REQUIRE_IO_FIXTURES();
-  if (!fs::exists(fixture("seq_blosc.h5"))) GTEST_SKIP() << "no blosc filter (hdf5-filter-plugin-blosc-serial)";
+  ASSERT_TRUE(fs::exists(fixture("seq_blosc.h5")))
+      << "no blosc filter: scripts/setup.sh installs hdf5-filter-plugin-blosc-serial";
   const fs::path d = celc::test::freshTempDir("io_hdf5_filter");
   const auto r = celc::test::runCelc("info '" + fixture("seq_blosc.h5") + "'", d);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -198,7 +200,7 @@ TEST(IoHdf5, HeaderChunksPastTheFileAreRefusedBeforeTheLibraryReadsThem) {
     const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     celc::detail::BinFile raw(fixture(name));
     const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
-    const int version = sb.version <= 1 ? 1 : 2;  // h5py: the earliest versions, or the newest
+    const int version = sb.version <= 1 ? 1 : 2;  // the fixtures: the earliest versions, or the newest
     for (const std::string object : {"/", "/events", "/events/y"}) {
       const std::uint64_t address =
           object == "/" ? sb.root_header : celc::detail::hdf5LinkAddress(fixture(name), object);

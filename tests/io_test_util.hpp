@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -70,6 +72,55 @@ inline std::string readBytes(const std::string& path) {
 inline void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
   f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+/// Overwrites the file at `path` with `bytes` from `offset` after the start of
+/// `pattern` (at its only, first, or last of at least two places); false when
+/// the pattern does not stand there that way.
+enum class Place { Only, First, LastOfSeveral };
+inline bool patchBytes(const std::string& path, const std::string& pattern, std::size_t offset, const std::string& bytes,
+                       Place place = Place::Only) {
+  std::string b = readBytes(path);
+  const std::size_t first = b.find(pattern), last = b.rfind(pattern);
+  if (first == std::string::npos || (place == Place::Only && first != last) ||
+      (place == Place::LastOfSeveral && first == last))
+    return false;
+  b.replace((place == Place::LastOfSeveral ? last : first) + offset, bytes.size(), bytes);
+  writeBytes(path, b);
+  return true;
+}
+inline void putLE32(std::string& b, std::size_t at, std::int32_t v) { std::memcpy(&b[at], &v, 4); }
+inline void putBE32(std::string& b, std::size_t at, std::uint32_t v) {
+  for (int k = 0; k < 4; ++k) b[at + std::size_t(k)] = char((v >> (24 - 8 * k)) & 0xFF);
+}
+
+/// Printable ASCII on one line: what every message may contain.
+inline void expectPrintable(const std::string& m) {
+  for (char c : m) {
+    const auto u = static_cast<unsigned char>(c);
+    ASSERT_TRUE(u >= 0x20 && u < 0x7F) << "byte " << int(u) << " in message: " << m;
+  }
+}
+
+/// The message of the IoError `f` throws ("" and a failure when it does not throw one).
+template <class F>
+std::string ioErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const IoError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an IoError: " << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return {};
+}
+
+inline ReaderOptions strictOptions() {
+  ReaderOptions o;
+  o.strict = true;
+  return o;
 }
 
 /// Reads everything (events and IMU) from a source; throws what the reader throws.

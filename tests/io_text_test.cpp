@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include "celc/io/text_io.hpp"
 #include "celc/io/writers.hpp"
@@ -9,7 +11,13 @@
 
 using namespace celc;
 using namespace celc;
+using celc::test::expectPrintable;
+using celc::test::ioErrorOf;
+using celc::test::putBE32;
+using celc::test::readBytes;
+using celc::test::strictOptions;
 using celc::test::TempDir;
+using celc::test::writeBytes;
 
 namespace {
 void expectSameEvents(const std::vector<Event>& a, const std::vector<Event>& b) {
@@ -141,41 +149,67 @@ TEST(IoText, PosesWithAndWithoutId) {
 
 // ---- bad input -------------------------------------------------------------
 
-TEST(IoTextBad, NonNumericFieldNamesFileAndLine) {
+// A text file a reader refuses: its name and content, the reader (events,
+// IMU or poses), and the fragments of the one-line error (with the file's
+// path when `names_path`).
+struct TextRefusal {
+  const char* label;
+  const char* file;
+  const char* content;
+  enum Reader { Events, Imu, Poses } reader;
+  std::vector<std::string> fragments;
+  bool names_path = false;
+};
+class IoTextBadFile : public ::testing::TestWithParam<TextRefusal> {};
+
+TEST_P(IoTextBadFile, RefusedWithItsLineAndReason) {
   TempDir d;
-  celc::test::writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), d.file("e.txt"), "line 3", "non-numeric x");
-  celc::test::writeBytes(d.file("t.txt"), "0.1 1 2 1\n0.2x 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("t.txt")), "line 2", "timestamp");
-  celc::test::writeBytes(d.file("n.txt"), "nan 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("n.txt")), "line 1", "timestamp");
+  const TextRefusal& c = GetParam();
+  celc::test::writeBytes(d.file(c.file), c.content);
+  std::vector<std::string> fragments = c.fragments;
+  if (c.names_path) fragments.insert(fragments.begin(), d.file(c.file));
+  switch (c.reader) {
+    case TextRefusal::Events:
+      EXPECT_IO_ERROR(celc::test::drain(d.file(c.file)), fragments);
+      break;
+    case TextRefusal::Imu:
+      EXPECT_IO_ERROR(readImuText(d.file(c.file)), fragments);
+      break;
+    case TextRefusal::Poses:
+      EXPECT_IO_ERROR(readPosesText(d.file(c.file)), fragments);
+      break;
+  }
 }
 
-TEST(IoTextBad, WrongColumnCounts) {
-  TempDir d;
-  celc::test::writeBytes(d.file("a.txt"), "0.1 1 2 1\n0.2 1 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("a.txt")), "line 2", "expected 4 columns, found 3");
-  celc::test::writeBytes(d.file("b.txt"), "0.1 1 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("b.txt")), "line 1", "unsupported column count 3");
-  celc::test::writeBytes(d.file("c.txt"), "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("c.txt")), "line 1", "column count");
-  celc::test::writeBytes(d.file("imu.txt"), "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n");
-  EXPECT_IO_ERROR(readImuText(d.file("imu.txt")), "imu.txt: line 2", "expected 7 columns");
-  celc::test::writeBytes(d.file("gt.txt"), "0.1 1 2 3 0 0 0\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("gt.txt")), "gt.txt: line 1", "column count 7");
-}
-
-TEST(IoTextBad, BadPolarityHeaderAndQuaternion) {
-  TempDir d;
-  celc::test::writeBytes(d.file("p.txt"), "0.1 1 2 2\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("p.txt")), "line 1", "polarity");
-  celc::test::writeBytes(d.file("h.txt"), "time col row sign\n0.1 1 2 1\n");
-  EXPECT_IO_ERROR(celc::test::drain(d.file("h.txt")), "line 1", "header");
-  celc::test::writeBytes(d.file("q.txt"), "0.1 0 0 0 0 0 0 0\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("q.txt")), "line 1", "zero quaternion");
-  celc::test::writeBytes(d.file("qt.txt"), "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n");
-  EXPECT_IO_ERROR(readPosesText(d.file("qt.txt")), "line 2", "increase");
-}
+INSTANTIATE_TEST_SUITE_P(
+    IoTextBad, IoTextBadFile,
+    ::testing::Values(
+        // non-numeric fields name the file and the line
+        TextRefusal{"non_numeric_x", "e.txt", "0.1 1 2 1\n0.2 1 2 1\n0.3 abc 2 1\n", TextRefusal::Events,
+                    {"line 3", "non-numeric x"}, true},
+        TextRefusal{"non_numeric_time", "t.txt", "0.1 1 2 1\n0.2x 1 2 1\n", TextRefusal::Events,
+                    {"line 2", "timestamp"}},
+        TextRefusal{"nan_time", "n.txt", "nan 1 2 1\n", TextRefusal::Events, {"line 1", "timestamp"}},
+        // wrong column counts
+        TextRefusal{"short_row", "a.txt", "0.1 1 2 1\n0.2 1 2\n", TextRefusal::Events,
+                    {"line 2", "expected 4 columns, found 3"}},
+        TextRefusal{"three_columns", "b.txt", "0.1 1 2\n", TextRefusal::Events,
+                    {"line 1", "unsupported column count 3"}},
+        TextRefusal{"eighteen_columns", "c.txt", "0.1 1 2 1 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n",
+                    TextRefusal::Events, {"line 1", "column count"}},
+        TextRefusal{"imu_short_row", "imu.txt", "0.1 1 2 3 4 5 6\n0.2 1 2 3 4 5\n", TextRefusal::Imu,
+                    {"imu.txt: line 2", "expected 7 columns"}},
+        TextRefusal{"poses_seven_columns", "gt.txt", "0.1 1 2 3 0 0 0\n", TextRefusal::Poses,
+                    {"gt.txt: line 1", "column count 7"}},
+        // polarity, header, quaternion
+        TextRefusal{"polarity_two", "p.txt", "0.1 1 2 2\n", TextRefusal::Events, {"line 1", "polarity"}},
+        TextRefusal{"unknown_header", "h.txt", "time col row sign\n0.1 1 2 1\n", TextRefusal::Events,
+                    {"line 1", "header"}},
+        TextRefusal{"zero_quaternion", "q.txt", "0.1 0 0 0 0 0 0 0\n", TextRefusal::Poses,
+                    {"line 1", "zero quaternion"}},
+        TextRefusal{"poses_backwards", "qt.txt", "0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n", TextRefusal::Poses,
+                    {"line 2", "increase"}}),
+    [](const ::testing::TestParamInfo<TextRefusal>& i) { return std::string(i.param.label); });
 
 TEST(IoTextBad, BackwardsTimestampsCountedOrStrict) {
   TempDir d;
@@ -274,4 +308,226 @@ TEST(IoText, CrOnlyLineEndingsAreNamed) {
   }
   auto r = openEventSource(d.file("crlf.txt"));
   EXPECT_EQ(readAllEvents(*r).size(), 5u);
+}
+
+// ---- malformed and hostile inputs (docs/robustness.md's table) -------------------
+
+// ---- messages never echo raw bytes ---------------------------------------------
+
+TEST(IoRobustness, MessagesArePrintableOneLine) {
+  TempDir d;
+  std::vector<std::string> messages;
+  // control bytes and an ANSI escape in a field
+  writeBytes(d.file("c.txt"), std::string("0.1\x01\x1b[31m 1 2 1\n"));
+  messages.push_back(ioErrorOf([&] { celc::test::drain(d.file("c.txt")); }));
+  // invalid UTF-8 in a header line (after a valid first block, so detection passes)
+  writeBytes(d.file("u.txt"), std::string("0.1 1 2 1\ntime col\xff\xfe row sign\n"));
+  messages.push_back(ioErrorOf([&] { celc::test::drain(d.file("u.txt")); }));
+  // a field with a carriage return inside the line
+  writeBytes(d.file("r.txt"), std::string("0.1 1 2 1\n0.2 1\r2 1 1\n"));
+  messages.push_back(ioErrorOf([&] { celc::test::drain(d.file("r.txt")); }));
+  // an AEDAT version "line" that spans two lines and holds control bytes
+  writeBytes(d.file("v.aedat"), std::string("#!AER-DAT9.9\rsecond line\n\x07\x1b[2J"));
+  messages.push_back(ioErrorOf([&] { openEventSource(d.file("v.aedat")); }));
+  // AEDAT 2.0 / 3.1 magic lines with junk
+  writeBytes(d.file("m2.aedat"), std::string("#!AER-DAT2.0\x1b[0m\xff\r\n"));
+  messages.push_back(ioErrorOf([&] { openEventSource(d.file("m2.aedat")); }));
+  writeBytes(d.file("m3.aedat"), std::string("#!AER-DAT3.1\x01\x02\xc3\x28\r\n"));
+  messages.push_back(ioErrorOf([&] { openEventSource(d.file("m3.aedat")); }));
+  // an AEDAT 2.0 chip name with control bytes: the note and the error are printable
+  writeBytes(d.file("chip.aedat"), std::string("#!AER-DAT2.0\r\n# AEChip: x.\x1b]0;DVS128\x07\r\n"));
+  messages.push_back(ioErrorOf([&] { openEventSource(d.file("chip.aedat")); }));
+  for (const auto& m : messages) {
+    SCOPED_TRACE(m);
+    EXPECT_FALSE(m.empty());
+    expectPrintable(m);
+    EXPECT_LT(m.size(), 600u);
+  }
+  EXPECT_EQ(messages[3].find("second line"), std::string::npos);  // the version ends at the line's end
+  EXPECT_EQ(detail::printable("a\nb\xff", 80), "a\\x0Ab\\xFF");
+  EXPECT_EQ(detail::printable(std::string(100, 'x'), 10), "xxxxxxxxxx...");
+}
+
+TEST(IoRobustness, RandomBinaryIsDetectedByItsHeaderAndNeverPrinted) {
+  TempDir d;
+  std::mt19937 rng(15);
+  // no NUL in the first 16 bytes (the old detector's window), NULs and control bytes later
+  std::string b;
+  for (int i = 0; i < 4096; ++i) b.push_back(char(i < 16 ? 'a' + rng() % 26 : rng() & 0xFF));
+  writeBytes(d.file("r.bin"), b);
+  std::string m = ioErrorOf([&] { openEventSource(d.file("r.bin")); });
+  expectPrintable(m);
+  EXPECT_NE(m.find("binary data"), std::string::npos) << m;
+  EXPECT_LT(m.size(), 200u) << m;
+  // bytes >= 0x80 only (no control byte at all): invalid UTF-8 is binary too
+  std::string h;
+  for (int i = 0; i < 4096; ++i) h.push_back(char(0x80 | (rng() & 0x7F)));
+  writeBytes(d.file("h.bin"), "0.1 1 2 1\n" + h);
+  m = ioErrorOf([&] { openEventSource(d.file("h.bin")); });
+  EXPECT_NE(m.find("binary data"), std::string::npos) << m;
+  expectPrintable(m);
+  // UTF-8 text in a comment is still text
+  writeBytes(d.file("t.txt"), "# t [\xc2\xb5s] x y p\n0.1 1 2 1\n");
+  EXPECT_EQ(detectFormat(d.file("t.txt")), Format::Text);
+}
+
+// ---- time sanity ---------------------------------------------------------------
+
+TEST(IoRobustness, BackwardsBeyondToleranceIsAnErrorOrDroppedOrSorted) {
+  TempDir d;
+  writeBytes(d.file("e.txt"), "0.1 1 2 1\n0.3 1 2 1\n0.2995 1 2 1\n0.2 1 2 1\n0.4 1 2 1\n");
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt")), "e.txt: line 4", "backwards_tolerance", "input.backwards");
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto r = openEventSource(d.file("e.txt"), drop);
+  EXPECT_EQ(readAllEvents(*r).size(), 4u);
+  EXPECT_EQ(r->warnings().backwards_time, 2u);  // 0.2995 kept (within 1 ms), 0.2 dropped
+  ReaderOptions sort;
+  sort.backwards = BackwardsPolicy::Sort;
+  auto s = openEventSource(d.file("e.txt"), sort);
+  const auto ev = readAllEvents(*s);
+  ASSERT_EQ(ev.size(), 5u);
+  for (std::size_t i = 1; i < ev.size(); ++i) EXPECT_LE(ev[i - 1].t, ev[i].t);
+  EXPECT_EQ(s->warnings().backwards_time, 2u);
+}
+
+TEST(IoRobustness, ForwardJumpOutlierDroppedGapKeptBothReported) {
+  TempDir d;
+  writeBytes(d.file("o.txt"), "1.0 1 2 1\n1.1 1 2 1\n99.0 1 2 1\n1.2 1 2 1\n1.3 1 2 1\n");
+  auto r = openEventSource(d.file("o.txt"));
+  auto ev = readAllEvents(*r);
+  ASSERT_EQ(ev.size(), 4u);
+  EXPECT_DOUBLE_EQ(ev[2].t, 1.2);
+  ASSERT_EQ(r->warnings().time_jumps, 1u);
+  EXPECT_NE(r->warnings().messages[0].find("line 3"), std::string::npos) << r->warnings().messages[0];
+  EXPECT_NE(r->warnings().messages[0].find("outlier dropped"), std::string::npos);
+  ReaderOptions tight;
+  tight.max_time_jump = 100.0;  // the bound is the schema option input.max_time_jump
+  auto r2 = openEventSource(d.file("o.txt"), tight);
+  EXPECT_IO_ERROR(readAllEvents(*r2), "line 4", "before the latest event so far");
+  writeBytes(d.file("g.txt"), "1.0 1 2 1\n1.1 1 2 1\n99.0 1 2 1\n99.1 1 2 1\n");
+  auto r3 = openEventSource(d.file("g.txt"));
+  EXPECT_EQ(readAllEvents(*r3).size(), 4u);
+  EXPECT_EQ(r3->warnings().time_jumps, 1u);
+  EXPECT_NE(r3->warnings().messages[0].find("a gap of"), std::string::npos) << r3->warnings().messages[0];
+}
+
+TEST(IoRobustness, ManyPixelsOutsideTheSensorAreAnError) {
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 1000; ++i) text += std::to_string(0.001 * i + 1.0) + " " + std::to_string(i % 346) + " 10 1\n";
+  writeBytes(d.file("e.txt"), text);
+  ReaderOptions o;
+  o.width = 240;
+  o.height = 180;
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), o), "e.txt: line", "outside the 240x180 sensor",
+                  "max_outside_share");
+  o.max_outside_share = 1.0;
+  auto r = openEventSource(d.file("e.txt"), o);
+  EXPECT_EQ(readAllEvents(*r).size(), 240u * 3);
+}
+
+TEST(IoRobustness, MicrosecondsReadAsSecondsGiveAHint) {
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 200; ++i) text += std::to_string(1600000000 + 7 * i) + " 1 2 1\n";
+  writeBytes(d.file("us.txt"), text);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("us.txt")), "us.txt: line 64", "input.time_scale", "--time-scale 1e-6");
+  ReaderOptions o;
+  o.text_time_scale = 1e-6;
+  EXPECT_EQ(celc::test::drain(d.file("us.txt"), o), 200u);
+}
+
+// ---- a corrupt first timestamp; backwards steps that add up ----------------------
+
+TEST(IoRobustness, CorruptFirstTimestampIsAnOutlierNotTheReference) {
+  TempDir d;
+  std::string text = "10000000 5 5 1\n";
+  for (int i = 0; i < 2000; ++i) text += std::to_string(1.0 + i * 1e-3) + " " + std::to_string(i % 240) + " 7 1\n";
+  writeBytes(d.file("e.txt"), text);
+  for (BackwardsPolicy policy : {BackwardsPolicy::Error, BackwardsPolicy::Drop, BackwardsPolicy::Sort}) {
+    ReaderOptions o;
+    o.backwards = policy;
+    auto r = openEventSource(d.file("e.txt"), o);
+    const auto ev = readAllEvents(*r);
+    ASSERT_EQ(ev.size(), 2000u) << toString(policy);  // the bogus first event dropped, every good one kept
+    EXPECT_DOUBLE_EQ(ev.front().t, 1.0);
+    EXPECT_EQ(r->warnings().time_outliers, 1u);
+    EXPECT_EQ(r->warnings().backwards_time, 0u);
+    ASSERT_FALSE(r->warnings().messages.empty());
+    EXPECT_NE(r->warnings().messages[0].find("e.txt: line 1: timestamp 1e+07 s of the first event"),
+              std::string::npos) << r->warnings().messages[0];
+  }
+  EXPECT_IO_ERROR(celc::test::drain(d.file("e.txt"), strictOptions()), "line 1", "first event", "outlier");
+  // The second event far back, the third near the first: the second is the outlier.
+  writeBytes(d.file("s.txt"), "100.0 1 1 1\n50.0 1 1 1\n100.001 1 1 1\n100.002 1 1 1\n");
+  auto s = openEventSource(d.file("s.txt"));
+  const auto sv = readAllEvents(*s);
+  ASSERT_EQ(sv.size(), 3u);
+  EXPECT_DOUBLE_EQ(sv[0].t, 100.0);
+  EXPECT_EQ(s->warnings().time_outliers, 1u);
+  EXPECT_NE(s->warnings().messages.at(0).find("line 2"), std::string::npos) << s->warnings().messages.at(0);
+  // AEDAT 2.0 whose first timestamp word is 0xFFFFFFFF: not taken for a wrap-around of the good ones.
+  const auto ev = celc::test::randomEvents(3000, 240, 180, 5, 1.0);
+  writeAedat2(d.file("a.aedat"), ev, {});
+  std::string b = readBytes(d.file("a.aedat"));
+  const std::size_t data = b.size() - 8 * ev.size();
+  putBE32(b, data + 4, 0xFFFFFFFFu);
+  writeBytes(d.file("f.aedat"), b);
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto a = openEventSource(d.file("f.aedat"), drop);
+  const auto got = readAllEvents(*a);
+  ASSERT_EQ(got.size(), ev.size() - 1);
+  EXPECT_EQ(got.front().t, ev[1].t);
+  EXPECT_EQ(got.back().t, ev.back().t);  // nothing shifted by 2^32 us
+  EXPECT_EQ(a->warnings().time_outliers, 1u);
+  EXPECT_EQ(a->warnings().backwards_dropped, 0u);
+  EXPECT_NE(a->warnings().messages.at(0).find("byte " + std::to_string(data)), std::string::npos)
+      << a->warnings().messages.at(0);
+}
+
+TEST(IoRobustness, BackwardsToleranceIsCumulativeNotPerStep) {
+  // 0.9 ms back per event for 9 s: every step is within the 1 ms tolerance, the walk is not.
+  TempDir d;
+  std::string text;
+  for (int i = 0; i < 10000; ++i) {
+    char line[64];
+    std::snprintf(line, sizeof line, "%.6f 1 2 1\n", 10.0 - i * 0.9e-3);
+    text += line;
+  }
+  writeBytes(d.file("w.txt"), text);
+  EXPECT_IO_ERROR(celc::test::drain(d.file("w.txt")), "w.txt: line 3", "0.0018 s before the latest event so far",
+                  "input.backwards_tolerance");
+  ReaderOptions drop;
+  drop.backwards = BackwardsPolicy::Drop;
+  auto r = openEventSource(d.file("w.txt"), drop);
+  EXPECT_EQ(readAllEvents(*r).size(), 2u);
+  EXPECT_EQ(r->warnings().backwards_dropped, 9998u);
+  // Jitter within the tolerance around a rising time is kept, as before.
+  writeBytes(d.file("j.txt"), "1.0000 1 1 1\n1.0010 1 1 1\n1.0005 1 1 1\n1.0008 1 1 1\n1.0020 1 1 1\n");
+  auto j = openEventSource(d.file("j.txt"));
+  EXPECT_EQ(readAllEvents(*j).size(), 5u);
+  EXPECT_EQ(j->warnings().backwards_time, 2u);
+}
+
+TEST(IoRobustness, HeldEventsNeverMakeABatchLargerThanItsMax) {
+  // A held first event, an outlier, a gap and the end of the stream: every
+  // batch size gives the same events, none more than its max.
+  TempDir d;
+  writeBytes(d.file("e.txt"), "100.0 1 1 1\n50.0 1 1 1\n100.001 1 1 1\n100.002 1 1 1\n500.0 1 1 1\n"
+                              "100.003 1 1 1\n200.0 1 1 1\n200.001 1 1 1\n900.0 1 1 1\n");
+  auto whole = openEventSource(d.file("e.txt"));
+  const auto all = readAllEvents(*whole);
+  ASSERT_EQ(all.size(), 7u);  // 50.0 and 500.0 dropped; the gap to 200 and the jump to 900 at the end kept
+  for (std::size_t max : {1u, 2u, 3u}) {
+    auto r = openEventSource(d.file("e.txt"));
+    std::vector<Event> got, b;
+    while (r->next(b, max)) {
+      ASSERT_LE(b.size(), max);
+      got.insert(got.end(), b.begin(), b.end());
+    }
+    ASSERT_EQ(got.size(), all.size()) << max;
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].t, all[i].t) << max << " " << i;
+  }
 }

@@ -14,6 +14,7 @@
 using namespace celc;
 using namespace celc;
 using celc::test::TempDir;
+using celc::test::writeBytes;
 
 TEST(IoWindow, CountWindowsCoverTheFileInOrder) {
   TempDir d;
@@ -277,4 +278,69 @@ TEST(IoWindow, WindowOverMaxEventsIsAnErrorNamingItsTime) {
   count.events_per_window = 2000;
   count.max_events = 1000;
   EXPECT_NE(count.validate().find("events: 2000 per window, more than max_events = 1000"), std::string::npos);
+}
+
+// ---- malformed and hostile inputs (docs/robustness.md's table) -------------------
+
+// ---- endless windowing across an outlier ----------------------------------------
+
+TEST(IoRobustness, OutlierTimestampInTextDoesNotMakeEndlessWindows) {
+  TempDir d;
+  for (const char* outlier : {"10000000", "1e300"}) {
+    std::string text;
+    for (int i = 0; i < 2000; ++i) {
+      char line[64];
+      std::snprintf(line, sizeof line, "%.6f %d %d 1\n", 1.0 + i * 1e-3, i % 240, i % 180);
+      text += line;
+      if (i == 700) text += std::string(outlier) + " 5 5 1\n";
+    }
+    writeBytes(d.file("e.txt"), text);
+    auto r = openEventSource(d.file("e.txt"));
+    WindowOptions w;
+    w.seconds_per_window = 0.1;
+    WindowSource src(*r, w);
+    EventWindow win;
+    std::size_t n = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (src.next(win) && n < 1000) ++n;
+    EXPECT_LT(n, 25u) << outlier;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+    EXPECT_EQ(r->warnings().time_jumps, 1u) << outlier;
+    EXPECT_NE(r->warnings().messages.at(0).find("line 702"), std::string::npos) << r->warnings().messages.at(0);
+  }
+}
+
+TEST(IoRobustness, WindowSourceSkipsLongGapsAndRefusesUnrepresentableTimes) {
+  TempDir d;
+  // a real gap (two events confirm it): kept by the reader, skipped by the windows
+  writeBytes(d.file("g.txt"), "1.0 1 1 1\n1.05 1 1 1\n1.25 1 1 1\n5000.0 2 2 1\n5000.01 2 2 1\n5000.2 2 2 1\n");
+  auto r = openEventSource(d.file("g.txt"));
+  WindowOptions w;
+  w.seconds_per_window = 0.1;
+  WindowSource src(*r, w);
+  EventWindow win;
+  std::vector<EventWindow> got;
+  while (src.next(win) && got.size() < 100) got.push_back(win);
+  // 1.0-1.3 s: three windows, then the window holding 5000.0 (the grid's rounding
+  // near 5000 s may put it one window earlier) and the one holding 5000.01
+  ASSERT_GE(got.size(), 4u);
+  ASSERT_LE(got.size(), 5u);
+  EXPECT_EQ(got[1].events.size(), 0u);  // a gap of one window is returned empty, as before
+  EXPECT_EQ(got[2].events.size(), 1u);
+  EXPECT_GT(got[3].t0, 4999.8);
+  EXPECT_LE(got[3].t0, 5000.0);
+  EXPECT_GT(got.back().t1, 5000.01);
+  EXPECT_EQ(src.gaps(), 1u);
+  EXPECT_GT(src.skippedWindows(), 40000u);
+  ASSERT_EQ(src.reports().size(), 1u);
+  EXPECT_NE(src.reports()[0].find("g.txt: no events in"), std::string::npos) << src.reports()[0];
+  EXPECT_EQ(r->warnings().time_jumps, 1u);  // the reader reports the gap too
+  // a gap to 1e300: the window grid restarts there and t0 + S == t0 is an error, not a loop
+  writeBytes(d.file("h.txt"), "1.0 1 1 1\n1.2 1 1 1\n1e300 2 2 1\n1e300 2 2 1\n");
+  auto r2 = openEventSource(d.file("h.txt"));
+  WindowSource src2(*r2, w);
+  std::size_t n = 0;
+  EXPECT_IO_ERROR(
+      while (src2.next(win) && n < 100) ++n, "h.txt", "too large for windows");
+  EXPECT_LT(n, 100u);
 }

@@ -14,53 +14,14 @@
 #include "celc/sim/peer_scene.hpp"
 #include "celc/sim/render_sequence.hpp"
 #include "celc/solver/solver.hpp"
+#include "lines_motion_scenes.hpp"
 
 namespace celc::test {
 namespace {
 
-const double kDeg = 180.0 / M_PI;
-
-// A DAVIS240 moving at V through segments 3-6 m away, no pixel noise.
-PeerSceneOptions davis240Scene(double speed, double duration, double omega_rad_s) {
-  PeerSceneOptions o;
-  o.camera = cameraPreset("davis240");  // 240 x 180, f = 200 px, no distortion
-  o.speed = speed;
-  o.duration = duration;
-  o.depth_range = Vec2(3.0, 6.0);
-  o.omega_deg_s = omega_rad_s * kDeg;
-  o.event_noise_px = 0.0;
-  o.min_separation_px = 60.0;
-  return o;
-}
-
-// Per method, the angle to the truth [deg] of every trial (180 when not ok),
-// and the lines rejected over all trials.
-struct Outcome {
-  std::vector<std::vector<double>> deg;
-  int lines_rejected = 0, trials = 0;
-};
-
-Outcome runScenes(const PeerSceneOptions& o, const std::vector<Method>& methods, int n,
-                  std::uint64_t seed) {
-  Outcome out;
-  out.deg.resize(methods.size());
-  for (int i = 0; i < n; ++i) {
-    std::mt19937_64 rng(seed + static_cast<std::uint64_t>(i));
-    const PeerSceneTrial tr = generatePeerScene(o, rng);
-    EXPECT_TRUE(tr.ok) << tr.message;
-    if (!tr.ok) continue;
-    ++out.trials;
-    out.lines_rejected += o.n_lines - tr.lines_fitted;
-    const auto res = solveMethods(tr.observations, tr.given_motion, methods, SolverOptions::paper());
-    for (size_t k = 0; k < methods.size(); ++k)
-      out.deg[k].push_back(res[k].ok() ? directionAngle(tr.true_direction, res[k].v) * kDeg : 180.0);
-  }
-  return out;
-}
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
+// Every trial's scene must generate.
+Outcome runScenes(const PeerSceneOptions& o, const std::vector<Method>& methods, int n, std::uint64_t seed) {
+  return runSceneTrials(o, methods, n, seed, [](const PeerSceneTrial& tr) { EXPECT_TRUE(tr.ok) << tr.message; });
 }
 
 const std::vector<Method> kLineMethods{Method::Celc, Method::CelcOpt, Method::Ce3lc};
@@ -143,39 +104,6 @@ TEST(LinesMotion, ClusterWithoutLinesServesNptOnly) {
   ASSERT_TRUE(with_failed[2].ok() && all[2].ok());
   EXPECT_LT(angleBetween(with_failed[2].v, all[2].v), 1e-12);
   EXPECT_GT(angleBetweenSignAgnostic(without[2].v, all[2].v), 1e-6);  // the cluster counts for npt
-}
-
-// The table of docs/method.md (opt-in, prints medians; not a check):
-//   CELC_LINES_STUDY=1 build/celc_tests --gtest_filter=LinesMotion.Study
-TEST(LinesMotion, Study) {
-  if (!std::getenv("CELC_LINES_STUDY")) GTEST_SKIP() << "set CELC_LINES_STUDY=1 to print the table";
-  const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::Ce3lc, Method::Npt};
-  LineFitOptions paper;
-  paper.model = LineModel::Static;
-  paper.interval_fraction = 0.0;
-  std::printf("| scene | lines | celc | celc_opt | ce3lc | npt |\n|---|---|---|---|---|---|\n");
-  auto row = [&](const char* name, PeerSceneOptions o, int n) {
-    for (int model = 0; model < 2; ++model) {
-      o.line_fit = model == 0 ? LineFitOptions{} : paper;
-      const Outcome r = runScenes(o, methods, n, 500);
-      std::printf("| %s | %s |", name, model == 0 ? "moving (default)" : "static 5 ms (paper)");
-      for (const auto& d : r.deg) std::printf(" %.3g |", median(d));
-      std::printf("\n");
-    }
-  };
-  row("float, 4 m/s, 0.2 s, still", davis240Scene(4.0, 0.2, 0.0), 20);
-  row("float, 4 m/s, 0.2 s, 3 rad/s", davis240Scene(4.0, 0.2, 3.0), 20);
-  for (double omega : {0.0, 3.0}) {
-    PeerSceneOptions o = davis240Scene(3.0, 0.5, omega);
-    o.integer_pixels = true;
-    o.events_per_line = 2000;
-    row(omega == 0.0 ? "integer, 3 m/s, 0.5 s, still" : "integer, 3 m/s, 0.5 s, 3 rad/s", o, 20);
-  }
-  for (int events : {20, 200}) {
-    PeerSceneOptions o;  // the peers' scene: 640 x 480, f 320, 2 m/s, 1 px, 15 deg/s
-    o.events_per_line = events;
-    row(events == 20 ? "peers, 5 x 20" : "peers, 5 x 200", o, 50);
-  }
 }
 
 }  // namespace

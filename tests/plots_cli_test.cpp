@@ -25,9 +25,10 @@ bool haveMatplotlib() {
   return std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") == 0;
 }
 
-#define SKIP_WITHOUT_MATPLOTLIB()                                                               \
-  if (!haveMatplotlib()) GTEST_SKIP() << "/usr/bin/python3 cannot import matplotlib "            \
-                                         "(apt-get install python3-matplotlib)"
+// scripts/setup.sh installs python3-matplotlib: its absence is a failure.
+#define REQUIRE_MATPLOTLIB()                                                               \
+  ASSERT_TRUE(haveMatplotlib()) << "/usr/bin/python3 cannot import matplotlib "                 \
+                                   "(scripts/setup.sh installs python3-matplotlib)"
 
 // A PNG file of some substance: the signature and more than SIZE bytes.
 void expectPng(const fs::path& p, std::uintmax_t size = 10000) {
@@ -42,7 +43,7 @@ void expectPng(const fs::path& p, std::uintmax_t size = 10000) {
 }  // namespace
 
 TEST(Plots, RunWritesVelocityAndErrorPng) {
-  SKIP_WITHOUT_MATPLOTLIB();
+  REQUIRE_MATPLOTLIB();
   const fs::path d = celc::test::freshTempDir("plots_run");
   const auto r = runCelc("run '" + kSample + "' -o " + q(d / "o") + kFast, d, true);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -83,7 +84,7 @@ TEST(Plots, NoPlotsFlagAndEnvironmentWriteNone) {
 }
 
 TEST(Plots, RunWithoutGroundTruthWritesVelocityOnly) {
-  SKIP_WITHOUT_MATPLOTLIB();
+  REQUIRE_MATPLOTLIB();
   const fs::path d = celc::test::freshTempDir("plots_nogt");
   // First with ground truth into the folder: its error.png must not survive the next run.
   auto r = runCelc("run '" + kSample + "' -o " + q(d / "o") + kFast, d, true);
@@ -146,7 +147,7 @@ TEST(Plots, FailedPlottingIsAOneLineWarning) {
 }
 
 TEST(Plots, ScriptPlotsOldFilesAndSkipsErrorWithoutGroundTruth) {
-  SKIP_WITHOUT_MATPLOTLIB();
+  REQUIRE_MATPLOTLIB();
   const fs::path d = celc::test::freshTempDir("plots_script");
   writeOldCsv(d / "gt", true);
   writeOldCsv(d / "nogt", false);
@@ -167,7 +168,7 @@ TEST(Plots, ScriptPlotsOldFilesAndSkipsErrorWithoutGroundTruth) {
 }
 
 TEST(Plots, TablePlotsRunsSideBySide) {
-  SKIP_WITHOUT_MATPLOTLIB();
+  REQUIRE_MATPLOTLIB();
   const fs::path d = celc::test::freshTempDir("plots_table");
   auto r = runCelc("run '" + kSample + "' -o " + q(d / "sample") + kFast + "--no-plots", d, true);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -192,7 +193,7 @@ TEST(Plots, TablePlotsRunsSideBySide) {
 }
 
 TEST(Plots, BatchPlotsEachRunAndTheTable) {
-  SKIP_WITHOUT_MATPLOTLIB();
+  REQUIRE_MATPLOTLIB();
   const fs::path d = celc::test::freshTempDir("plots_batch");
   std::ofstream(d / "batch.yaml") << "sequences:\n"
                                   << "  - {label: a, path: '" << kSample << "', t_end: 0.12}\n"

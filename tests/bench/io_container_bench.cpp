@@ -1,7 +1,7 @@
 // Throughput (events/s, one core) of the ROS bag and HDF5 readers, and the
 // memory of windowed reading from a bag. The inputs are written once per
-// process by tests/fixtures/make_fixtures.py --bench (Debian's python3-rosbag,
-// python3-h5py) into the temp directory and removed at exit.
+// process by celc_make_fixtures --bench (tests/fixtures/make_fixtures.cpp) into
+// the temp directory and removed at exit.
 // Targets (docs/formats.md): bag with lz4 chunks >= 10 M/s, HDF5 uncompressed >= 20 M/s.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
@@ -28,8 +28,7 @@ struct ContainerInputs {
   ContainerInputs() {
     dir = std::filesystem::temp_directory_path() / ("celc_io_container_bench_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
-    const std::string cmd = "/usr/bin/python3 '" CELC_SOURCE_DIR "/tests/fixtures/make_fixtures.py' --bench 4000000 '" +
-                            dir.string() + "'";
+    const std::string cmd = "'" CELC_MAKE_FIXTURES "' --bench 4000000 '" + dir.string() + "'";
     ok = std::system(cmd.c_str()) == 0;
   }
   ~ContainerInputs() { std::filesystem::remove_all(dir); }
@@ -43,7 +42,7 @@ ContainerInputs& containerInputs() {
 
 void readContainer(benchmark::State& state, const char* name) {
   if (!containerInputs().ok) {
-    state.SkipWithError("make_fixtures.py --bench failed (python3-rosbag, python3-h5py installed?)");
+    state.SkipWithError("celc_make_fixtures --bench failed");
     return;
   }
   readAll(state, containerInputs().file(name));
@@ -70,7 +69,7 @@ long statusKbOf(const char* key) {
 /// the peak resident set above the start [MB] against the file size.
 void windowedPeak(benchmark::State& state, const char* name) {
   if (!containerInputs().ok) {
-    state.SkipWithError("make_fixtures.py --bench failed");
+    state.SkipWithError("celc_make_fixtures --bench failed");
     return;
   }
   const std::string path = containerInputs().file(name);

@@ -4,7 +4,7 @@
 // inputs plus a few edge cases), so that no shared recording is needed. The
 // HDF5 seeds are written here with the HDF5 C library (small, unchunked,
 // chunked and deflate-compressed); the ROS bag seeds come from the bag writer
-// of the io fixtures (tests/fixtures/make_fixtures.py), which scripts/fuzz.sh
+// of the io fixtures (celc_make_fixtures, tests/fixtures/make_fixtures.cpp), which scripts/fuzz.sh
 // runs on the small sequence written to OUTDIR/bag_sequence.
 #include <hdf5.h>
 
@@ -257,7 +257,7 @@ int main(int argc, char** argv) {
   writeMvsec(out / "hdf5/seed_mvsec_chunked", ev, im, 16);
   writeDsecOddTypes(out / "hdf5");
 
-  // ROS bags: the sequence make_fixtures.py turns into bags (fuzz.sh runs it)
+  // ROS bags: the sequence celc_make_fixtures turns into bags (fuzz.sh runs it)
   writeEventsText((out / "bag_sequence/events.txt").string(), ev);
   writeImuText((out / "bag_sequence/imu.txt").string(), im, false);
   writePosesText((out / "bag_sequence/groundtruth.txt").string(), poses);
