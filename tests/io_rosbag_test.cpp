@@ -3,7 +3,6 @@
 // text does, bit for bit.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -11,6 +10,7 @@
 #include "celc/io/calibration.hpp"
 #include "celc/io/event_reader.hpp"
 #include "celc/io/text_io.hpp"
+#include "bag12_writer.hpp"
 #include "io_fixtures.hpp"
 #include "io_test_util.hpp"
 
@@ -215,71 +215,13 @@ TEST(IoRosbag, DamagedBytesNeverCrash) {
   EXPECT_GT(errors, 10);
 }
 
-namespace {
-/// Bytes of a ROS 1 bag record: header fields ("name=value", each with its
-/// uint32 length), then the data with its length.
-struct BagBytes {
-  std::string s;
-  template <typename T>
-  static std::string le(T v) {
-    return std::string(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  static std::string field(const std::string& name, const std::string& value) {
-    return le(std::uint32_t(name.size() + 1 + value.size())) + name + "=" + value;
-  }
-  std::size_t record(const std::vector<std::string>& fields, const std::string& data) {
-    const std::size_t at = s.size();
-    std::string h;
-    for (const auto& f : fields) h += f;
-    s += le(std::uint32_t(h.size())) + h + le(std::uint32_t(data.size())) + data;
-    return at;
-  }
-};
-
-/// A serialised dvs_msgs/EventArray (header stamp = the first event's time).
-std::string eventArrayBytes(const std::vector<Event>& ev, std::uint32_t width, std::uint32_t height) {
-  auto le = [](auto v) { return BagBytes::le(v); };
-  auto sec = [](double t) { return std::uint32_t(std::llround(t * 1e6) / 1000000); };
-  auto nsec = [](double t) { return std::uint32_t(std::llround(t * 1e6) % 1000000 * 1000); };
-  std::string m = le(std::uint32_t(0)) + le(sec(ev[0].t)) + le(nsec(ev[0].t)) + le(std::uint32_t(0)) + le(height) +
-                  le(width) + le(std::uint32_t(ev.size()));
-  for (const Event& e : ev)
-    m += le(std::uint16_t(e.x)) + le(std::uint16_t(e.y)) + le(sec(e.t)) + le(nsec(e.t)) + char(e.on ? 1 : 0);
-  return m;
-}
-}  // namespace
-
 // Format 1.2 (no chunks; the index points at file positions, the first entry of
 // a topic at its message definition record): written here byte by byte.
 TEST(IoRosbag, Format12ReadsItsEventsThroughItsIndex) {
   celc::test::TempDir dir;
   const auto ev = celc::test::randomEvents(300, 240, 180, 5);
-  const std::vector<Event> first(ev.begin(), ev.begin() + 120), second(ev.begin() + 120, ev.end());
-  BagBytes b;
-  b.s = "#ROSBAG V1.2\n";
-  using B = BagBytes;
-  const std::size_t head = b.record({B::field("op", "\x03"), B::field("index_pos", B::le(std::uint64_t(0)))},
-                                    std::string(64, ' '));
-  const std::string md5 = "5e8beee5a6c107e504c2e78903c224b8";
-  const std::size_t def = b.record({B::field("op", "\x01"), B::field("topic", "/dvs/events"), B::field("md5", md5),
-                                    B::field("type", "dvs_msgs/EventArray"), B::field("def", "Header header\n")},
-                                   "");
-  auto message = [&](const std::vector<Event>& e) {
-    return b.record({B::field("op", "\x02"), B::field("topic", "/dvs/events"), B::field("md5", md5),
-                     B::field("type", "dvs_msgs/EventArray")},
-                    eventArrayBytes(e, 240, 180));
-  };
-  message(first);
-  const std::size_t m2 = message(second);
-  const std::size_t index_pos = b.s.size();
-  std::string entries = B::le(std::uint32_t(10)) + B::le(std::uint32_t(0)) + B::le(std::uint64_t(def)) +
-                        B::le(std::uint32_t(11)) + B::le(std::uint32_t(0)) + B::le(std::uint64_t(m2));
-  b.record({B::field("op", "\x04"), B::field("ver", B::le(std::uint32_t(0))), B::field("topic", "/dvs/events"),
-            B::field("count", B::le(std::uint32_t(2)))},
-           entries);
-  const std::string index_field = "index_pos=";
-  b.s.replace(b.s.find(index_field, head) + index_field.size(), 8, B::le(std::uint64_t(index_pos)));
-  std::ofstream(dir.file("old.bag"), std::ios::binary) << b.s;
+  const celc::test::Bag12 b = celc::test::bag12(ev, 120, 240, 180);
+  std::ofstream(dir.file("old.bag"), std::ios::binary) << b.bytes;
 
   auto r = openEventSource(dir.file("old.bag"));
   EXPECT_TRUE(hasNote(*r, "bag format 1.2"));
@@ -288,9 +230,10 @@ TEST(IoRosbag, Format12ReadsItsEventsThroughItsIndex) {
   celc::test::expectSameEvents(readAllEvents(*r), ev);
 
   // an entry off a record's start is an error naming the entry's byte
-  std::string bad = b.s;
-  const std::size_t second_pos = b.s.size() - 8;  // the last entry's position field ends the file
-  bad.replace(second_pos, 8, B::le(std::uint64_t(m2 + 1)));
+  std::string bad = b.bytes;
+  const std::size_t second_pos = bad.size() - 8;  // the second entry's position field
+  const std::uint64_t m2 = b.second_message;
+  bad.replace(second_pos, 8, celc::test::BagBytes::le(m2 + 1));
   std::ofstream(dir.file("bad.bag"), std::ios::binary) << bad;
   const std::string m = ioErrorOf([&] { openEventSource(dir.file("bad.bag")); });
   EXPECT_NE(m.find("bad.bag: byte " + std::to_string(second_pos) + ": index entry position " + std::to_string(m2 + 1) +
