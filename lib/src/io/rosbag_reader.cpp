@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include "io/aedat_readers.hpp"
 #include "io/bag_file.hpp"
@@ -60,6 +61,8 @@ class RosBagReader final : public EventReader {
     events_ = bag_.messages(topic(events_topic_).conns);
     // The sensor size: the first EventArray's (CameraInfo's when it says 0), unless the options give one.
     if (!events_.empty()) {
+      if (side_buf_.chunk >= 0 && side_buf_.chunk == std::int64_t(events_.front().chunk))
+        std::swap(side_buf_, events_buf_);  // the camera info's chunk holds the first events too
       msg_ = bag_.message(events_.front(), events_buf_);
       const EventArrayView v = decodeEvents();
       if (v.width > 0 && v.height > 0) {
