@@ -459,17 +459,18 @@ void BagFile::open12() {
     }
     at = r.end();
   }
+  readDefinitions12();
+}
+
+/// Each 1.2 topic's type, MD5 sum and definition: the record at its first
+/// entry (in time order) must be its message definition record.
+void BagFile::readDefinitions12() {
   for (BagConnection& c : connections_) {
-    const std::vector<BagEntry> all = [&] {
-      std::vector<BagEntry> v;
-      for (const BagEntry& e : entries_)
-        if (e.conn == c.id) v.push_back(e);
-      std::stable_sort(v.begin(), v.end(), [](const BagEntry& a, const BagEntry& b) { return a.time_ns < b.time_ns; });
-      return v;
-    }();
-    if (all.empty()) continue;
-    // the topic's first entry points at its message definition record
-    const BagRecord d = readRecord(f_, all.front().pos, "message definition record");
+    const BagEntry* first = nullptr;  // the earliest, the first in file order among equal times
+    for (const BagEntry& e : entries_)
+      if (e.conn == c.id && (!first || e.time_ns < first->time_ns)) first = &e;
+    if (!first) continue;
+    const BagRecord d = readRecord(f_, first->pos, "message definition record");
     const std::string *topic = d.text("topic"), *md5 = d.text("md5"), *type = d.text("type"), *def = d.text("def");
     if (d.op() != 0x01 || !topic || *topic != c.topic || !md5 || !type || !def)
       f_.fail(d.at, "the first index entry of topic " + printable(c.topic, 100) +
