@@ -481,11 +481,13 @@ void BagFile::readDefinitions12() {
   }
 }
 
-/// A 1.2 message: the record at e.pos, past a message definition record, must
-/// be a message data record of the entry's topic.
+/// A 1.2 message: the record at e.pos, past at most kMaxDefinitions message
+/// definition records, must be a message data record of the entry's topic.
 BagMessage BagFile::message12(const BagEntry& e, ChunkBuffer& buf) {
+  constexpr int kMaxDefinitions = 16;  // a writer puts one before a topic's first message
   BagRecord r = readRecord(f_, e.pos, "message record");
-  while (r.op() == 0x01 && r.end() < index_pos12_) r = readRecord(f_, r.end(), "message record");
+  for (int k = 0; k < kMaxDefinitions && r.op() == 0x01 && r.end() < index_pos12_; ++k)
+    r = readRecord(f_, r.end(), "message record");
   const std::string* topic = r.text("topic");
   const std::string& want = connections_[e.conn].topic;
   if (r.op() != 0x02 || (topic && *topic != want))
