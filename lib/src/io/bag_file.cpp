@@ -165,7 +165,7 @@ void BagFile::open20() {
   if (index_pos >= f_.size() || index_pos < head.end())
     f_.fail(kMagicBytes, "index position " + std::to_string(index_pos) + " beyond the end of the file (" +
                              std::to_string(f_.size()) + " bytes): truncated bag" + kReindexHint);
-  const std::vector<std::uint64_t> chunks = readIndexSection(index_pos, index_pos, head.data_at);
+  const std::vector<std::uint64_t> chunks = readIndexSection(index_pos, head.data_at);
   if (connections_.size() != conn_count || chunks.size() != chunk_count)
     f_.fail(index_pos, "index section holds " + std::to_string(connections_.size()) + " connections and " +
                            std::to_string(chunks.size()) + " chunk infos, the header says " +
@@ -174,12 +174,12 @@ void BagFile::open20() {
 }
 
 /// The connection records (into connections_) and chunk infos (returned: the
-/// chunk positions) of the index section [from, end of file).
-std::vector<std::uint64_t> BagFile::readIndexSection(std::uint64_t from, std::uint64_t index_pos,
-                                                     std::uint64_t header_end) {
+/// chunk positions, each in [header_end, index_pos)) of the index section
+/// [index_pos, end of file).
+std::vector<std::uint64_t> BagFile::readIndexSection(std::uint64_t index_pos, std::uint64_t header_end) {
   std::vector<std::uint64_t> chunks;
   std::vector<unsigned char> data;
-  for (std::uint64_t at = from; at < f_.size();) {
+  for (std::uint64_t at = index_pos; at < f_.size();) {
     const BagRecord r = readRecord(f_, at, "index record");
     if (r.op() == 0x07) {
       BagConnection c;

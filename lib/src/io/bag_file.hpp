@@ -127,8 +127,7 @@ class BagFile {
   void open20();
   void open12();
   void readDefinitions12();
-  std::vector<std::uint64_t> readIndexSection(std::uint64_t from, std::uint64_t index_pos,
-                                              std::uint64_t header_end);
+  std::vector<std::uint64_t> readIndexSection(std::uint64_t index_pos, std::uint64_t header_end);
   void readChunk(std::uint64_t at, std::uint64_t index_pos);
   void readIndexData(std::uint32_t chunk, std::uint64_t from, std::uint64_t index_pos,
                      const std::vector<ChunkRecord>* records);
