@@ -72,7 +72,7 @@ class RosBagReader final : public EventReader {
       first_loaded_ = true;
     }
     if (width_ > kMaxReaderSensorSide || height_ > kMaxReaderSensorSide)
-      throw IoError(path_ + ": topic " + events_topic_ + ": a " + std::to_string(width_) + "x" +
+      throw IoError(path_ + ": topic " + printable(events_topic_, 100) + ": a " + std::to_string(width_) + "x" +
                     std::to_string(height_) + " sensor (at most " + std::to_string(kMaxReaderSensorSide) + ")");
     if (o.width > 0) width_ = o.width;
     if (o.height > 0) height_ = o.height;
@@ -167,7 +167,7 @@ class RosBagReader final : public EventReader {
     if (!want) return;
     for (const BagConnection& c : bag_.connections())
       if (c.topic == t.topic && c.md5sum != want->md5sum)
-        throw IoError(path_ + ": topic " + printable(t.topic, 100) + ": " + t.type + " with md5sum " +
+        throw IoError(path_ + ": topic " + printable(t.topic, 100) + ": " + printable(t.type, 80) + " with md5sum " +
                       printable(c.md5sum, 40) + ", expected " + want->md5sum + " (the definition celc decodes: " +
                       want->fields + ")");
   }
