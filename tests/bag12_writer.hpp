@@ -1,6 +1,6 @@
 #pragma once
-// A ROS bag of format 1.2 written byte by byte (no ROS writer makes that
-// format any more): one dvs_msgs/EventArray topic /dvs/events, its message
+// A ROS bag of format 1.2 written byte by byte (the ROS writers make 2.0):
+// one dvs_msgs/EventArray topic, its message
 // definition record, its messages, and the index (one index data record whose
 // first entry points at the definition record). Used by the bag tests and the
 // fuzz seeds.
@@ -48,25 +48,26 @@ inline std::string eventArrayBytes(const std::vector<Event>& ev, std::uint32_t w
   return m;
 }
 
-/// A format 1.2 bag of `ev` in two EventArray messages (the first holds
-/// `split` events), recorded at 10 s and 11 s; the index's second entry, the
+/// A format 1.2 bag of `ev` in two EventArray messages of topic `topic` (the
+/// first holds `split` events), recorded at 10 s and 11 s; the index's second entry, the
 /// file's last 8 bytes, holds `second_message`, the second message's position.
 struct Bag12 {
   std::string bytes;
   std::uint64_t second_message = 0;
 };
-inline Bag12 bag12(const std::vector<Event>& ev, std::size_t split, std::uint32_t width, std::uint32_t height) {
+inline Bag12 bag12(const std::vector<Event>& ev, std::size_t split, std::uint32_t width, std::uint32_t height,
+                   const std::string& topic = "/dvs/events") {
   using B = BagBytes;
   B b;
   b.s = "#ROSBAG V1.2\n";
   const std::size_t head = b.record({B::field("op", "\x03"), B::field("index_pos", B::le(std::uint64_t(0)))},
                                     std::string(64, ' '));
   const std::string md5 = "5e8beee5a6c107e504c2e78903c224b8";
-  const std::size_t def = b.record({B::field("op", "\x01"), B::field("topic", "/dvs/events"), B::field("md5", md5),
+  const std::size_t def = b.record({B::field("op", "\x01"), B::field("topic", topic), B::field("md5", md5),
                                     B::field("type", "dvs_msgs/EventArray"), B::field("def", "Header header\n")},
                                    "");
   auto message = [&](const std::vector<Event>& e) {
-    return b.record({B::field("op", "\x02"), B::field("topic", "/dvs/events"), B::field("md5", md5),
+    return b.record({B::field("op", "\x02"), B::field("topic", topic), B::field("md5", md5),
                      B::field("type", "dvs_msgs/EventArray")},
                     eventArrayBytes(e, width, height));
   };
@@ -76,7 +77,7 @@ inline Bag12 bag12(const std::vector<Event>& ev, std::size_t split, std::uint32_
   const std::size_t index_pos = b.s.size();
   const std::string entries = B::le(std::uint32_t(10)) + B::le(std::uint32_t(0)) + B::le(std::uint64_t(def)) +
                               B::le(std::uint32_t(11)) + B::le(std::uint32_t(0)) + B::le(out.second_message);
-  b.record({B::field("op", "\x04"), B::field("ver", B::le(std::uint32_t(0))), B::field("topic", "/dvs/events"),
+  b.record({B::field("op", "\x04"), B::field("ver", B::le(std::uint32_t(0))), B::field("topic", topic),
             B::field("count", B::le(std::uint32_t(2)))},
            entries);
   const std::string index_field = "index_pos=";

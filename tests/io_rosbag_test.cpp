@@ -260,3 +260,15 @@ TEST(IoRosbag, AnotherDefinitionUnderAKnownTypeIsAnError) {
       << m;
   EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
+
+// Found by fuzz_rosbag: a sensor beyond the bound on a topic whose name holds
+// raw bytes is a printable one-line error.
+TEST(IoRosbag, HugeSensorOnARawTopicNameIsAPrintableError) {
+  celc::test::TempDir dir;
+  const auto ev = celc::test::randomEvents(40, 240, 180, 6);
+  std::ofstream(dir.file("raw.bag"), std::ios::binary)
+      << celc::test::bag12(ev, 20, 83886320, 180, std::string("/dv\xd0\x9a\x01" "ents")).bytes;
+  const std::string m = ioErrorOf([&] { openEventSource(dir.file("raw.bag")); });
+  EXPECT_NE(m.find("a 83886320x180 sensor (at most 4096)"), std::string::npos) << m;
+  for (const char c : m) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << m;
+}
