@@ -28,7 +28,7 @@
 // the op it must be, the counts the header states, every chunk's header
 // (compression known, uncompressed size at most max_packet_bytes), every index
 // data record's size, connection and entries. A chunk's records are checked
-// when its bytes are first at hand: every record inside the chunk, every
+// whenever its bytes are at hand: every record inside the chunk, every
 // message record naming a declared connection, and every index entry of the
 // chunk on a message record of the entry's connection (the index decides which
 // topic, hence which layout, a message is decoded as). An uncompressed chunk
