@@ -10,6 +10,7 @@
 #include "celc/io/calibration.hpp"
 #include "celc/io/event_reader.hpp"
 #include "celc/io/text_io.hpp"
+#include "bag12_writer.hpp"
 #include "io_fixtures.hpp"
 #include "io_test_util.hpp"
 
@@ -219,4 +220,62 @@ TEST(IoRosbag, DamagedBytesNeverCrash) {
     }
   }
   EXPECT_GT(errors, 10);
+}
+
+// Format 1.2 (no chunks; the index points at file positions, the first entry of
+// a topic at its message definition record): written here byte by byte.
+TEST(IoRosbag, Format12ReadsItsEventsThroughItsIndex) {
+  celc::test::TempDir dir;
+  const auto ev = celc::test::randomEvents(300, 240, 180, 5);
+  const celc::test::Bag12 b = celc::test::bag12(ev, 120, 240, 180);
+  std::ofstream(dir.file("old.bag"), std::ios::binary) << b.bytes;
+
+  auto r = openEventSource(dir.file("old.bag"));
+  EXPECT_TRUE(hasNote(*r, "bag format 1.2"));
+  EXPECT_TRUE(hasNote(*r, "topic /dvs/events: dvs_msgs/EventArray, 2 messages"));
+  EXPECT_EQ(r->width(), 240);
+  celc::test::expectSameEvents(readAllEvents(*r), ev);
+
+  // an entry off a record's start is an error naming the entry's byte
+  std::string bad = b.bytes;
+  const std::size_t second_pos = bad.size() - 8;  // the second entry's position field
+  const std::uint64_t m2 = b.second_message;
+  bad.replace(second_pos, 8, celc::test::BagBytes::le(m2 + 1));
+  std::ofstream(dir.file("bad.bag"), std::ios::binary) << bad;
+  const std::string m = ioErrorOf([&] { openEventSource(dir.file("bad.bag")); });
+  EXPECT_NE(m.find("bad.bag: byte " + std::to_string(second_pos) + ": index entry position " + std::to_string(m2 + 1) +
+                   " is not a record's start"),
+            std::string::npos)
+      << m;
+}
+
+// A connection whose MD5 sum is not the decoded layout's is refused by name.
+TEST(IoRosbag, AnotherDefinitionUnderAKnownTypeIsAnError) {
+  CELC_REQUIRE_IO_FIXTURES();
+  celc::test::TempDir dir;
+  std::ifstream in(fixture("seq_lz4.bag"), std::ios::binary);
+  std::string bag((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string sum = "md5sum=6a62c6daae103f4ff57a132d6f95cec2";  // sensor_msgs/Imu
+  const std::size_t at = bag.rfind(sum);                             // the index section's connection record
+  ASSERT_NE(at, std::string::npos);
+  bag.replace(at + 7, 4, "0000");
+  std::ofstream(dir.file("imu.bag"), std::ios::binary) << bag;
+  const std::string m = ioErrorOf([&] { openEventSource(dir.file("imu.bag")); });
+  EXPECT_NE(m.find("imu.bag: topic /dvs/imu: sensor_msgs/Imu with md5sum 0000c6daae103f4ff57a132d6f95cec2, expected "
+                   "6a62c6daae103f4ff57a132d6f95cec2 (the definition celc decodes: Header header, "),
+            std::string::npos)
+      << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+// Found by fuzz_rosbag: a sensor beyond the bound on a topic whose name holds
+// raw bytes is a printable one-line error.
+TEST(IoRosbag, HugeSensorOnARawTopicNameIsAPrintableError) {
+  celc::test::TempDir dir;
+  const auto ev = celc::test::randomEvents(40, 240, 180, 6);
+  std::ofstream(dir.file("raw.bag"), std::ios::binary)
+      << celc::test::bag12(ev, 20, 83886320, 180, std::string("/dv\xd0\x9a\x01" "ents")).bytes;
+  const std::string m = ioErrorOf([&] { openEventSource(dir.file("raw.bag")); });
+  EXPECT_NE(m.find("a 83886320x180 sensor (at most 4096)"), std::string::npos) << m;
+  for (const char c : m) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << m;
 }

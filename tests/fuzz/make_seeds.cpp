@@ -5,7 +5,8 @@
 // HDF5 seeds are written here with the HDF5 C library (small, unchunked,
 // chunked and deflate-compressed); the ROS bag seeds come from the bag writer
 // of the io fixtures (celc_make_fixtures, tests/fixtures/make_fixtures.cpp), which scripts/fuzz.sh
-// runs on the small sequence written to OUTDIR/bag_sequence.
+// runs on the small sequence written to OUTDIR/bag_sequence, and a format 1.2
+// bag from tests/bag12_writer.hpp.
 #include <hdf5.h>
 
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "celc/io/writers.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/sim/render_sequence.hpp"
+#include "bag12_writer.hpp"
 
 namespace fs = std::filesystem;
 using namespace celc;
@@ -257,7 +259,8 @@ int main(int argc, char** argv) {
   writeMvsec(out / "hdf5/seed_mvsec_chunked", ev, im, 16);
   writeDsecOddTypes(out / "hdf5");
 
-  // ROS bags: the sequence celc_make_fixtures turns into bags (fuzz.sh runs it)
+  // ROS bags: a format 1.2 bag, and the sequence celc_make_fixtures turns into bags (fuzz.sh runs it)
+  std::ofstream(out / "rosbag/seed_v12", std::ios::binary) << celc::test::bag12(ev, 20, 240, 180).bytes;
   writeEventsText((out / "bag_sequence/events.txt").string(), ev);
   writeImuText((out / "bag_sequence/imu.txt").string(), im, false);
   writePosesText((out / "bag_sequence/groundtruth.txt").string(), poses);

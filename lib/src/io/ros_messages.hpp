@@ -32,6 +32,42 @@ inline constexpr const char* kOdometry = "nav_msgs/Odometry";
 inline constexpr const char* kCameraInfo = "sensor_msgs/CameraInfo";
 }  // namespace ros_type
 
+/// A message type celc decodes: its name, the MD5 sum of its definition and
+/// the definition's fields (the layout the decoders below read).
+struct RosTypeSum {
+  const char* type;
+  const char* md5sum;
+  const char* fields;
+};
+/// The MD5 sums of the decoded types, by the ROS 1 rule: the MD5 of the
+/// definition text with comments and blank lines dropped, constants first,
+/// then one line "type name" per field, where a field of another message type
+/// (arrays too) is written as that type's own MD5 sum; lines joined by '\n'
+/// without a final one. The nested sums: std_msgs/Header
+/// 2176decaecbce78abc3b96ef049fabed, dvs_msgs/Event
+/// 40d339b261445b8ce9a6fef01267cd5d. A connection recorded with another sum
+/// carries another layout under the same name, which these decoders would
+/// misread: the reader refuses it.
+inline constexpr RosTypeSum kRosTypeSums[] = {
+    {ros_type::kEventArray, "5e8beee5a6c107e504c2e78903c224b8",
+     "Header header, uint32 height, uint32 width, Event[] events (uint16 x, uint16 y, time ts, bool polarity)"},
+    {ros_type::kImu, "6a62c6daae103f4ff57a132d6f95cec2",
+     "Header header, Quaternion orientation, float64[9] orientation_covariance, Vector3 angular_velocity, "
+     "float64[9] angular_velocity_covariance, Vector3 linear_acceleration, float64[9] linear_acceleration_covariance"},
+    {ros_type::kPoseStamped, "d3812c3cbc69362b77dc0b19b345f8f5", "Header header, Pose pose"},
+    {ros_type::kOdometry, "cd5e73d190d741a2f92e81eda573aca7",
+     "Header header, string child_frame_id, PoseWithCovariance pose, TwistWithCovariance twist"},
+    {ros_type::kCameraInfo, "c9a58c1b0b154e0e6da7578cb991d214",
+     "Header header, uint32 height, uint32 width, string distortion_model, float64[] D, float64[9] K, "
+     "float64[9] R, float64[12] P, uint32 binning_x, uint32 binning_y, RegionOfInterest roi"},
+};
+/// The entry of kRosTypeSums for `type`; nullptr for a type celc does not decode.
+inline const RosTypeSum* rosTypeSum(const std::string& type) {
+  for (const RosTypeSum& t : kRosTypeSums)
+    if (type == t.type) return &t;
+  return nullptr;
+}
+
 /// A message shorter than its layout, or a value out of range; `offset` is the
 /// byte inside the message.
 class RosDecodeError : public std::runtime_error {
