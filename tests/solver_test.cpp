@@ -71,15 +71,15 @@ TEST(Solvers, NoiseFreeRecoversVelocityBothMotionModels) {
       const double angle = (i % 3 == 0) ? 3.0 : 1.2;
       o.omega = (i % 3 == 0 ? Vec3::UnitZ() : randomUnit(rng)) * angle / o.duration;
       const LineSceneTrial tr = generateLineScene(o, rng);
-      const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper());
+      const auto res = solveMethods(tr.observations, tr.given_motion, paperMethods(), SolverOptions::paper());
       for (size_t m = 0; m < res.size(); ++m) {
-        ASSERT_TRUE(res[m].ok()) << toString(defaultMethods()[m]) << " " << res[m].message;
+        ASSERT_TRUE(res[m].ok()) << toString(paperMethods()[m]) << " " << res[m].message;
         // npt models P(t) = tau I: exact for a reference-frame velocity only
         // (the peer scene, solver_npt_test.cpp, which also bounds its error
         // under a body-frame velocity, the model of both kinds here).
-        if (defaultMethods()[m] == Method::Npt) continue;
+        if (paperMethods()[m] == Method::Npt) continue;
         EXPECT_LT(angleBetween(res[m].v, tr.true_direction), 1e-6)
-            << toString(defaultMethods()[m]) << " model " << toString(model) << " trial " << i;
+            << toString(paperMethods()[m]) << " model " << toString(model) << " trial " << i;
       }
     }
   }
@@ -223,13 +223,13 @@ TEST(Solvers, LinearTukeyStageAddsFewPasses) {
 TEST(Degeneracy, ZeroVelocityIsDegenerate) {
   LineSceneOptions o;
   o.velocity = Vec3::Zero();
-  const auto s = runTrials(o, 50, 3, defaultMethods());
+  const auto s = runTrials(o, 50, 3, paperMethods());
   for (const auto& m : s) EXPECT_EQ(m.degenerate, 50);
-  const auto s0 = runTrials(noiseFree(), 1, 3, defaultMethods());  // sanity: the same scene moving is fine
+  const auto s0 = runTrials(noiseFree(), 1, 3, paperMethods());  // sanity: the same scene moving is fine
   for (const auto& m : s0) EXPECT_EQ(m.ok, 1);
   LineSceneOptions nf = noiseFree();
   nf.velocity = Vec3::Zero();
-  for (const auto& m : runTrials(nf, 20, 4, defaultMethods())) EXPECT_EQ(m.degenerate, 20);
+  for (const auto& m : runTrials(nf, 20, 4, paperMethods())) EXPECT_EQ(m.degenerate, 20);
 }
 
 TEST(Degeneracy, ParallelLinesWithMotionAlongThem) {
@@ -245,8 +245,8 @@ TEST(Degeneracy, ParallelLinesWithMotionAlongThem) {
   // Rotation about d keeps the body-frame velocity along d in the world too
   // (with w about z the motion would turn away from the lines).
   o.omega = 0.8 * d;
-  const auto s = runTrials(o, 20, 9, defaultMethods());
-  for (size_t m = 0; m < s.size(); ++m) EXPECT_EQ(s[m].degenerate, 20) << toString(defaultMethods()[m]);
+  const auto s = runTrials(o, 20, 9, paperMethods());
+  for (size_t m = 0; m < s.size(); ++m) EXPECT_EQ(s[m].degenerate, 20) << toString(paperMethods()[m]);
 }
 
 TEST(Degeneracy, OneClusterIsDegenerate) {
@@ -254,7 +254,7 @@ TEST(Degeneracy, OneClusterIsDegenerate) {
   o.n_lines = 1;
   std::mt19937_64 rng(1);
   const auto tr = generateLineScene(o, rng);
-  for (const auto& r : solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper())) {
+  for (const auto& r : solveMethods(tr.observations, tr.given_motion, paperMethods(), SolverOptions::paper())) {
     EXPECT_EQ(r.status, SolveStatus::Degenerate);
     EXPECT_EQ(r.degeneracy, Degeneracy::TooFewClusters);
   }
@@ -264,7 +264,7 @@ TEST(Solvers, BadInputGivesStatusNotCrash) {
   std::mt19937_64 rng(2);
   const auto tr = generateLineScene(LineSceneOptions{}, rng);
   WindowObservations empty;
-  for (const auto& r : solveMethods(empty, tr.given_motion, defaultMethods(), SolverOptions::paper()))
+  for (const auto& r : solveMethods(empty, tr.given_motion, paperMethods(), SolverOptions::paper()))
     EXPECT_EQ(r.status, SolveStatus::Degenerate);
   WindowObservations bad_focal = tr.observations;
   bad_focal.focal_px = 0.0;
@@ -274,7 +274,7 @@ TEST(Solvers, BadInputGivesStatusNotCrash) {
   for (size_t k = 0; k < nan.clusters[0].size(); k += 3)
     nan.clusters[0].bearings[k].x() = std::numeric_limits<double>::quiet_NaN();
   nan.clusters[1].l1.normal.setConstant(std::numeric_limits<double>::quiet_NaN());
-  for (const auto& r : solveMethods(nan, tr.given_motion, defaultMethods(), SolverOptions::paper())) {
+  for (const auto& r : solveMethods(nan, tr.given_motion, paperMethods(), SolverOptions::paper())) {
     EXPECT_TRUE(r.ok()) << r.message;
     EXPECT_TRUE(r.v.allFinite());
   }
@@ -410,7 +410,7 @@ TEST(MethodNames, RoundTrip) {
   EXPECT_EQ(parseMethod("celc_acc"), Method::CelcAcc);
   // "all" is every method; the default leaves celc_acc out (asked for by name).
   EXPECT_EQ(parseMethodList("all").size(), allMethods().size());
-  EXPECT_EQ(allMethods().size(), defaultMethods().size() + 1);
+  EXPECT_EQ(allMethods().size(), paperMethods().size() + 1);
   EXPECT_THROW(parseMethod("npt2"), std::invalid_argument);
   EXPECT_THROW(parseMethodList(""), std::invalid_argument);
 }

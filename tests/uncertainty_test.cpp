@@ -74,7 +74,7 @@ TEST(Uncertainty, CalibratedOnSimulatedWindows) {
 // sigma_deg rises with every witness (measured with these seeds: 7 of 40
 // windows without, 10 of 40 with).
 TEST(Uncertainty, DisagreeingEstimatesRaiseSigma) {
-  const std::vector<Method> methods = defaultMethods();
+  const std::vector<Method> methods = paperMethods();
   SolverOptions fisher_only = SolverOptions::paper();
   fisher_only.uncertainty.agreement = false;
   const SolverOptions defaults = SolverOptions::paper();
@@ -194,7 +194,7 @@ TEST(Uncertainty, BudgetCoversAWrongGyroRate) {
 // celc_ml's errors at 2 sigma (measured: 44 sigmas raised over the 5
 // methods; 17 -> 20 of 30 windows covered).
 TEST(Uncertainty, SubsetWitnessRaisesSigmaUnderModelErrors) {
-  const std::vector<Method> methods = defaultMethods();
+  const std::vector<Method> methods = paperMethods();
   SolverOptions without = SolverOptions::paper();
   without.linear.max_rows = 4000;
   without.uncertainty.linear_witness_refined = true;  // the subset witness raises celc_ml too
@@ -246,11 +246,11 @@ TEST(Uncertainty, PureRotationIsNeverConfident) {
         o.omega = Vec3(0.3, -0.5, 0.8).normalized() * w;
         o.duration = T;
         const LineSceneTrial tr = generateLineScene(o, rng);
-        const auto res = solveMethods(tr.observations, tr.given_motion, defaultMethods(), SolverOptions::paper());
+        const auto res = solveMethods(tr.observations, tr.given_motion, paperMethods(), SolverOptions::paper());
         ++windows;
         for (size_t m = 0; m < res.size(); ++m) {
           EXPECT_FALSE(res[m].ok() && res[m].sigma_deg < 10.0)
-              << toString(defaultMethods()[m]) << " w " << w << " T " << T << " sigma " << res[m].sigma_deg;
+              << toString(paperMethods()[m]) << " w " << w << " T " << T << " sigma " << res[m].sigma_deg;
           EXPECT_EQ(res[m].status, res[0].status);
           EXPECT_EQ(res[m].degeneracy, res[0].degeneracy);
           EXPECT_EQ(res[m].n_lines, res[0].n_lines);

@@ -20,7 +20,7 @@ std::string toString(Method method) {
   return "unknown";
 }
 
-const std::vector<Method>& defaultMethods() {
+const std::vector<Method>& paperMethods() {
   static const std::vector<Method> methods{Method::Celc, Method::CelcOpt, Method::CelcMl, Method::Ce3lc, Method::Npt};
   return methods;
 }

@@ -24,7 +24,7 @@ struct SimulateConfig {
     s.uncertainty.clearBudget();
     return s;
   }();
-  std::vector<Method> methods = defaultMethods();
+  std::vector<Method> methods = paperMethods();
   int trials = 500;
   std::uint64_t seed = 1;
   std::string validate() const;  ///< empty when valid

@@ -64,7 +64,7 @@ struct PeerCellResult {
 struct PeerStudyConfig {
   PeerSceneOptions scene;         ///< base scene (the cells override their factors)
   SolverOptions solver = SolverOptions::paper();  ///< the peers' study runs the paper's preset
-  std::vector<Method> methods = defaultMethods();
+  std::vector<Method> methods = paperMethods();
   int trials = 200;
   std::uint64_t seed = 1;
   std::string validate() const;

@@ -18,12 +18,11 @@ Method parseMethod(const std::string& name);
 std::vector<Method> parseMethodList(const std::string& list);
 /// Every method, in the order of the enum ("all" in a method list).
 const std::vector<Method>& allMethods();
-/// What the studies (`celc simulate`, the peers' study) and the library's
-/// solveMethods callers run unless told otherwise: every method but
-/// celc_acc, the paper's methods and the peers'.
-const std::vector<Method>& defaultMethods();
+/// The paper's and the peers' methods, every method but celc_acc: what the
+/// studies (`celc simulate`, the peers' study) run unless told otherwise.
+const std::vector<Method>& paperMethods();
 /// What `celc run`, `batch`, `solve` and the Python module's run() solve
-/// unless told otherwise: defaultMethods() and celc_acc, whose row holds the
+/// unless told otherwise: paperMethods() and celc_acc, whose row holds the
 /// window's choice between the constant-velocity and the acceleration model.
 const std::vector<Method>& runMethods();
 
