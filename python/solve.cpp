@@ -29,7 +29,10 @@ CameraModel cameraFrom(const pyb::handle& calib, bool normalized, double focal) 
     for (const std::string& a : assignments(calib)) key += a + "\n";
     if (key == last_key && !key.empty()) return last_camera;
     applyDict(calib, "solve(calib)", [&](FieldVisitor& v) { describe(v, cam); });
-    if (const std::string err = cam.validate(); !err.empty()) throw ConfigError("solve(calib): " + err);
+    if (std::string err = cam.validate(); !err.empty()) {
+      while (!err.empty() && (err.back() == ' ' || err.back() == ';')) err.pop_back();
+      throw ConfigError("solve(calib): " + err);
+    }
     last_key = key;
     last_camera = cam;
   } else {
