@@ -588,7 +588,7 @@ TEST(IoRobustness, Aedat4HeaderHugeSensorRefusedBeforeAnyTable) {
   EXPECT_NO_THROW(celc::test::drain(d.file("b.aedat4")));
 }
 
-// ---- AEDAT 2.0: one corrupt timestamp no longer shifts the rest ------------------
+// ---- AEDAT 2.0: one corrupt timestamp does not shift the rest ------------------
 
 TEST(IoRobustness, Aedat2OneTimestampAllOnesIsAnOutlierNotAWrap) {
   TempDir d;

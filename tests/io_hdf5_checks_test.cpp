@@ -44,7 +44,7 @@ std::vector<double> mvsecEvents(std::size_t n, double t0, double dt) {
 TEST(IoRobustness, Hdf5ChunkLayoutLargerThanItsStoredChunksIsAnError) {
   // An MVSEC file whose events are stored in unfiltered chunks of 16 x 4 doubles
   // (512 bytes each), written by libhdf5; then the layout message's chunk rows
-  // 16 -> 199 (the fuzzer's change): the HDF5 library used to copy 6368 bytes
+  // 16 -> 199 (the fuzzer's change): unchecked, the HDF5 library copies 6368 bytes
   // out of each 512-byte chunk buffer (a heap overflow inside libhdf5).
   TempDir d;
   const std::string h5 = d.file("m.h5");
@@ -65,7 +65,7 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
   // A DSEC file whose /events/x is stored compact (in its object header, 60
   // uint16 = 120 bytes), written by libhdf5; then the layout message's compact size
   // 120 -> 0 (the fuzzer turned a chunked layout into a compact one of no
-  // bytes): the HDF5 library used to copy the values from a null buffer.
+  // bytes): unchecked, the HDF5 library copies the values from a null buffer.
   TempDir d;
   const std::string h5 = d.file("c.h5");
   {
