@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "celc/core/fields.hpp"
+#include "celc/core/text.hpp"
 
 namespace celc {
 
@@ -13,10 +14,7 @@ namespace {
 std::string numberText(double x) {
   if (std::isnan(x)) return "nan";
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.15g", x);
-  if (std::strtod(buf, nullptr) != x) std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
+  return roundTripText(x);
 }
 
 std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }

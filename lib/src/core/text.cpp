@@ -1,5 +1,8 @@
 #include "celc/core/text.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
 namespace celc {
 
 std::vector<std::string> splitList(std::string_view text, char separator) {
@@ -25,6 +28,13 @@ std::string byteCountText(double bytes) {
   if (!(bytes >= 0.0)) return "an invalid number of";
   if (!(bytes < 18446744073709551616.0)) return "more than 2^64";
   return std::to_string(static_cast<unsigned long long>(bytes));
+}
+
+std::string roundTripText(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", x);
+  if (std::strtod(buf, nullptr) != x) std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
 }
 
 }  // namespace celc

@@ -1,4 +1,5 @@
 #include "celc/core/yaml.hpp"
+#include "celc/core/text.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -62,10 +63,7 @@ namespace {
 std::string numberText(double x) {
   if (std::isnan(x)) return ".nan";
   if (std::isinf(x)) return x > 0 ? ".inf" : "-.inf";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.15g", x);
-  if (std::strtod(buf, nullptr) != x) std::snprintf(buf, sizeof buf, "%.17g", x);
-  std::string s = buf;
+  std::string s = roundTripText(x);
   // Keep it a float to the eye: "2" -> "2.0" (YAML reads both).
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
   return s;

@@ -23,4 +23,8 @@ std::string trimBlanks(std::string_view text);
 /// number of" (negative, NaN); never a float-to-integer overflow.
 std::string byteCountText(double bytes);
 
+/// A finite double as the shortest of "%.15g" and "%.17g" that reads back to
+/// the same value ("0.5", "1e-10", "2"); callers spell NaN and infinities.
+std::string roundTripText(double x);
+
 }  // namespace celc
