@@ -6,7 +6,9 @@
 # of the median phi [rad] per method with ok windows / windows.
 #   scripts/scene_table.sh [OUTDIR] [-- extra celc run arguments]
 # Then the same over all windows of every scene. Default OUTDIR out/scenes;
-# about 8 minutes on 2 cores (rendering included).
+# about 8 minutes on 2 cores (rendering included). CELC_SCENE_FILTER, when
+# set, is a command every scene file passes through (stdin to stdout) before
+# it is rendered, e.g. scripts/imu_still_scene.py.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 out="$root/out/scenes"
@@ -40,7 +42,7 @@ printf '| scene | events | seconds | celc | celc_opt | celc_ml | ce3lc | npt | c
 for s in "${scenes[@]}"; do
   IFS='|' read -r name file edits <<<"$s"
   seq="$out/seq/$name"
-  sed -e "${edits:-s/^//}" "$file" >"$out/seq/$name.yaml"
+  sed -e "${edits:-s/^//}" "$file" | ${CELC_SCENE_FILTER:-cat} >"$out/seq/$name.yaml"
   if [ ! -f "$seq/events.txt" ] || ! cmp -s "$out/seq/$name.yaml" "$seq/.scene.yaml"; then
     "$celc" synth "$out/seq/$name.yaml" -o "$seq" --force -q
     cp "$out/seq/$name.yaml" "$seq/.scene.yaml"

@@ -634,3 +634,29 @@ TEST(SimSequence, CliRefusesExistingDirectoryWithoutForce) {
   fs::remove_all(dir);
   fs::remove_all(dir.string() + "_cfg");
 }
+
+// imu.still_before_s: the IMU starts that long before the motion, at rest at
+// the initial pose (gyro 0, accelerometer minus gravity in the camera
+// frame), and follows the trajectory from t = 0 on.
+TEST(SimImu, StillBeforeTheMotionRestsAtTheInitialPose) {
+  TrajectorySpec s = twistSpec(Vec3(0.5, -0.2, 1.0), Vec3(0.3, 0.1, -0.4));
+  s.initial.R = so3::exp(Vec3(0.2, -0.1, 0.3));
+  const Trajectory tr(s, 1.0);
+  ImuOptions o;
+  o.gyro_noise = 0.0;
+  o.accel_noise = 0.0;
+  o.still_before_s = 0.5;
+  const auto imu = simulateImu(tr, o, -o.still_before_s, 0.2, 3);
+  ASSERT_EQ(imu.size(), 701u);
+  EXPECT_NEAR(imu.front().t, -0.5, 1e-12);
+  for (const auto& m : imu) {
+    if (m.t < 0.0) {
+      ASSERT_LT(m.gyro.norm(), 1e-15) << "t=" << m.t;
+      ASSERT_LT((m.accel + s.initial.R.transpose() * o.gravity).norm(), 1e-12) << "t=" << m.t;
+    } else {
+      ASSERT_LT((m.gyro - tr.angularVelocity(m.t)).norm(), 1e-12) << "t=" << m.t;
+    }
+  }
+  o.still_before_s = -1.0;
+  EXPECT_NE(o.validate().find("still_before_s"), std::string::npos);
+}

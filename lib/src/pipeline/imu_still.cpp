@@ -63,7 +63,7 @@ StillSpan findFirstStill(const std::vector<ImuSample>& imu, const StillOptions& 
     while (begin < imu.size() && imu[begin].t < t0) ++begin;
     const double t1 = t0 + o.span_s;
     in_span.clear();
-    Vec3 gs = Vec3::Zero(), gq = Vec3::Zero();
+    Vec3 gs = Vec3::Zero(), gq = Vec3::Zero(), avs = Vec3::Zero(), avq = Vec3::Zero();
     double as = 0.0, aq = 0.0;
     for (std::size_t k = begin; k < imu.size() && imu[k].t < t1; ++k) {
       const Vec3& g = imu[k].gyro;
@@ -71,6 +71,8 @@ StillSpan findFirstStill(const std::vector<ImuSample>& imu, const StillOptions& 
       in_span.push_back(k);
       gs += g;
       gq += g.cwiseProduct(g);
+      avs += imu[k].accel;
+      avq += imu[k].accel.cwiseProduct(imu[k].accel);
       const double a = imu[k].accel.norm();
       as += a;
       aq += a * a;
@@ -129,6 +131,8 @@ StillSpan findFirstStill(const std::vector<ImuSample>& imu, const StillOptions& 
     out.gyro_mean = gm;
     out.gyro_std = gstd;
     out.accel_turn = turn;
+    out.accel_mean = avs / n;
+    out.accel_std = (avq / n - out.accel_mean.cwiseProduct(out.accel_mean)).cwiseMax(0.0).cwiseSqrt();
     out.refused.clear();
     return out;
   }

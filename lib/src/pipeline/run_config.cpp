@@ -30,6 +30,7 @@ void describeMotion(FieldVisitor& s, RunConfig& c) {
                  "significant and gyro_bias is zero; true = always (an error without one); false = never"},
                 c.gyro_bias_from_still, {StillBias::Auto, StillBias::On, StillBias::Off});
   describe(s, c.gyro);
+  describe(s, c.accelerometer);
 }
 }  // namespace
 

@@ -19,6 +19,7 @@
 #include "celc/io/sequence_layout.hpp"
 #include "celc/io/text_io.hpp"
 #include "celc/io/truth_labels.hpp"
+#include "celc/pipeline/accelerometer.hpp"
 #include "celc/pipeline/imu_still.hpp"
 
 namespace fs = std::filesystem;
@@ -48,6 +49,26 @@ struct SequenceRunner::Impl {
   std::size_t n_imu = 0, n_poses = 0;
   std::optional<WindowDumpContext> dump;  ///< dumpWindows()
   std::optional<TruthLabels> truth;       ///< RunInputs::truth_labels, when there are any
+  AccelerometerTrack accelerometer;       ///< empty without accelerometer or still span
+  std::string accelerometer_note;         ///< how the accelerometer is used, or why not
+
+  /// The accelerometer track from the IMU (gyro bias removed) and its still
+  /// span, or the note why there is none.
+  void setUpAccelerometer(const std::vector<ImuSample>& imu, const StillSpan& still) {
+    if (!still.has_accel) {
+      accelerometer_note = "accelerometer: none (every sample 0)";
+    } else if (!still.found) {
+      accelerometer_note = "accelerometer: not used, no still second for gravity (" + still.refused + ")";
+    } else {
+      accelerometer = AccelerometerTrack(imu, calib.R_cam_imu, calib.time_offset, still, config.accelerometer);
+      const Vec3& g = accelerometer.gravity();
+      accelerometer_note = fmt::format(
+          "accelerometer: gravity {:.3f},{:.3f},{:.3f} m/s^2 (camera frame) from the still second [{:.3f}, {:.3f}] "
+          "s; celc_acc checks its acceleration against it (motion.use_accelerometer)",
+          g.x(), g.y(), g.z(), still.t0, still.t1);
+    }
+    spdlog::info("{}", accelerometer_note);
+  }
 
   /// The window's clusters against the true edges (`labels`: the clusters
   /// the solvers see, fragments of one edge joined), and celc_ml on the true
@@ -269,9 +290,11 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     m.gyro_bias = m.config.gyro_bias;
     if (!m.gyro_bias.isZero(0.0)) m.gyro_note = "motion.gyro_bias";
     const StillBias from_still = m.config.gyro_bias_from_still;
-    if (from_still == StillBias::On || (from_still == StillBias::Auto && m.gyro_bias.isZero(0.0))) {
+    const bool bias_from_still =
+        from_still == StillBias::On || (from_still == StillBias::Auto && m.gyro_bias.isZero(0.0));
+    const StillSpan still = bias_from_still || m.config.accelerometer.use ? findFirstStill(imu) : StillSpan{};
+    if (bias_from_still) {
       const std::string imu_path = m.inputs.imu.empty() ? in.events : m.inputs.imu;
-      const StillSpan still = findFirstStill(imu);
       if (!still.warning.empty()) {
         spdlog::warn("{}: {}", imu_path, still.warning);
         m.notes.push_back("gyro at rest: " + still.warning);
@@ -305,6 +328,7 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
     if (!m.gyro_bias.isZero(0.0))
       for (ImuSample& sample : imu) sample.gyro -= m.gyro_bias;
     m.gyro = GyroTrack(imu, m.calib.R_cam_imu, m.calib.time_offset, m.config.gyro);
+    if (m.config.accelerometer.use) m.setUpAccelerometer(imu, still);
   }
   if (!m.inputs.truth_labels.empty() && m.inputs.truth_labels != "none") {
     const std::string events_file =
@@ -343,6 +367,7 @@ std::vector<std::string> SequenceRunner::describe() const {
                        m.gyro_bias.y(), m.gyro_bias.z(), m.gyro_bias.norm() * 180.0 / M_PI, m.gyro_note);
     d.push_back(g);
     d.insert(d.end(), m.notes.begin(), m.notes.end());
+    if (!m.accelerometer_note.empty()) d.push_back(m.accelerometer_note);
   }
   d.push_back(m.gt ? "ground truth: " + m.inputs.groundtruth + " (" + std::to_string(m.n_poses) + " poses)"
                    : std::string("ground truth: none (no metrics)"));
@@ -479,6 +504,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     rec.times.redraw = secondsSince(start);
     start = Clock::now();
   }
+  obs.accelerometer = m.accelerometer.window(t0, t1, motion.referenceTime());
   const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds);
   rec.times.solve += secondsSince(start);
   dump(solved_labels);

@@ -59,10 +59,12 @@ std::vector<ImuSample> simulateImu(const Trajectory& trajectory, const ImuOption
   out.reserve(n);
   for (size_t k = 0; k < n; ++k) {
     const double t = t0 + static_cast<double>(k) / options.rate;
-    const RigidPose T = trajectory.pose(t);
-    const Vec3 v = trajectory.linearVelocity(t), w = trajectory.angularVelocity(t);
-    const Vec3 f_cam =
-        trajectory.linearVelocityRate(t) + w.cross(v) - T.R.transpose() * options.gravity;
+    const bool at_rest = t < 0.0 && options.still_before_s > 0.0;
+    const RigidPose T = trajectory.pose(at_rest ? 0.0 : t);
+    const Vec3 v = at_rest ? Vec3::Zero() : trajectory.linearVelocity(t);
+    const Vec3 w = at_rest ? Vec3::Zero() : trajectory.angularVelocity(t);
+    const Vec3 rate = at_rest ? Vec3::Zero() : trajectory.linearVelocityRate(t);
+    const Vec3 f_cam = rate + w.cross(v) - T.R.transpose() * options.gravity;
     ImuSample s;
     s.t = t;
     s.gyro = R_imu_cam * w + options.gyro_bias + sg * Vec3(N(rng), N(rng), N(rng));
@@ -274,7 +276,7 @@ SynthSummary writeSequence(const SynthConfig& config, const std::string& dir_nam
   summary.stats = sim.stats();
 
   {  // IMU
-    const auto imu = simulateImu(trajectory, config.imu, 0.0, config.duration, config.seed + 1);
+    const auto imu = simulateImu(trajectory, config.imu, -config.imu.still_before_s, config.duration, config.seed + 1);
     PartialFile f(dir, file::kImu);
     char line[256];
     for (const ImuSample& s : imu) {

@@ -154,6 +154,8 @@ void describe(FieldVisitor& v, ImuOptions& o) {
   if (!isRotation(read)) v.fail("R_cam_imu", "must be a rotation matrix (row-major 3x3)");
   o.R_cam_imu = read;
   v.field({"gravity", "m/s^2", "gravity in the world frame", anyFinite()}, o.gravity);
+  v.field({"still_before_s", "s", "the IMU starts this long before the motion, the camera at rest",
+           within(0, 60)}, o.still_before_s);
   if (v.reading())
     if (const std::string err = o.validate(); !err.empty()) v.fail("", err);
 }

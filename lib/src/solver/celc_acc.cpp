@@ -208,8 +208,10 @@ struct AccStarts {
 /// The starts: celc_ml's answer with a = 0 and its lines (with its Huber
 /// threshold, which the problem takes: the same events), or, where celc_ml
 /// hands over none, with the fitted lines; the linear (v, a) `linear` (null:
-/// none) with the fitted lines.
-AccStarts accStarts(JointProblem& problem, const SolverResult& ml, const MlEnd& ml_end, const Vec6* linear) {
+/// none) with the fitted lines; celc_ml's v with the accelerometer's a
+/// (over a speed) `a_measured` (null: none) with the fitted lines.
+AccStarts accStarts(JointProblem& problem, const SolverResult& ml, const MlEnd& ml_end, const Vec6* linear,
+                    const Vec3* a_measured) {
   AccStarts s;
   s.handed = ml_end.valid && ml_end.m1.size() == problem.clusters() && ml_end.huber_px > 0.0;
   s.from_ml = problem.start(ml.v);
@@ -221,6 +223,7 @@ AccStarts accStarts(JointProblem& problem, const SolverResult& ml, const MlEnd& 
   }
   if (linear) s.states.push_back(problem.start(linear->head<3>(), linear->tail<3>()));
   if (!s.handed) s.states.push_back(problem.start(ml.v));
+  if (a_measured) s.states.push_back(problem.start(ml.v, *a_measured));
   return s;
 }
 
@@ -315,33 +318,59 @@ AccSpread accelerationSpread(const JointProblem& problem, const JointProblem::St
   return out;
 }
 
-/// The longest |t - t_ref| [s] over the usable clusters' events.
-double windowReach(const WindowObservations& obs, const WindowFrames& frames, double t_ref) {
-  double reach = 0.0;
-  for (int c : frames.clusters())
-    for (double t : obs.clusters[c].times)
-      if (std::isfinite(t)) reach = std::max(reach, std::abs(t - t_ref));
-  return reach;
+/// The camera's mean acceleration over its speed [1/s] in the reference
+/// frame over [t0, t1] at the end point (v, a), what the accelerometer
+/// measures: with p(t) = P(t) v + q(t) a, p'' = a where the velocity is
+/// constant in the reference frame (P = tau I); where it is constant in the
+/// body frame, P' = R(t) and p''(t) = R(t) (w(t) x v) + a, whose mean over
+/// [t0, t1] is a + (R(t1) v - R(t0) v) / (t1 - t0), v unit.
+Vec3 meanAcceleration(const Vec3& v, const Vec3& a, const MotionModel& motion, double t0, double t1) {
+  if (motion.velocityFrame() == VelocityFrame::Reference || !(t1 > t0)) return a;
+  const Vec3 u = v.normalized();
+  return a + (motion.rotate(t1, u) - motion.rotate(t0, u)) / (t1 - t0);
 }
 
-/// The accelerating answer from the end point `best`: v and a (their sign
-/// by cheirality with resolve_sign), the spread of v's tangent block as
+/// The accelerometer against an accelerating end point (AccOptions::accelerometer_chi2):
+/// the statistic and the speed s [m/s] that fits a (over the speed [1/s],
+/// along v = the camera's velocity) to the measured a_m [m/s^2] best. c_aa
+/// is a's covariance [1/s^2] (NaN: taken as 0).
+struct AccelerometerAgreement {
+  double chi2 = NAN;
+  double speed = NAN;
+};
+
+AccelerometerAgreement accelerometerAgreement(const MeasuredAcceleration& m, const Vec3& a, const Mat3& c_aa) {
+  AccelerometerAgreement out;
+  if (!a.allFinite()) return out;
+  const double a2 = a.squaredNorm();
+  out.speed = a2 > 0.0 ? std::max(0.0, m.a.dot(a) / a2) : 0.0;
+  const Vec3 r = m.a - out.speed * a;
+  Mat3 cov = std::max(m.sigma * m.sigma, 1e-12) * Mat3::Identity();
+  if (c_aa.allFinite()) cov += out.speed * out.speed * c_aa;
+  out.chi2 = r.dot(cov.ldlt().solve(r));
+  return out;
+}
+
+/// a's covariance at the spread: the Fisher or the cluster-robust block,
+/// whichever is larger (trace), NaN where neither is finite.
+Mat3 accelerationCovariance(const AccSpread& spread) {
+  const Mat3 fisher = spread.cov.bottomRightCorner<3, 3>(), robust = spread.robust_cov.bottomRightCorner<3, 3>();
+  if (!robust.allFinite()) return fisher;
+  if (!fisher.allFinite()) return robust;
+  return robust.trace() > fisher.trace() ? robust : fisher;
+}
+
+/// The accelerating answer from the end point `best`: v and a (times the
+/// sign decided, judgeEnd), the spread of v's tangent block as
 /// sigma_deg, the robust scale as the residual, the likelihood ratio lr in
 /// the message; its time is not set.
 SolverResult acceleratingAnswer(const JointProblem::Result& best, const AccSpread& spread, double lr,
-                                const WindowObservations& obs, const MotionModel& motion,
-                                const WindowFrames& frames, bool resolve_sign) {
+                                const SignDecision& sign) {
   SolverResult result;
   result.status = SolveStatus::Ok;
   result.acceleration_seen = true;
-  result.v = best.state.v;
-  result.acceleration = best.state.a;
-  SignDecision sign;
-  if (resolve_sign) {
-    sign = resolveSign(obs, motion, result.v, &result.acceleration, frames);
-    result.v *= static_cast<double>(sign.sign);
-    result.acceleration *= static_cast<double>(sign.sign);
-  }
+  result.v = static_cast<double>(sign.sign) * best.state.v;
+  result.acceleration = static_cast<double>(sign.sign) * best.state.a;
   result.sign_margin = sign.margin * sign.sign;
   result.iterations = best.iterations;
   result.rows_used = best.events;
@@ -357,6 +386,93 @@ SolverResult acceleratingAnswer(const JointProblem::Result& best, const AccSprea
                 "acceleration seen (likelihood ratio %.3g, cluster-robust Wald %.3g), |a|/|v| = %.3g 1/s", lr,
                 spread.robust_wald, result.acceleration.norm());
   result.message = text;
+  return result;
+}
+
+/// What the tests make of an accelerating end point: the acceleration is
+/// not observable, not seen (the likelihood ratio against the
+/// constant-velocity cost C_0 and the cluster-robust Wald statistic, both
+/// against test_chi2), contradicted by the accelerometer, or seen.
+struct AccJudgement {
+  enum class Verdict { Unobservable, NotSeen, Contradicted, Seen };
+  Verdict verdict = Verdict::NotSeen;
+  Degeneracy reason = Degeneracy::None;
+  std::string why;             ///< the message of a constant-velocity answer
+  Vec3 a_along_ml;             ///< a with the sign of celc_ml's v
+  SignDecision sign;           ///< the sign of (v, a): by cheirality with resolve_sign, else celc_ml's
+  AccSpread spread;
+  double lr = NAN;             ///< the likelihood ratio
+  AccelerometerAgreement agreement;  ///< chi2 NaN without accelerometer
+};
+
+/// The window an accelerating end point is judged on.
+struct AccWindow {
+  const WindowObservations& obs;
+  const MotionModel& motion;
+  const WindowFrames& frames;
+  double reach;  ///< the usable clusters' events' longest |t - t_ref| [s]
+};
+
+AccJudgement judgeEnd(const JointProblem& problem, const JointProblem::Result& end,
+                      const JointProblem::Result& constant, const SolverResult& ml, const AccWindow& w,
+                      const SolverOptions& options) {
+  const AccOptions& acc = options.acc;
+  const double reach = w.reach;
+  AccJudgement j;
+  j.a_along_ml = end.state.v.dot(ml.v) < 0.0 ? Vec3(-end.state.a) : end.state.a;
+  j.spread = accelerationSpread(problem, end.state);
+  char text[240];
+  if (!(j.spread.sigma_a * reach <= acc.max_sigma)) {
+    j.verdict = AccJudgement::Verdict::Unobservable;
+    j.reason = Degeneracy::AccelerationUnobservable;
+    std::snprintf(text, sizeof text, "acceleration not observable: its std times the window's reach, %.3g, above %g",
+                  j.spread.sigma_a * reach, acc.max_sigma);
+    j.why = text;
+    return j;
+  }
+  const double scale2 = std::max(j.spread.scale * j.spread.scale, 1e-300);
+  j.lr = constant.ok ? 2.0 * (constant.cost - end.cost) / scale2 : INFINITY;
+  // Seen only where both tests pass: the likelihood ratio (independent
+  // events) and the cluster-robust Wald statistic (clusters as samples;
+  // NaN with too few clusters, where the ratio decides alone).
+  if (!(j.lr > acc.test_chi2) || j.spread.robust_wald <= acc.test_chi2) {
+    std::snprintf(text, sizeof text,
+                  "no acceleration seen (likelihood ratio %.3g, cluster-robust Wald %.3g; both must exceed %g)", j.lr,
+                  j.spread.robust_wald, acc.test_chi2);
+    j.why = text;
+    return j;
+  }
+  j.sign.sign = end.state.v.dot(ml.v) < 0.0 ? -1 : 1;
+  if (options.linear.resolve_sign) j.sign = resolveSign(w.obs, w.motion, end.state.v, &end.state.a, w.frames);
+  const MeasuredAcceleration& measured = w.obs.accelerometer;
+  if (measured.valid) {
+    const double sign = static_cast<double>(j.sign.sign);
+    const Vec3 a = meanAcceleration(sign * end.state.v, sign * end.state.a, w.motion, measured.t0, measured.t1);
+    j.agreement = accelerometerAgreement(measured, a, accelerationCovariance(j.spread));
+    if (!(j.agreement.chi2 <= acc.accelerometer_chi2)) {
+      j.verdict = AccJudgement::Verdict::Contradicted;
+      std::snprintf(text, sizeof text,
+                    "the accelerometer contradicts the acceleration seen (likelihood ratio %.3g; accelerometer "
+                    "chi2 %.3g above %g, |a_m| = %.3g m/s^2)",
+                    j.lr, j.agreement.chi2, acc.accelerometer_chi2, measured.a.norm());
+      j.why = text;
+      return j;
+    }
+  }
+  j.verdict = AccJudgement::Verdict::Seen;
+  return j;
+}
+
+/// The accelerating answer at `end` with its judgement, its time set.
+SolverResult acceptedAnswer(const JointProblem::Result& end, const AccJudgement& judged, double time_us) {
+  SolverResult result = acceleratingAnswer(end, judged.spread, judged.lr, judged.sign);
+  if (std::isfinite(judged.agreement.chi2)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "; the accelerometer agrees (chi2 %.3g), |v| about %.3g m/s",
+                  judged.agreement.chi2, judged.agreement.speed);
+    result.message += text;
+  }
+  result.time_us = time_us;
   return result;
 }
 
@@ -387,46 +503,54 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
                             before_us + microsecondsSince(start));
   const int iterations = options.refine.max_iterations;
   const double tolerance = std::max(options.refine.function_tolerance, kFunctionTolerance);
+  // The usable clusters' events span [t_first, t_last]; reach is their longest |t - t_ref| [s].
+  double t_first = INFINITY, t_last = -INFINITY;
+  for (int c : frames.clusters())
+    for (double t : obs.clusters[c].times)
+      if (std::isfinite(t)) t_first = std::min(t_first, t), t_last = std::max(t_last, t);
+  const double t_ref = motion.referenceTime();
+  const double reach = t_last >= t_first ? std::max(std::abs(t_first - t_ref), std::abs(t_last - t_ref)) : 0.0;
   Vec6 linear;
   const bool have_linear = linearAcceleration(obs, motion, celc, options.linear, frames, row_seed, linear);
-  const AccStarts starts = accStarts(problem, ml, ml_end, have_linear ? &linear : nullptr);
+  // The accelerometer's a as a start, over a speed: the linear stage's |a|
+  // where there is one, else a velocity change of the velocity's size over the window.
+  const MeasuredAcceleration& measured = obs.accelerometer;
+  const bool measured_start = measured.valid && measured.a.norm() > 0.0 &&
+                              measured.a.norm() >= acc.accelerometer_start_sigma * measured.sigma;
+  const double start_rate =
+      have_linear && linear.tail<3>().norm() > 0.0 ? linear.tail<3>().norm() : 1.0 / std::max(reach, 1e-3);
+  const Vec3 a_measured =
+      measured_start ? Vec3(start_rate * measured.a.normalized() -
+                            meanAcceleration(ml.v, Vec3::Zero(), motion, measured.t0, measured.t1))
+                     : Vec3::Zero();
+  const AccStarts starts =
+      accStarts(problem, ml, ml_end, have_linear ? &linear : nullptr, measured_start ? &a_measured : nullptr);
   const JointProblem::Result best = screenAccStarts(problem, starts, iterations, tolerance, options);
   if (!best.ok)
     return constantVelocity(ml, Degeneracy::None, "the accelerating refinement failed",
                             before_us + microsecondsSince(start));
-  // a with the sign of celc_ml's v, for the constant-velocity answers.
-  const Vec3 a_along_ml = best.state.v.dot(ml.v) < 0.0 ? Vec3(-best.state.a) : best.state.a;
   // The test's C_0: celc_ml's answer refined on this problem under the
   // constant-velocity model (the answer without a; from celc_ml's lines a
   // few iterations).
   const JointProblem::Result constant = problem.refineConstantVelocity(starts.from_ml, iterations, tolerance);
-  const AccSpread spread = accelerationSpread(problem, best.state);
-  const double reach = windowReach(obs, frames, motion.referenceTime());
-  char text[240];
-  if (!(spread.sigma_a * reach <= acc.max_sigma)) {
-    std::snprintf(text, sizeof text, "acceleration not observable: its std times the window's reach, %.3g, above %g",
-                  spread.sigma_a * reach, acc.max_sigma);
-    SolverResult r = constantVelocity(ml, Degeneracy::AccelerationUnobservable, text,
-                                      before_us + microsecondsSince(start));
-    r.acceleration = a_along_ml;
+  const AccWindow window{obs, motion, frames, reach};
+  const AccJudgement judged = judgeEnd(problem, best, constant, ml, window, options);
+  if (judged.verdict == AccJudgement::Verdict::Contradicted && measured_start) {
+    // The lowest end point contradicts the accelerometer: the end point of
+    // its own start, where that one agrees.
+    const JointProblem::Result own = problem.refine(starts.states.back(), iterations, tolerance);
+    if (own.ok) {
+      const AccJudgement second = judgeEnd(problem, own, constant, ml, window, options);
+      if (second.verdict == AccJudgement::Verdict::Seen)
+        return acceptedAnswer(own, second, before_us + microsecondsSince(start));
+    }
+  }
+  if (judged.verdict != AccJudgement::Verdict::Seen) {
+    SolverResult r = constantVelocity(ml, judged.reason, judged.why, before_us + microsecondsSince(start));
+    r.acceleration = judged.a_along_ml;
     return r;
   }
-  const double scale2 = std::max(spread.scale * spread.scale, 1e-300);
-  const double lr = constant.ok ? 2.0 * (constant.cost - best.cost) / scale2 : INFINITY;
-  // Seen only where both tests pass: the likelihood ratio (independent
-  // events) and the cluster-robust Wald statistic (clusters as samples;
-  // NaN with too few clusters, where the ratio decides alone).
-  if (!(lr > acc.test_chi2) || spread.robust_wald <= acc.test_chi2) {
-    std::snprintf(text, sizeof text,
-                  "no acceleration seen (likelihood ratio %.3g, cluster-robust Wald %.3g; both must exceed %g)", lr,
-                  spread.robust_wald, acc.test_chi2);
-    SolverResult r = constantVelocity(ml, Degeneracy::None, text, before_us + microsecondsSince(start));
-    r.acceleration = a_along_ml;
-    return r;
-  }
-  SolverResult result = acceleratingAnswer(best, spread, lr, obs, motion, frames, options.linear.resolve_sign);
-  result.time_us = before_us + microsecondsSince(start);
-  return result;
+  return acceptedAnswer(best, judged, before_us + microsecondsSince(start));
 }
 
 }  // namespace celc::detail

@@ -160,6 +160,15 @@ void describe(FieldVisitor& v, AccOptions& o) {
            "the acceleration is seen when 2 (C_0 - C_a) / s^2 exceeds this (chi-square, 3 dof: 16.27 at p = 0.001); "
            "else celc_ml's answer", atLeast(0)},
           o.test_chi2);
+  v.field({"accelerometer_chi2", "-",
+           "an accelerating answer whose direction of a the accelerometer contradicts beyond this (chi-square, "
+           "2 dof: 13.82 at p = 0.001) is not kept",
+           atLeast(0)},
+          o.accelerometer_chi2);
+  v.field({"accelerometer_start_sigma", "-",
+           "the refinement also starts from a along the accelerometer's where |a_m| is this many sigma or more",
+           atLeast(0)},
+          o.accelerometer_start_sigma);
 }
 
 void describe(FieldVisitor& v, UncertaintyOptions& o) {

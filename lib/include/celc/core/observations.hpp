@@ -33,10 +33,22 @@ struct ClusterObservation {
   size_t size() const { return times.size(); }
 };
 
+/// The accelerometer's view of a window: the camera's mean acceleration
+/// over [t0, t1] in the reference frame (the camera at the motion model's
+/// t_ref), gravity removed, with its 1-sigma error per axis. Not valid
+/// without an accelerometer or without gravity (pipeline/accelerometer.hpp).
+struct MeasuredAcceleration {
+  bool valid = false;
+  Vec3 a = Vec3::Zero();  ///< [m/s^2], reference frame
+  double sigma = 0.0;     ///< [m/s^2] per axis
+  double t0 = 0.0, t1 = 0.0;  ///< [s] the first and last sample averaged
+};
+
 /// All clusters of one window.
 struct WindowObservations {
   std::vector<ClusterObservation> clusters;
   double focal_px = 320.0;  ///< converts normalised distances to pixels (thresholds are in px)
+  MeasuredAcceleration accelerometer;  ///< celc_acc's check (solver/options.hpp AccOptions)
 };
 
 }  // namespace celc

@@ -66,6 +66,8 @@ struct StillSpan {
   Vec3 gyro_mean = Vec3::Zero();    ///< [rad/s], IMU frame: the bias estimate
   Vec3 gyro_std = Vec3::Zero();     ///< [rad/s] per axis
   double accel_turn = 0.0;          ///< [rad] over the span (0 without accelerometer)
+  Vec3 accel_mean = Vec3::Zero();   ///< [m/s^2], IMU frame: minus gravity, plus the accelerometer's bias
+  Vec3 accel_std = Vec3::Zero();    ///< [m/s^2] per axis, the sample noise
   /// False when every accelerometer sample is zero: (b) was not tested.
   bool has_accel = true;
   /// Non-empty when the answer is weaker than usual (no accelerometer).

@@ -13,6 +13,7 @@
 #include "celc/io/event_reader.hpp"
 #include "celc/io/imu_window.hpp"
 #include "celc/io/window_source.hpp"
+#include "celc/pipeline/accelerometer.hpp"
 #include "celc/pipeline/imu_still.hpp"
 #include "celc/pipeline/window_policy.hpp"
 #include "celc/solver/solver.hpp"
@@ -76,6 +77,9 @@ struct RunConfig {
   /// without a still second or with gyro_bias set; Off never.
   StillBias gyro_bias_from_still = StillBias::Auto;
   GyroWindowOptions gyro;
+  /// The accelerometer for celc_acc's check, with gravity from the first
+  /// still second (pipeline/accelerometer.hpp).
+  AccelerometerOptions accelerometer;
   ClusterOptions cluster;
   ObservationOptions observations;
   /// The solvers' defaults (solver/options.hpp): the library's and the tool's are one.

@@ -13,7 +13,7 @@
 /// Output directory (RPG text layout, no header lines):
 ///   events.txt       t x y p          [s, 6 decimals] [px] [px] {0, 1}
 ///   labels.txt       edge id per event line (-1: noise)
-///   imu.txt          t ax ay az gx gy gz    [s] [m/s^2] [rad/s], IMU frame
+///   imu.txt          t ax ay az gx gy gz    [s] [m/s^2] [rad/s], IMU frame, from -imu.still_before_s
 ///   groundtruth.txt  t px py pz qx qy qz qw  T_world_body [s] [m]
 ///   twist.txt        t vx vy vz wx wy wz  true camera-frame twist at the GT times
 ///   calib.txt        fx fy cx cy k1 k2 p1 p2 k3
@@ -42,6 +42,11 @@ struct ImuOptions {
   Vec3 accel_bias = Vec3::Zero();  ///< [m/s^2]
   Mat3 R_cam_imu = Mat3::Identity();
   Vec3 gravity = Vec3(0.0, 9.81, 0.0);  ///< g in the world frame [m/s^2] (y down by default)
+  /// [s] the IMU starts this long before the motion, the camera at rest at
+  /// the initial pose (timestamps from -still_before_s): the still span from
+  /// which `celc run` takes the gyro bias and gravity. The twist then starts
+  /// at t = 0 without the accelerometer seeing the step.
+  double still_before_s = 0.0;
   std::string validate() const;
 };
 
@@ -71,7 +76,8 @@ struct SynthConfig {
   std::string validate() const;  ///< empty when valid
 };
 
-/// IMU samples at t0, t0 + 1/rate, ... <= t1.
+/// IMU samples at t0, t0 + 1/rate, ... <= t1; at t < 0, when
+/// options.still_before_s > 0, the camera rests at trajectory.pose(0).
 std::vector<ImuSample> simulateImu(const Trajectory& trajectory, const ImuOptions& options,
                                    double t0, double t1, uint64_t seed);
 /// Ground-truth poses T_world_body at t0, t0 + 1/rate, ... <= t1.

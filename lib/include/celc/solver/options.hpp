@@ -308,6 +308,16 @@ struct AccOptions {
   /// this: the chi-square law's point with 3 degrees of freedom (a's) at
   /// p = 0.001 is 16.27.
   double test_chi2 = 16.27;  ///< [-]
+  /// With an accelerometer (WindowObservations::accelerometer): an
+  /// accelerating answer a (over the speed) whose direction the measured
+  /// acceleration a_m contradicts is not kept. The statistic
+  /// r^T (sigma^2 I + s^2 C_a)^-1 r, r = a_m - s a, s = max(0, a_m.a / |a|^2)
+  /// the speed that fits best and C_a a's covariance, is about chi-square
+  /// with 2 degrees of freedom where they agree: its point at p = 0.001 is
+  /// 13.82. And where |a_m| is at least accelerometer_start_sigma times its
+  /// sigma, the joint refinement also starts from a along a_m.
+  double accelerometer_chi2 = 13.82;     ///< [-]
+  double accelerometer_start_sigma = 3.0;  ///< [-]
   std::string validate() const;  ///< empty when valid
 };
 
