@@ -13,6 +13,7 @@
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
+#   accelerometer scripts/accelerometer_table.sh: accelerometer.md (the scenes with a still IMU start; 15 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
 #   summary     the README's results table from simulation, peers and scenes: summary.md;
 #               then the tables the pages of docs/ include (<!-- include results/NAME.md -->)
@@ -30,7 +31,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds acceleration studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -102,6 +103,10 @@ for name in "${names[@]}"; do
     acceleration)
       scripts/acceleration_sweep.sh 200 "$work/acceleration" > "$work/acceleration.txt"
       $tables table 0 < "$work/acceleration.txt" | put acceleration_sweep.md acceleration "scripts/acceleration_sweep.sh 200"
+      ;;
+    accelerometer)
+      scripts/accelerometer_table.sh "$work/accelerometer" > "$work/accelerometer.txt"
+      put accelerometer.md accelerometer "scripts/accelerometer_table.sh" < "$work/accelerometer.txt"
       ;;
     studies)
       for s in acceleration rate_offset solve_path; do

@@ -533,7 +533,8 @@ TEST(Uncertainty, GyroBiasFromTheFirstStillSecond) {
 // still start's bias (1.2-2.1 deg/s, hundreds of standard errors) comes off
 // every sample, and summary.md and the log say so with the span; false keeps
 // the raw rates (every window's rate off by R_cam_imu b) and the summary names
-// no bias; an explicit motion.gyro_bias wins over auto.
+// no bias; an explicit motion.gyro_bias wins over auto. The same still
+// second gives the accelerometer its gravity.
 TEST(Uncertainty, GyroBiasFromAStillStartIsUsedByDefault) {
   const fs::path d = test::freshTempDir("unc_bias_auto");
   const Vec3 bias(0.012, -0.021, 0.008);
@@ -546,6 +547,8 @@ TEST(Uncertainty, GyroBiasFromAStillStartIsUsedByDefault) {
   // The sample itself (0.3 s of IMU) has no still second: nothing subtracted, and the summary says why.
   const std::string plain = test::readAll(d / "a" / "summary.md");
   EXPECT_NE(plain.find("gyro bias: none subtracted; no still second in the IMU"), std::string::npos) << plain;
+  // Nor gravity: the accelerometer is not used, and the summary says why.
+  EXPECT_NE(plain.find("accelerometer: not used, no still second for gravity"), std::string::npos) << plain;
   r = test::runCelc("run '" + (d / "seq").string() + "' -o '" + (d / "b").string() + "'" + common +
                         "--set windows.t_end=1.55",
                     d);
@@ -557,6 +560,9 @@ TEST(Uncertainty, GyroBiasFromAStillStartIsUsedByDefault) {
   EXPECT_NE(summary.find("subtracted: the mean over the first still second [0.000, 1.000] s"), std::string::npos)
       << summary;
   EXPECT_NE(summary.find("motion.gyro_bias_from_still: auto"), std::string::npos) << summary;
+  // The still second's accelerometer (0, -9.81, 0) gives gravity, the
+  // calibration's R_cam_imu turning it into the camera frame.
+  EXPECT_NE(summary.find("accelerometer: gravity"), std::string::npos) << summary;
   EXPECT_NE(r.err.find("gyro bias 0.01"), std::string::npos) << r.err;  // the log
   EXPECT_NE(test::readAll(d / "b" / "config.yaml").find("gyro_bias_from_still: auto"), std::string::npos);
   r = test::runCelc("info '" + (d / "seq").string() + "'", d);

@@ -403,6 +403,10 @@ struct AccJudgement {
   AccSpread spread;
   double lr = NAN;             ///< the likelihood ratio
   AccelerometerAgreement agreement;  ///< chi2 NaN without accelerometer
+  /// The accelerometer's reading stands out of its noise
+  /// (AccOptions::accelerometer_start_sigma): only then does the agreement
+  /// fix a speed.
+  bool reading_significant = false;
 };
 
 /// The window an accelerating end point is judged on.
@@ -449,6 +453,7 @@ AccJudgement judgeEnd(const JointProblem& problem, const JointProblem::Result& e
     const double sign = static_cast<double>(j.sign.sign);
     const Vec3 a = meanAcceleration(sign * end.state.v, sign * end.state.a, w.motion, measured.t0, measured.t1);
     j.agreement = accelerometerAgreement(measured, a, accelerationCovariance(j.spread));
+    j.reading_significant = measured.a.norm() >= acc.accelerometer_start_sigma * measured.sigma;
     if (!(j.agreement.chi2 <= acc.accelerometer_chi2)) {
       j.verdict = AccJudgement::Verdict::Contradicted;
       std::snprintf(text, sizeof text,
@@ -466,12 +471,14 @@ AccJudgement judgeEnd(const JointProblem& problem, const JointProblem::Result& e
 /// The accelerating answer at `end` with its judgement, its time set.
 SolverResult acceptedAnswer(const JointProblem::Result& end, const AccJudgement& judged, double time_us) {
   SolverResult result = acceleratingAnswer(end, judged.spread, judged.lr, judged.sign);
-  if (std::isfinite(judged.agreement.chi2)) {
-    char text[160];
+  char text[160] = "";
+  if (std::isfinite(judged.agreement.chi2) && judged.reading_significant && judged.agreement.speed > 0.0)
     std::snprintf(text, sizeof text, "; the accelerometer agrees (chi2 %.3g), |v| about %.3g m/s",
                   judged.agreement.chi2, judged.agreement.speed);
-    result.message += text;
-  }
+  else if (std::isfinite(judged.agreement.chi2))
+    std::snprintf(text, sizeof text, "; the accelerometer reads no acceleration beyond its noise (chi2 %.3g)",
+                  judged.agreement.chi2);
+  result.message += text;
   result.time_us = time_us;
   return result;
 }
