@@ -111,14 +111,15 @@ struct SequenceRunner::Impl {
   /// The window's clusters redrawn under the witness's answer `first`
   /// (cluster/motion_reassign.hpp), with their observations. Kept, replacing
   /// `first` (by the witness's answer on them), `labels` (the clusters before
-  /// fragments join), `report` and `obs`, when
+  /// fragments join), `report`, `obs` and `solves` (the witness's shared
+  /// estimates on them), when
   /// the witness answers on them and the window's cost per event under that
   /// answer and its clusters (motionCost) is below the first answer's with
   /// the first clusters. Returns whether it was kept.
   bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
                          const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
                          SolverResult& first, std::vector<int>& labels, ObservationReport& report,
-                         WindowObservations& obs) const {
+                         WindowObservations& obs, SharedSolves& solves) const {
     auto to_bearing = [&](const Vec2& p) { return bearing(p); };
     std::vector<int> redrawn = report.event_clusters;
     const MotionReassignReport redraw =
@@ -128,7 +129,9 @@ struct SequenceRunner::Impl {
     ObservationReport redrawn_report;
     WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
                                                     config.observations, &motion, &redrawn_report);
-    const SolverResult after = solveMethods(redrawn_obs, motion, {witness}, witnessOptions(), seeds).front();
+    SharedSolves redrawn_solves;
+    const SolverResult after =
+        solveMethods(redrawn_obs, motion, {witness}, witnessOptions(), seeds, redrawn_solves).front();
     // The window's cost per event (every event: the same set both times)
     // under each answer with its clusters.
     const double cost_before = redraw.cost;
@@ -148,6 +151,7 @@ struct SequenceRunner::Impl {
     labels = clusters.labels;
     report = std::move(redrawn_report);
     obs = std::move(redrawn_obs);
+    solves = std::move(redrawn_solves);
     return true;
   }
 
@@ -490,13 +494,15 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // The clusters redrawn under the witness's first answer, where kept; then
   // every method on the window's final clusters.
   std::vector<int> solved_labels = clusters.labels;  // the final clusters, before fragments join
+  // The witness's estimates on the final clusters, which the methods share (SharedSolves).
+  SharedSolves solves;
   if (const std::optional<Method> witness = m.redrawWitness(cluster_options)) {
-    SolverResult answer = solveMethods(obs, motion, {*witness}, m.witnessOptions(), seeds).front();
+    SolverResult answer = solveMethods(obs, motion, {*witness}, m.witnessOptions(), seeds, solves).front();
     rec.times.solve = secondsSince(start);
     start = Clock::now();
     for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {
       if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer, solved_labels,
-                               report, obs))
+                               report, obs, solves))
         break;
       rec.n_clusters = report.n_used;
       rec.n_line_fit_failed = report.n_line_fit_failed;
@@ -505,7 +511,7 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     start = Clock::now();
   }
   obs.accelerometer = m.accelerometer.window(t0, t1, motion.referenceTime());
-  const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds);
+  const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds, solves);
   rec.times.solve += secondsSince(start);
   dump(solved_labels);
   if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);

@@ -165,15 +165,31 @@ SolverResult solveCelcOpt(const WindowObservations& obs, const MotionModel& moti
 }
 
 
-/// The estimates several methods share, each computed on first use and kept:
-/// celc's linear estimate, npt's (its sign resolved by cheirality with
-/// linear.resolve_sign) and celc_ml's with its end point's lines (celc_acc's
-/// start). Refers to its inputs, which outlive it.
+}  // namespace
+
+/// The shared estimates as computed (SharedSolves).
+struct SharedSolves::Store {
+  std::optional<SolverResult> linear, npt, ml;
+  detail::MlEnd ml_end;
+};
+
+SharedSolves::SharedSolves() : store_(std::make_unique<Store>()) {}
+SharedSolves::~SharedSolves() = default;
+SharedSolves::SharedSolves(SharedSolves&&) noexcept = default;
+SharedSolves& SharedSolves::operator=(SharedSolves&&) noexcept = default;
+
+namespace {
+
+/// The estimates several methods share, each computed on first use and kept
+/// in a SharedSolves store: celc's linear estimate, npt's (its sign resolved
+/// by cheirality with linear.resolve_sign) and celc_ml's with its end
+/// point's lines (celc_acc's start). Refers to its inputs, which outlive it.
 class SharedEstimates {
  public:
   SharedEstimates(const WindowObservations& obs, const MotionModel& motion, const SolverOptions& options,
-                  const detail::WindowFrames& frames, const SampleSeeds& seeds)
-      : obs_(obs), motion_(motion), options_(options), frames_(frames), seeds_(seeds) {}
+                  const detail::WindowFrames& frames, const SampleSeeds& seeds, SharedSolves::Store& store)
+      : obs_(obs), motion_(motion), options_(options), frames_(frames), seeds_(seeds), linear_(store.linear),
+        npt_(store.npt), ml_(store.ml), ml_end_(store.ml_end) {}
 
   /// celc's linear estimate on the rows seeded by seeds.linear_rows.
   const SolverResult& linear() {
@@ -221,8 +237,10 @@ class SharedEstimates {
   const SolverOptions& options_;
   const detail::WindowFrames& frames_;
   const SampleSeeds& seeds_;
-  std::optional<SolverResult> linear_, npt_, ml_;
-  detail::MlEnd ml_end_;
+  std::optional<SolverResult>& linear_;
+  std::optional<SolverResult>& npt_;
+  std::optional<SolverResult>& ml_;
+  detail::MlEnd& ml_end_;
 };
 
 /// Method m's result on the window, the shared estimates taken from `shared`.
@@ -436,11 +454,18 @@ void floorBehindCamera(std::vector<SolverResult>& out, const std::vector<bool>& 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options, const SampleSeeds& seeds) {
+  SharedSolves shared;
+  return solveMethods(obs, motion, methods, options, seeds, shared);
+}
+
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods, const SolverOptions& options,
+                                       const SampleSeeds& seeds, SharedSolves& solves) {
   // Window-level checks once; a degenerate window is degenerate for every method.
   const SolverResult window = detail::checkWindow(obs, motion, options.linear, options.check_parallax);
   if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
   const detail::WindowFrames frames(obs, motion);
-  SharedEstimates shared(obs, motion, options, frames, seeds);
+  SharedEstimates shared(obs, motion, options, frames, seeds, solves.store());
   std::vector<SolverResult> out;
   for (Method m : methods) out.push_back(solveMethod(m, shared, obs, motion, options, frames, seeds));
 

@@ -14,6 +14,7 @@
 /// f_k = (x, y, 1) lies on it: f_k^T B_k v = 0 (the paper's CELC, its
 /// event-line-line constraint). Row a_k = B_k^T f_k, stacked: A v = 0.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "celc/geometry/motion_model.hpp"
@@ -52,6 +53,26 @@ struct SampleSeeds {
   std::uint64_t refine_events = 1;
 };
 
+/// The estimates several methods share on one window: celc's linear
+/// estimate, npt's, and celc_ml's with its end point. solveMethods computes
+/// each on first use; given one of these, it keeps them for the next call on
+/// the same observations, motion, seeds and solver options but
+/// `uncertainty` (which they do not use), and takes them from it: `celc run`
+/// solves celc_ml to redraw a window's clusters, then every method on the
+/// clusters it kept. Move-only; empty when built.
+class SharedSolves {
+ public:
+  SharedSolves();
+  ~SharedSolves();
+  SharedSolves(SharedSolves&&) noexcept;
+  SharedSolves& operator=(SharedSolves&&) noexcept;
+  struct Store;
+  Store& store() { return *store_; }
+
+ private:
+  std::unique_ptr<Store> store_;
+};
+
 /// Runs the requested methods on one window; celc_opt and celc_ml start from
 /// the celc result (computed once; also when its nullspace is ambiguous,
 /// Degeneracy::NullspaceNotUnique: celc_opt then resolves the sign at its end
@@ -65,6 +86,10 @@ struct SampleSeeds {
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options, const SampleSeeds& seeds);
+/// The same, the shared estimates taken from and kept in `shared` (SharedSolves).
+std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
+                                       const std::vector<Method>& methods, const SolverOptions& options,
+                                       const SampleSeeds& seeds, SharedSolves& shared);
 /// The same with the seeds of the options (options.linear.seed, options.refine.seed).
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
