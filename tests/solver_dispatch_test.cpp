@@ -1,9 +1,11 @@
 // The dispatcher (solveMethods) against the methods run one by one: the
 // clusters' frames it computes once per window and shares with every method
 // and sign test give the same results as each method's own frames, and the
-// per-window seeds passed as arguments the same as seeds set in the options.
+// per-window seeds passed as arguments the same as seeds set in the options;
+// the estimates kept in a SharedSolves store those of one call.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "celc/sim/line_scene.hpp"
@@ -94,4 +96,36 @@ TEST(SolverDispatch, SeedsAsArgumentsEqualSeedsInOptions) {
   const auto b = solveMethods(tr.observations, tr.given_motion, allMethods(), defaults, SampleSeeds{7, 9});
   ASSERT_EQ(a.size(), b.size());
   for (size_t m = 0; m < a.size(); ++m) expectSameResult(a[m], b[m], "method", static_cast<int>(m));
+}
+
+// SharedSolves: celc_ml solved alone (without uncertainty, as `celc run`'s
+// redraw does) and then every method with the same store give every method's
+// result of one call without a store, sigma_deg included; celc_ml's is taken
+// from the store, not solved again (its time is the first call's).
+TEST(SolverDispatch, SharedSolvesGiveTheResultsOfOneCall) {
+  std::mt19937_64 rng(31);
+  const SolverOptions options;  // `celc run`'s defaults: uncertainty on
+  SolverOptions witness = options;
+  witness.uncertainty.enabled = false;
+  for (int trial = 0; trial < 4; ++trial) {
+    LineSceneOptions o;
+    o.events_per_line = 400;
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    const SampleSeeds seeds{3 + static_cast<std::uint64_t>(trial), 5};
+    SharedSolves shared;
+    const SolverResult first =
+        solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, witness, seeds, shared).front();
+    const auto with_store = solveMethods(tr.observations, tr.given_motion, allMethods(), options, seeds, shared);
+    const auto alone = solveMethods(tr.observations, tr.given_motion, allMethods(), options, seeds);
+    ASSERT_EQ(with_store.size(), alone.size());
+    for (size_t m = 0; m < alone.size(); ++m) {
+      expectSameResult(with_store[m], alone[m], toString(allMethods()[m]).c_str(), trial);
+      EXPECT_EQ(with_store[m].sigma_deg, alone[m].sigma_deg) << toString(allMethods()[m]) << ", trial " << trial;
+      if (allMethods()[m] == Method::CelcMl) {
+        ASSERT_TRUE(first.ok()) << first.message;
+        EXPECT_EQ(with_store[m].time_us, first.time_us) << "trial " << trial;
+        EXPECT_TRUE(std::isnan(first.sigma_deg) || first.sigma_deg != alone[m].sigma_deg);
+      }
+    }
+  }
 }
