@@ -10,7 +10,7 @@ Over the ok rows with ground truth and a sigma_deg, per method and bin:
   sharp      of the rows within 2 deg, the share with sigma_deg <= 5 deg
   sigma/phi  median of sigma_deg / phi (phi in deg, at least 0.01 deg)
   median sigma_deg, and how often a rule raised it (sigma_rule: disagreement
-  d, behind_camera b, ambiguous_nullspace n)
+  d, behind_camera b, ambiguous_nullspace n, accelerometer_refused a)
 --compact LABEL prints instead one row per method, labelled LABEL: ok rows,
 coverage per bin, sharp and sigma/phi over all (--header: the table's header
 first), so that several sets make one table.
@@ -62,7 +62,8 @@ def cell(rows):
     good = [r for r in rows if r["phi_deg"] <= 2.0]
     ratio = statistics.median(r["sigma"] / max(r["phi_deg"], PHI_FLOOR_DEG) for r in rows)
     rules = {k: sum(r["rule"] == name for r in rows)
-             for k, name in (("d", "disagreement"), ("b", "behind_camera"), ("n", "ambiguous_nullspace"))}
+             for k, name in (("d", "disagreement"), ("b", "behind_camera"), ("n", "ambiguous_nullspace"),
+                             ("a", "accelerometer_refused"))}
     return {"ok": len(rows), "coverage": covered / len(rows),
             "sharp": (sum(r["sigma"] <= 5.0 for r in good) / len(good)) if good else float("nan"),
             "good": len(good), "ratio": ratio, "sigma": statistics.median(r["sigma"] for r in rows),

@@ -268,8 +268,9 @@ TEST(CelcAcc, AgreeingAccelerometerKeepsTheAccelerationAndGivesTheSpeed) {
 }
 
 // An accelerometer that contradicts the acceleration the events show (its
-// reading turned 90 deg, sigma 0.07 m/s^2 against |a| = 2 m/s^2): no
-// accelerating answer is kept, the answer is celc_ml's and says why.
+// reading turned 90 deg, sigma 0.07 m/s^2 against |a| = 4 m/s^2): no
+// accelerating answer is kept, the answer is celc_ml's and says why, and its
+// sigma_deg is at least its angle to the refused answer.
 TEST(CelcAcc, ContradictingAccelerometerKeepsConstantVelocity) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 5; ++trial) {
@@ -281,5 +282,10 @@ TEST(CelcAcc, ContradictingAccelerometerKeepsConstantVelocity) {
     EXPECT_FALSE(res[1].acceleration_seen) << res[1].message;
     EXPECT_EQ(res[1].v, res[0].v);
     EXPECT_NE(res[1].message.find("the accelerometer contradicts"), std::string::npos) << res[1].message;
+    // Neither model explains these events: the angle to the refused answer
+    // (celc_ml's bias at rho = 2, tens of degrees) bounds sigma_deg.
+    EXPECT_GT(res[1].sigma_floor_deg, 5.0);
+    EXPECT_GE(res[1].sigma_deg, res[1].sigma_floor_deg);
+    EXPECT_EQ(res[1].sigma_rule, "accelerometer_refused");
   }
 }

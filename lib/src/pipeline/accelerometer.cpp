@@ -41,11 +41,13 @@ AccelerometerTrack::AccelerometerTrack(const std::vector<ImuSample>& imu, const 
   const std::size_t mid = static_cast<std::size_t>(
       std::min<std::ptrdiff_t>(std::lower_bound(t_.begin(), t_.end(), t_s_) - t_.begin(), n - 1));
   t_s_ = t_[mid];
-  R_s_[mid] = Mat3::Identity();
-  for (std::size_t k = mid + 1; k < n; ++k)
-    R_s_[k] = R_s_[k - 1] * so3::exp(0.5 * (w_[k - 1] + w_[k]) * (t_[k] - t_[k - 1]));
-  for (std::size_t k = mid; k-- > 0;)
-    R_s_[k] = R_s_[k + 1] * so3::exp(0.5 * (w_[k] + w_[k + 1]) * (t_[k + 1] - t_[k])).transpose();
+  // Unit quaternions, renormalised at every step (a long recording's product drifts off unit norm).
+  const auto step = [&](std::size_t a, std::size_t b) {
+    return Eigen::Quaterniond(so3::exp(0.5 * (w_[a] + w_[b]) * (t_[b] - t_[a])));
+  };
+  R_s_[mid] = Eigen::Quaterniond::Identity();
+  for (std::size_t k = mid + 1; k < n; ++k) R_s_[k] = (R_s_[k - 1] * step(k - 1, k)).normalized();
+  for (std::size_t k = mid; k-- > 0;) R_s_[k] = (R_s_[k + 1] * step(k, k + 1).conjugate()).normalized();
   for (std::size_t k = 0; k < n; ++k) f_s_[k] = R_s_[k] * (R_cam_imu * kept[k].accel);
   g_s_ = -(R_cam_imu * still.accel_mean);
   noise_ = still.accel_std.maxCoeff();
@@ -56,7 +58,7 @@ AccelerometerTrack::AccelerometerTrack(const std::vector<ImuSample>& imu, const 
 Mat3 AccelerometerTrack::rotationAt(double t) const {
   const auto it = std::upper_bound(t_.begin(), t_.end(), t);
   const std::size_t k = it == t_.begin() ? 0 : static_cast<std::size_t>(it - t_.begin()) - 1;
-  return R_s_[k] * so3::exp(w_[k] * (t - t_[k]));
+  return R_s_[k].toRotationMatrix() * so3::exp(w_[k] * (t - t_[k]));
 }
 
 MeasuredAcceleration AccelerometerTrack::window(double t0, double t1, double t_ref) const {

@@ -555,6 +555,12 @@ SolverResult solveCelcAcc(const WindowObservations& obs, const MotionModel& moti
   if (judged.verdict != AccJudgement::Verdict::Seen) {
     SolverResult r = constantVelocity(ml, judged.reason, judged.why, before_us + microsecondsSince(start));
     r.acceleration = judged.a_along_ml;
+    // Refused by the accelerometer: the events showed an acceleration that
+    // is not the camera's, so neither model explains them; the two answers'
+    // angle bounds sigma_deg from below.
+    if (judged.verdict == AccJudgement::Verdict::Contradicted && r.ok())
+      r.sigma_floor_deg =
+          angleBetween(ml.v, static_cast<double>(judged.sign.sign) * best.state.v) * 180.0 / M_PI;
     return r;
   }
   return acceptedAnswer(best, judged, before_us + microsecondsSince(start));

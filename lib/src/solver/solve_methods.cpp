@@ -366,6 +366,10 @@ void setUncertainties(std::vector<SolverResult>& out, const std::vector<Method>&
       r.sigma_deg = floor_deg[i];
       r.sigma_rule = "ambiguous_nullspace";
     }
+    if (r.sigma_floor_deg > r.sigma_deg) {
+      r.sigma_deg = r.sigma_floor_deg;
+      r.sigma_rule = "accelerometer_refused";
+    }
   }
 }
 

@@ -21,6 +21,7 @@
 /// has), the sample noise (the still span's std) over the n samples, and
 /// gravity turned by the gyro's residual bias e (the still span's standard
 /// error of its mean rate) over the time since the span.
+#include <Eigen/Geometry>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,7 @@ class AccelerometerTrack {
 
   std::vector<double> t_;    ///< camera time [s]
   std::vector<Vec3> f_s_;    ///< R_s(t_k) R_cam_imu f_k [m/s^2]
-  std::vector<Mat3> R_s_;    ///< R_s(t_k)
+  std::vector<Eigen::Quaterniond> R_s_;  ///< R_s(t_k)
   std::vector<Vec3> w_;      ///< camera-frame rate [rad/s]
   Vec3 g_s_ = Vec3::Zero();  ///< gravity, camera frame at t_s [m/s^2]
   double t_s_ = 0.0;         ///< the still span's middle, camera time [s]

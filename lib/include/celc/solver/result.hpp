@@ -46,8 +46,14 @@ struct SolverResult {
   /// The rule that raised sigma_deg above hypot(sigma_fisher_deg,
   /// sigma_budget_deg), empty when none: "disagreement" (another estimate of
   /// the window disagrees), "behind_camera" (the clusters' cheirality votes
-  /// disagree), "ambiguous_nullspace" (the linear rows' own spread).
+  /// disagree), "ambiguous_nullspace" (the linear rows' own spread),
+  /// "accelerometer_refused" (sigma_floor_deg).
   std::string sigma_rule;
+  /// A floor of sigma_deg [deg] the method sets itself, 0 for none. celc_acc
+  /// where the accelerometer refused the acceleration the events show: the
+  /// angle between its constant-velocity answer and the refused one (the
+  /// events fit neither model well).
+  double sigma_floor_deg = 0.0;
   /// The window's measured parallax, shared by every method (solveMethods):
   /// the median over the clusters with >= 8 events of the ratio of the robust
   /// scales of the rotation-compensated events about one static line and about
