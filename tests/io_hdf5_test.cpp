@@ -253,6 +253,45 @@ TEST(IoHdf5, LocalHeapPastTheFileIsRefusedBeforeTheLibraryReadsIt) {
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
+// The hdf5 fuzz target's fourth finding: a local heap whose free list loops
+// back on itself made libhdf5 allocate a node per step until memory ran out
+// (24 GB from a 14 KB file). The free list of every heap the reader walks is
+// followed first, at most one block per 16 bytes of its data segment.
+TEST(IoHdf5, LocalHeapFreeListThatLoopsIsRefused) {
+  CELC_REQUIRE_IO_FIXTURES();
+  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
+  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
+  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+  ASSERT_EQ(sb.base, 0u);
+  ASSERT_EQ(sb.length_bytes, 8);
+  const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, sb.root_header, "/");
+  const auto table = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x11; });
+  ASSERT_NE(table, messages.end());
+  auto load = [&](std::uint64_t at) {
+    std::uint64_t x = 0;
+    for (int i = 7; i >= 0; --i) x = (x << 8) | std::uint8_t(file[at + i]);
+    return x;
+  };
+  auto store = [&](std::uint64_t at, std::uint64_t x) {
+    for (int i = 0; i < 8; ++i) file[at + i] = char((x >> (8 * i)) & 0xff);
+  };
+  const std::uint64_t heap = load(table->data_byte + 8);
+  ASSERT_EQ(file.substr(heap, 4), "HEAP");
+  const std::uint64_t bytes = load(heap + 8), data = load(heap + 24);
+  ASSERT_GE(bytes, 32u);
+  // The list's head at offset 16 of the data segment, a block whose next is itself.
+  store(heap + 16, 16);
+  store(data + 16, 16);
+  store(data + 24, 16);
+  celc::test::TempDir dir;
+  const std::string path = dir.file("loop.h5");
+  std::ofstream(path, std::ios::binary) << file;
+  const std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
+  EXPECT_EQ(e, path + ": byte " + std::to_string(heap + 16) + ": object header of /: local heap free list of more than " +
+                   std::to_string(bytes / 16 + 1) + " blocks in " + std::to_string(bytes) + " bytes: it loops");
+}
+
 // The hdf5 fuzz target's third finding: a chunked layout of rank 0 made
 // libhdf5 divide by zero (SIGFPE) when it opened the dataset. The layout
 // message of every dataset is checked before the library opens it.

@@ -117,3 +117,41 @@ TEST(Accelerometer, WithoutGravityOrSamplesThereIsNoAnswer) {
   bad.bias_m_s2 = -1.0;
   EXPECT_NE(bad.validate().find("accel_bias_m_s2"), std::string::npos);
 }
+
+// Hostile IMU streams: NaN and infinite samples, repeated and backward
+// timestamps, a huge reading. The track skips what it cannot use, never
+// answers with a non-finite value; a window without two usable samples, or
+// beyond a gap in the gyro from the still span, has no answer.
+TEST(Accelerometer, BrokenSamplesAreSkippedNeverAnswered) {
+  ImuOptions o = imuOptions();
+  Recording r = record(o);
+  ASSERT_TRUE(r.still.found);
+  std::vector<ImuSample> broken = r.imu;
+  for (std::size_t k = 1500; k < 1600; ++k) broken[k].accel.x() = NAN;       // inside [0.5, 0.6)
+  for (std::size_t k = 1600; k < 1650; ++k) broken[k].gyro.y() = INFINITY;   // [0.6, 0.65)
+  for (std::size_t k = 1700; k < 1710; ++k) broken[k].t = broken[1699].t;    // repeated times
+  broken[1800].t = 0.1;                                                       // backwards
+  broken[1900].accel = Vec3(1e300, -1e300, 1e300);                            // absurd
+  const AccelerometerTrack track(broken, o.R_cam_imu, 0.0, r.still, AccelerometerOptions{});
+  ASSERT_FALSE(track.empty());
+  for (double t0 = 0.0; t0 < 0.95; t0 += 0.05) {
+    const MeasuredAcceleration m = track.window(t0, t0 + 0.05, t0);
+    if (m.valid) {
+      EXPECT_TRUE(m.a.allFinite()) << "t0=" << t0;
+      EXPECT_TRUE(std::isfinite(m.sigma) && m.sigma > 0.0) << "t0=" << t0;
+    }
+  }
+  // A window of NaN readings only has no answer; one that overlaps them is
+  // answered from its other samples.
+  EXPECT_FALSE(track.window(0.5, 0.6, 0.5).valid);
+  const MeasuredAcceleration around = track.window(0.45, 0.64, 0.45);
+  ASSERT_TRUE(around.valid);
+  EXPECT_NEAR(around.t0, 0.45, 1e-9);
+  EXPECT_NEAR(around.t1, 0.499, 1e-9);  // the samples of [0.5, 0.64) are NaN or infinite
+  // Beyond that 0.15 s gap the integrated rotation is broken: no answer.
+  EXPECT_FALSE(track.window(0.7, 0.8, 0.7).valid);
+  EXPECT_FALSE(track.window(0.4, 0.8, 0.4).valid);
+  // A recording of one usable sample has no track.
+  std::vector<ImuSample> one(r.imu.begin(), r.imu.begin() + 1);
+  EXPECT_TRUE(AccelerometerTrack(one, o.R_cam_imu, 0.0, r.still, AccelerometerOptions{}).empty());
+}

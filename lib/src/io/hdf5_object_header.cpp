@@ -55,7 +55,8 @@ void collectMessages(const std::vector<unsigned char>& chunk, std::uint64_t star
 /// The local heap of an old-style group (the names of its links): "HEAP",
 /// version 0, 3 reserved bytes, the data segment's size (a length), the free
 /// list's offset (a length), the data segment's address. Its data segment must
-/// lie inside the file: the library sizes its buffer from that field.
+/// lie inside the file: the library sizes its buffer from that field; and its
+/// free list must end inside it.
 void checkLocalHeap(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address, const std::string& what) {
   const std::uint64_t in_file = file.size() - sb.base;
   const std::size_t o = std::size_t(sb.offset_bytes), l = std::size_t(sb.length_bytes);
@@ -69,6 +70,24 @@ void checkLocalHeap(BinFile& file, const Hdf5Superblock& sb, std::uint64_t addre
     file.fail(sb.base + address + 8, what + ": local heap data of " + std::to_string(bytes) + " bytes at address " +
                                          std::to_string(data) + " passes the file's end (" +
                                          std::to_string(file.size()) + " bytes)");
+  // The free list: blocks in the data segment, each holding the next block's
+  // offset and its own size (two lengths); offset 1 or all ones ends it. The
+  // library follows it without a bound, allocating a node per block: a list
+  // that loops takes all the memory there is. It holds at most one block per
+  // 2 lengths of the segment.
+  const std::uint64_t end_marker = sb.length_bytes >= 8 ? ~0ull : (1ull << (8 * sb.length_bytes)) - 1;
+  std::uint64_t block = loadUnsigned(&h[8 + l], sb.length_bytes);
+  for (std::uint64_t count = 0; block != 1 && block != end_marker; ++count) {
+    if (count > bytes / (2 * l))
+      file.fail(sb.base + address + 8 + l, what + ": local heap free list of more than " +
+                                               std::to_string(count) + " blocks in " + std::to_string(bytes) +
+                                               " bytes: it loops");
+    if (block >= bytes || 2 * l > bytes - block)
+      file.fail(sb.base + address + 8 + l, what + ": local heap free block at offset " + std::to_string(block) +
+                                               " outside its " + std::to_string(bytes) + "-byte data segment");
+    const std::vector<unsigned char> b = bytesAt(file, sb.base + data + block, 2 * l, what + ": local heap free block");
+    block = loadUnsigned(b.data(), sb.length_bytes);
+  }
 }
 
 /// A chunked layout's chunk sizes must be positive and its rank (the dataset's

@@ -5,7 +5,8 @@
 //  - a continuation message's length sizes a metadata-cache buffer: 4 GB
 //    allocated for a 14 KB file;
 //  - an old-style group's local heap sizes its data segment the same way
-//    (88 TB), and a heap at the undefined address is read through NULL;
+//    (88 TB), a heap at the undefined address is read through NULL, and a
+//    free list that loops is followed until memory runs out;
 //  - a chunked layout of rank 0 is divided by (SIGFPE in H5Dopen2).
 // The reader checks every object header it is about to open with these
 // functions: every chunk of the header, its local heap and its layout.

@@ -20,7 +20,7 @@ void describe(FieldVisitor& v, AccelerometerOptions& o) {
 std::string AccelerometerOptions::validate() const { return rangeProblemsOf(*this); }
 
 AccelerometerTrack::AccelerometerTrack(const std::vector<ImuSample>& imu, const Mat3& R_cam_imu, double time_offset,
-                                       const StillSpan& still, const AccelerometerOptions& options) {
+                                       const StillSpan& still, const AccelerometerOptions& options, double max_gap) {
   if (!still.found || !still.has_accel || imu.size() < 2) return;
   std::vector<ImuSample> kept;
   kept.reserve(imu.size());
@@ -31,16 +31,19 @@ AccelerometerTrack::AccelerometerTrack(const std::vector<ImuSample>& imu, const 
   const std::size_t n = kept.size();
   t_.resize(n);
   w_.resize(n);
+  gaps_.assign(n, 0);
   R_s_.resize(n);
   f_s_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     t_[k] = kept[k].t + time_offset;
     w_[k] = R_cam_imu * kept[k].gyro;
+    if (k > 0) gaps_[k] = gaps_[k - 1] + (t_[k] - t_[k - 1] > max_gap ? 1 : 0);
   }
   t_s_ = 0.5 * (still.t0 + still.t1) + time_offset;
   const std::size_t mid = static_cast<std::size_t>(
       std::min<std::ptrdiff_t>(std::lower_bound(t_.begin(), t_.end(), t_s_) - t_.begin(), n - 1));
   t_s_ = t_[mid];
+  mid_ = mid;
   // Unit quaternions, renormalised at every step (a long recording's product drifts off unit norm).
   const auto step = [&](std::size_t a, std::size_t b) {
     return Eigen::Quaterniond(so3::exp(0.5 * (w_[a] + w_[b]) * (t_[b] - t_[a])));
@@ -68,6 +71,11 @@ MeasuredAcceleration AccelerometerTrack::window(double t0, double t1, double t_r
   const auto end = std::lower_bound(t_.begin(), t_.end(), t1);
   const std::ptrdiff_t count = end - begin;
   if (count < 2) return out;
+  // No gap between the still span and the window's samples or t_ref.
+  const auto ref = static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), t_ref) - t_.begin()) - 1;
+  const std::size_t lo = std::min({mid_, static_cast<std::size_t>(begin - t_.begin()), ref});
+  const std::size_t hi = std::max({mid_, static_cast<std::size_t>(end - t_.begin()) - 1, ref});
+  if (gaps_[hi] != gaps_[lo]) return out;
   Vec3 sum = Vec3::Zero();
   for (auto k = static_cast<std::size_t>(begin - t_.begin()); k < static_cast<std::size_t>(end - t_.begin()); ++k)
     sum += f_s_[k];

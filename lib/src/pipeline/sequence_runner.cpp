@@ -60,7 +60,8 @@ struct SequenceRunner::Impl {
     } else if (!still.found) {
       accelerometer_note = "accelerometer: not used, no still second for gravity (" + still.refused + ")";
     } else {
-      accelerometer = AccelerometerTrack(imu, calib.R_cam_imu, calib.time_offset, still, config.accelerometer);
+      accelerometer = AccelerometerTrack(imu, calib.R_cam_imu, calib.time_offset, still, config.accelerometer,
+                                         config.gyro.max_gap);
       const Vec3& g = accelerometer.gravity();
       accelerometer_note = fmt::format(
           "accelerometer: gravity {:.3f},{:.3f},{:.3f} m/s^2 (camera frame) from the still second [{:.3f}, {:.3f}] "

@@ -51,16 +51,19 @@ class AccelerometerTrack {
  public:
   AccelerometerTrack() = default;
   /// `imu`: samples in time order with the gyro bias already removed (IMU
-  /// frame); `still`: a found still span of the same samples (before the
-  /// bias came off: its gyro_std and samples give the residual bias).
+  /// frame); samples with a non-finite field or a time not after the last
+  /// kept one are skipped. `still`: a found still span of the same samples
+  /// (before the bias came off: its gyro_std and samples give the residual
+  /// bias). `max_gap` [s]: a longer step between kept samples breaks the
+  /// integrated rotation, and no window beyond it from the still span is answered.
   AccelerometerTrack(const std::vector<ImuSample>& imu, const Mat3& R_cam_imu, double time_offset,
-                     const StillSpan& still, const AccelerometerOptions& options);
+                     const StillSpan& still, const AccelerometerOptions& options, double max_gap = 0.02);
   bool empty() const { return t_.empty(); }
   /// Gravity in the camera frame at the still span's middle [m/s^2].
   const Vec3& gravity() const { return g_s_; }
   /// a_ref over [t0, t1) for the reference time t_ref [s]; not valid where
-  /// the track is empty, the window holds fewer than 2 samples, or t_ref
-  /// lies outside the samples.
+  /// the track is empty, the window holds fewer than 2 samples, t_ref lies
+  /// outside the samples, or a gap lies between the still span and them.
   MeasuredAcceleration window(double t0, double t1, double t_ref) const;
 
  private:
@@ -71,6 +74,8 @@ class AccelerometerTrack {
   std::vector<Vec3> f_s_;    ///< R_s(t_k) R_cam_imu f_k [m/s^2]
   std::vector<Eigen::Quaterniond> R_s_;  ///< R_s(t_k)
   std::vector<Vec3> w_;      ///< camera-frame rate [rad/s]
+  std::vector<int> gaps_;    ///< gaps longer than max_gap among the steps up to each sample
+  std::size_t mid_ = 0;      ///< the sample at t_s
   Vec3 g_s_ = Vec3::Zero();  ///< gravity, camera frame at t_s [m/s^2]
   double t_s_ = 0.0;         ///< the still span's middle, camera time [s]
   double noise_ = 0.0;       ///< per-sample std [m/s^2], the still span's largest axis
