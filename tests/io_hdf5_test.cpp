@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "celc/io/event_reader.hpp"
 #include "celc/io/text_io.hpp"
@@ -223,29 +224,62 @@ TEST(IoHdf5, HeaderChunksPastTheFileAreRefusedBeforeTheLibraryReadsThem) {
   }
 }
 
+namespace {
+
+/// seq_dsec.h5's bytes and the byte of its root group's local heap ("HEAP"),
+/// with little-endian u64 access to the bytes (8-byte addresses and lengths).
+struct RootHeap {
+  std::string file;
+  std::uint64_t heap = 0;
+  std::uint64_t load(std::uint64_t at) const {
+    std::uint64_t x = 0;
+    for (int i = 7; i >= 0; --i) x = (x << 8) | std::uint8_t(file[at + i]);
+    return x;
+  }
+  void store(std::uint64_t at, std::uint64_t x) {
+    for (int i = 0; i < 8; ++i) file[at + i] = char((x >> (8 * i)) & 0xff);
+  }
+};
+
+RootHeap rootHeap() {
+  RootHeap r;
+  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
+  r.file.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
+  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+  EXPECT_EQ(sb.base, 0u);
+  EXPECT_EQ(sb.offset_bytes, 8);
+  EXPECT_EQ(sb.length_bytes, 8);
+  const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, sb.root_header, "/");
+  const auto table = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x11; });
+  if (table == messages.end()) {
+    ADD_FAILURE() << "no symbol table message in the root group";
+    return r;
+  }
+  r.heap = r.load(table->data_byte + 8);
+  return r;
+}
+
+/// The reader's error on `file` written to a temporary path, and that path.
+std::pair<std::string, std::string> errorOnPatched(const std::string& file, celc::test::TempDir& dir) {
+  const std::string path = dir.file("patched.h5");
+  std::ofstream(path, std::ios::binary) << file;
+  return {ioErrorOf([&] { readAllEvents(*openEventSource(path)); }), path};
+}
+
+}  // namespace
+
 // The hdf5 fuzz target's next finding: an old-style group's local heap whose
 // data segment claims 88 TB made libhdf5 size a buffer from it while looking
 // up a link. The heap of every group the reader walks is checked first.
 TEST(IoHdf5, LocalHeapPastTheFileIsRefusedBeforeTheLibraryReadsIt) {
   CELC_REQUIRE_IO_FIXTURES();
-  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
-  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
-  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
-  ASSERT_EQ(sb.offset_bytes, 8);
-  ASSERT_EQ(sb.length_bytes, 8);
-  const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, sb.root_header, "/");
-  const auto table = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x11; });
-  ASSERT_NE(table, messages.end());
-  std::uint64_t heap = 0;
-  for (int i = 7; i >= 0; --i) heap = (heap << 8) | std::uint8_t(file[table->data_byte + 8 + i]);
-  ASSERT_EQ(file.substr(heap, 4), "HEAP");
-  for (int i = 0; i < 8; ++i) file[heap + 8 + i] = char(i == 5 ? 0x50 : 0);  // 0x500000000000 bytes
+  RootHeap r = rootHeap();
+  ASSERT_EQ(r.file.substr(r.heap, 4), "HEAP");
+  r.store(r.heap + 8, 0x500000000000ull);  // the data segment's size: 88 TB
   celc::test::TempDir dir;
-  const std::string path = dir.file("heap.h5");
-  std::ofstream(path, std::ios::binary) << file;
-  const std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
-  EXPECT_EQ(e.rfind(path + ": byte " + std::to_string(heap + 8) +
+  const auto [e, path] = errorOnPatched(r.file, dir);
+  EXPECT_EQ(e.rfind(path + ": byte " + std::to_string(r.heap + 8) +
                         ": object header of /: local heap data of 87960930222080 bytes at address ",
                     0),
             0u)
@@ -259,36 +293,17 @@ TEST(IoHdf5, LocalHeapPastTheFileIsRefusedBeforeTheLibraryReadsIt) {
 // followed first, at most one block per 16 bytes of its data segment.
 TEST(IoHdf5, LocalHeapFreeListThatLoopsIsRefused) {
   CELC_REQUIRE_IO_FIXTURES();
-  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
-  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
-  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
-  ASSERT_EQ(sb.base, 0u);
-  ASSERT_EQ(sb.length_bytes, 8);
-  const auto messages = celc::detail::checkHdf5ObjectHeader(raw, sb, sb.root_header, "/");
-  const auto table = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x11; });
-  ASSERT_NE(table, messages.end());
-  auto load = [&](std::uint64_t at) {
-    std::uint64_t x = 0;
-    for (int i = 7; i >= 0; --i) x = (x << 8) | std::uint8_t(file[at + i]);
-    return x;
-  };
-  auto store = [&](std::uint64_t at, std::uint64_t x) {
-    for (int i = 0; i < 8; ++i) file[at + i] = char((x >> (8 * i)) & 0xff);
-  };
-  const std::uint64_t heap = load(table->data_byte + 8);
-  ASSERT_EQ(file.substr(heap, 4), "HEAP");
-  const std::uint64_t bytes = load(heap + 8), data = load(heap + 24);
+  RootHeap r = rootHeap();
+  ASSERT_EQ(r.file.substr(r.heap, 4), "HEAP");
+  const std::uint64_t bytes = r.load(r.heap + 8), data = r.load(r.heap + 24);
   ASSERT_GE(bytes, 32u);
   // The list's head at offset 16 of the data segment, a block whose next is itself.
-  store(heap + 16, 16);
-  store(data + 16, 16);
-  store(data + 24, 16);
+  r.store(r.heap + 16, 16);
+  r.store(data + 16, 16);
+  r.store(data + 24, 16);
   celc::test::TempDir dir;
-  const std::string path = dir.file("loop.h5");
-  std::ofstream(path, std::ios::binary) << file;
-  const std::string e = ioErrorOf([&] { readAllEvents(*openEventSource(path)); });
-  EXPECT_EQ(e, path + ": byte " + std::to_string(heap + 16) + ": object header of /: local heap free list of more than " +
+  const auto [e, path] = errorOnPatched(r.file, dir);
+  EXPECT_EQ(e, path + ": byte " + std::to_string(r.heap + 16) + ": object header of /: local heap free list of more than " +
                    std::to_string(bytes / 16 + 1) + " blocks in " + std::to_string(bytes) + " bytes: it loops");
 }
 
