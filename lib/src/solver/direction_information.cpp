@@ -111,9 +111,41 @@ DirectionInformation DirectionTerms::information(const Vec3& direction, bool kee
 }
 
 Eigen::Vector2d DirectionTerms::shift(const Vec3& direction, const DirectionTerms& changed) const {
-  const Eigen::Vector2d invalid = Eigen::Vector2d::Constant(NAN);
-  if (changed.begin_ != begin_ || !direction.allFinite() || !(direction.norm() > 0.0) || !(focal_px_ > 0.0))
-    return invalid;
+  return shifts(direction, {&changed}).front();
+}
+
+namespace {
+
+/// One cluster's information blocks (I_vv, I_vl, I_ll) summed over events.
+struct InformationBlocks {
+  Eigen::Matrix2d vv = Eigen::Matrix2d::Zero();
+  Mat24 vl = Mat24::Zero();
+  Mat4 ll = Mat4::Zero();
+  void add(const Eigen::Vector2d& jv, const Eigen::Vector4d& jl) {
+    vv += jv * jv.transpose();
+    vl += jv * jl.transpose();
+    ll += jl * jl.transpose();
+  }
+};
+
+/// -S^-1 b, NaN when S is singular (eigenvalue ratio below 1e-12).
+Eigen::Vector2d solveShift(Eigen::Matrix2d S, const Eigen::Vector2d& b) {
+  S = 0.5 * (S + S.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+  if (!(es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(1), 1e-300)))
+    return Eigen::Vector2d::Constant(NAN);
+  return -S.inverse() * b;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> DirectionTerms::shifts(const Vec3& direction,
+                                                    const std::vector<const DirectionTerms*>& changed) const {
+  const size_t m = changed.size();
+  std::vector<Eigen::Vector2d> out(m, Eigen::Vector2d::Constant(NAN));
+  if (!direction.allFinite() || !(direction.norm() > 0.0) || !(focal_px_ > 0.0)) return out;
+  for (const DirectionTerms* other : changed)
+    if (other == nullptr || other->begin_ != begin_) return out;
   const Vec3 v = direction.normalized();
   const Mat32 Bv = tangentBasis(v);
   // Events beyond kShiftInlierScales robust scales of their line at the
@@ -126,44 +158,64 @@ Eigen::Vector2d DirectionTerms::shift(const Vec3& direction, const DirectionTerm
       const double d = eventDistance(terms_[k], v, m1_[c], m3_[c], focal_px_, nullptr, nullptr, nullptr);
       if (std::isfinite(d)) residuals.push_back(d);
     }
-  if (residuals.empty()) return invalid;
+  if (residuals.empty()) return out;
   const double limit = kShiftInlierScales * 1.4826 * detail::medianAbs(residuals);
-  Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  // The blocks of the unchanged terms are shared by every change; an event
+  // whose changed residual is not finite leaves that change's sums only,
+  // through its own `excluded` blocks.
+  std::vector<Eigen::Matrix2d> S(m, Eigen::Matrix2d::Zero());
+  std::vector<Eigen::Vector2d> b(m, Eigen::Vector2d::Zero());
+  std::vector<Eigen::Vector2d> av(m);
+  std::vector<Eigen::Vector4d> al(m);
+  std::vector<InformationBlocks> excluded(m);
+  std::vector<char> has_excluded(m);
+  std::vector<double> g(m);
   for (size_t c = 0; c < m1_.size(); ++c) {
     const Vec3& m1 = m1_[c];
     const Vec3& m3 = m3_[c];
     const Mat32 B1 = tangentBasis(m1), B3 = tangentBasis(m3);
-    Eigen::Matrix2d Ivv = Eigen::Matrix2d::Zero();
-    Mat24 Ivl = Mat24::Zero();
-    Mat4 Ill = Mat4::Zero();
-    Eigen::Vector2d av = Eigen::Vector2d::Zero();
-    Eigen::Vector4d al = Eigen::Vector4d::Zero();
+    InformationBlocks shared;
+    std::fill(av.begin(), av.end(), Eigen::Vector2d::Zero());
+    std::fill(al.begin(), al.end(), Eigen::Vector4d::Zero());
+    std::fill(excluded.begin(), excluded.end(), InformationBlocks{});
+    std::fill(has_excluded.begin(), has_excluded.end(), 0);
     for (size_t k = begin_[c]; k < begin_[c + 1]; ++k) {
       Vec3 gv, g1, g3;
       const double d = eventDistance(terms_[k], v, m1, m3, focal_px_, &gv, &g1, &g3);
-      const double d_changed = eventDistance(changed.terms_[k], v, m1, m3, focal_px_, nullptr, nullptr, nullptr);
-      if (!std::isfinite(d) || !std::isfinite(d_changed) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite())
-        continue;
+      if (!std::isfinite(d) || !gv.allFinite() || !g1.allFinite() || !g3.allFinite()) continue;
       if (limit > 0.0 && std::abs(d) > limit) continue;
       const Eigen::Vector2d jv = Bv.transpose() * gv;
       Eigen::Vector4d jl;
       jl << B1.transpose() * g1, B3.transpose() * g3;
-      const double g = d_changed - d;
-      Ivv += jv * jv.transpose();
-      Ivl += jv * jl.transpose();
-      Ill += jl * jl.transpose();
-      av += jv * g;
-      al += jl * g;
+      shared.add(jv, jl);
+      for (size_t j = 0; j < m; ++j) {
+        const double d_changed = eventDistance(changed[j]->terms_[k], v, m1, m3, focal_px_, nullptr, nullptr, nullptr);
+        if (!std::isfinite(d_changed)) {
+          excluded[j].add(jv, jl);
+          has_excluded[j] = 1;
+          continue;
+        }
+        g[j] = d_changed - d;
+        av[j] += jv * g[j];
+        al[j] += jl * g[j];
+      }
     }
-    const Mat4 Ill_pinv = pinvSymmetric(Ill);
-    S += Ivv - Ivl * Ill_pinv * Ivl.transpose();
-    b += av - Ivl * Ill_pinv * al;
+    const Mat4 shared_pinv = pinvSymmetric(shared.ll);
+    const Eigen::Matrix2d shared_schur = shared.vv - shared.vl * shared_pinv * shared.vl.transpose();
+    for (size_t j = 0; j < m; ++j) {
+      if (!has_excluded[j]) {
+        S[j] += shared_schur;
+        b[j] += av[j] - shared.vl * shared_pinv * al[j];
+        continue;
+      }
+      const Mat24 vl = shared.vl - excluded[j].vl;
+      const Mat4 pinv = pinvSymmetric(Mat4(shared.ll - excluded[j].ll));
+      S[j] += shared.vv - excluded[j].vv - vl * pinv * vl.transpose();
+      b[j] += av[j] - vl * pinv * al[j];
+    }
   }
-  S = 0.5 * (S + S.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
-  if (!(es.eigenvalues()(0) > 1e-12 * std::max(es.eigenvalues()(1), 1e-300))) return invalid;
-  return -S.inverse() * b;
+  for (size_t j = 0; j < m; ++j) out[j] = solveShift(S[j], b[j]);
+  return out;
 }
 
 double DirectionTerms::sigmaDeg(const Vec3& direction, double scale) const {

@@ -47,9 +47,10 @@ ErrorBudget::ErrorBudget(const WindowObservations& obs, const MotionModel& motio
 ErrorBudget::~ErrorBudget() = default;
 
 double ErrorBudget::sigmaDeg(const DirectionTerms& base, const Vec3& direction) const {
+  std::vector<const DirectionTerms*> changed;
+  for (const auto& c : changed_) changed.push_back(c.get());
   double sum = 0.0;
-  for (const auto& changed : changed_) {
-    const Eigen::Vector2d s = base.shift(direction, *changed);
+  for (const Eigen::Vector2d& s : base.shifts(direction, changed)) {
     if (!s.allFinite()) return NAN;
     sum += s.squaredNorm();
   }

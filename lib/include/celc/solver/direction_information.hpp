@@ -79,6 +79,10 @@ class DirectionTerms {
   /// (1.4826 median |d|) of their line at the estimate. NaN when S is
   /// singular or the events differ.
   Eigen::Vector2d shift(const Vec3& direction, const DirectionTerms& changed) const;
+  /// shift() for each of `changed`, the same numbers; the unchanged terms'
+  /// residuals, Jacobians and Schur blocks are computed once for all of them.
+  std::vector<Eigen::Vector2d> shifts(const Vec3& direction,
+                                      const std::vector<const DirectionTerms*>& changed) const;
 
  private:
   /// Cluster c's events: terms_[begin_[c], begin_[c + 1]); its plane
