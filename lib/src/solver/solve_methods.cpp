@@ -279,9 +279,16 @@ class UncertaintyModel {
     return *terms_;
   }
   /// The budget's sigma [deg] at v: 0 with no source, NaN where it fails.
+  /// Methods that answer the very same v (celc_acc keeping celc_ml's
+  /// constant velocity) share one evaluation.
   double budgetDeg(const Vec3& v) {
     if (!budget_) budget_.emplace(obs_, motion_, u_);
-    return budget_->sources() == 0 ? 0.0 : budget_->sigmaDeg(terms(), v);
+    if (budget_->sources() == 0) return 0.0;
+    for (const auto& [asked, deg] : budget_at_)
+      if (asked == v) return deg;
+    const double deg = budget_->sigmaDeg(terms(), v);
+    budget_at_.emplace_back(v, deg);
+    return deg;
   }
   /// Sets r's Fisher sigma (times `scale`), its budget and sigma_deg, the two
   /// in quadrature (infinite where the budget fails).
@@ -297,6 +304,7 @@ class UncertaintyModel {
   const UncertaintyOptions& u_;
   std::optional<DirectionTerms> terms_;
   std::optional<ErrorBudget> budget_;
+  std::vector<std::pair<Vec3, double>> budget_at_;  ///< directions asked about and their budget [deg]
 };
 
 /// The linear methods' ambiguous verdicts checked against the events' bound
