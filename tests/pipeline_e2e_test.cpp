@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -440,5 +441,55 @@ TEST(EndToEnd, AnswersLieInFrontOfTheCamera) {
     EXPECT_NEAR(row(on, 0, method).phi, row(off, 0, method).phi, 1e-9) << method;
     EXPECT_NEAR(row(on, 0, method).sigma_deg, row(off, 0, method).sigma_deg, 1e-9) << method;
   }
+  fs::remove_all(d);
+}
+
+// A redraw under the motion that gives again the clusters of the redraw kept
+// before it is not solved again (`celc run -vv` logs "unchanged, not kept"):
+// it would give the same observations, answer and cost. On the 4 m/s room
+// three of five windows end so after one kept round (measured), and their
+// rows are those of a run that stops after one round.
+TEST(EndToEnd, RedrawThatGivesTheKeptClustersAgainEndsTheRounds) {
+  const fs::path d = test::freshTempDir("e2e_redraw_unchanged");
+  const auto synth = test::runCelc(
+      "synth '" CELC_SOURCE_DIR "/config/scenes/e2e_davis346_room_fast.yaml' -o '" + (d / "seq").string() + "' -q", d);
+  ASSERT_EQ(synth.status, 0) << synth.err;
+  auto run = [&](const std::string& name, const std::string& extra) {
+    const auto r = test::runCelc("run '" + (d / "seq").string() + "' --methods celc_ml --threads 2 --no-plots -vv " +
+                                     extra + " -o '" + (d / name).string() + "'",
+                                 d);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.err;
+  };
+  const std::string log = run("three", "");
+  run("one", "--set cluster.motion_redraw_rounds=1");
+  // Each window's redraw outcomes in order: 'k' kept, 'n' not kept, 'u' unchanged.
+  std::map<std::int64_t, std::string> rounds;
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);) {
+    const auto at = line.find("debug window ");
+    if (at == std::string::npos || line.find("clusters under the motion") == std::string::npos) continue;
+    const std::int64_t window = std::stoll(line.substr(at + 13));
+    rounds[window] += line.find("unchanged, not kept") != std::string::npos ? 'u'
+                      : line.find(": not kept") != std::string::npos    ? 'n'
+                                                                          : 'k';
+  }
+  std::map<std::int64_t, WindowsCsvRow> three, one;
+  for (const auto& row : readWindowsCsv((d / "three" / "windows.csv").string(), false)) three[row.window] = row;
+  for (const auto& row : readWindowsCsv((d / "one" / "windows.csv").string(), false)) one[row.window] = row;
+  int ended_unchanged = 0;
+  for (const auto& [window, outcomes] : rounds) {
+    const auto u = outcomes.find('u');
+    if (u == std::string::npos) continue;
+    EXPECT_EQ(u, outcomes.size() - 1) << "window " << window << ": " << outcomes;  // it ends the rounds
+    EXPECT_GT(u, 0u) << "window " << window << ": only after a kept redraw";
+    if (outcomes != "ku") continue;
+    ++ended_unchanged;
+    ASSERT_TRUE(three.count(window) && one.count(window)) << "window " << window;
+    EXPECT_EQ(three[window].v, one[window].v) << "window " << window;
+    EXPECT_EQ(three[window].sigma_deg, one[window].sigma_deg) << "window " << window;
+    EXPECT_EQ(three[window].n_clusters, one[window].n_clusters) << "window " << window;
+  }
+  EXPECT_GE(ended_unchanged, 2);
   fs::remove_all(d);
 }

@@ -117,15 +117,23 @@ struct SequenceRunner::Impl {
   /// the witness answers on them and the window's cost per event under that
   /// answer and its clusters (motionCost) is below the first answer's with
   /// the first clusters. Returns whether it was kept.
+  /// `drawn_from` holds the clusters' labels (clustersFromLabels') a kept
+  /// redraw built `obs` from, empty before one is kept: a redraw that gives
+  /// them again would give the same observations, answer and cost, so it is
+  /// not kept, without solving again.
   bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
                          const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
                          SolverResult& first, std::vector<int>& labels, ObservationReport& report,
-                         WindowObservations& obs, SharedSolves& solves) const {
+                         WindowObservations& obs, SharedSolves& solves, std::vector<int>& drawn_from) const {
     auto to_bearing = [&](const Vec2& p) { return bearing(p); };
     std::vector<int> redrawn = report.event_clusters;
     const MotionReassignReport redraw =
         reassignToMotionLines(events, redrawn, to_bearing, calib.camera.focal(), motion, first.v, cluster_options);
     const ClusterResult clusters = clustersFromLabels(events, redrawn);
+    if (clusters.labels == drawn_from) {
+      spdlog::debug("window {}: clusters under the motion: unchanged, not kept", index);
+      return false;
+    }
     if (clusters.status != ClusterStatus::Ok) return false;
     ObservationReport redrawn_report;
     WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
@@ -149,6 +157,7 @@ struct SequenceRunner::Impl {
                   keep ? "kept" : "not kept");
     if (!keep) return false;
     first = after;
+    drawn_from = clusters.labels;
     labels = clusters.labels;
     report = std::move(redrawn_report);
     obs = std::move(redrawn_obs);
@@ -501,9 +510,10 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     SolverResult answer = solveMethods(obs, motion, {*witness}, m.witnessOptions(), seeds, solves).front();
     rec.times.solve = secondsSince(start);
     start = Clock::now();
+    std::vector<int> drawn_from;
     for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {
       if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer, solved_labels,
-                               report, obs, solves))
+                               report, obs, solves, drawn_from))
         break;
       rec.n_clusters = report.n_used;
       rec.n_line_fit_failed = report.n_line_fit_failed;
