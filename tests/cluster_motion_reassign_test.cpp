@@ -173,5 +173,39 @@ TEST(MotionReassign, OffOrWithoutAVelocityLeavesTheLabels) {
   EXPECT_EQ(labels, before);
 }
 
+// Lines fitted once (fitMotionLines: the cost of a redraw's result, which
+// the next redraw starts from) give the redraw the lines it would fit
+// itself: the same labels, counts and cost, with fragments joined (1 px) and
+// without; lines of other labels or another v are not taken.
+TEST(MotionReassign, PrefittedLinesGiveTheSameRedraw) {
+  const LabelledWindow w = window(6);
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  const auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
+  const Vec3 v = w.v.normalized();
+  for (double join_px : {0.0, 1.0}) {
+    ClusterOptions options;
+    options.motion_join_px = join_px;
+    const std::vector<int> start = corrupted(w, 6);
+    std::vector<int> fitted = start, prefitted = start;
+    const MotionReassignReport a =
+        reassignToMotionLines(w.events, fitted, bearing, w.camera.focal(), motion, v, options);
+    MotionLines lines = fitMotionLines(w.events, start, bearing, w.camera.focal(), motion, v, options);
+    ASSERT_TRUE(lines.fittedFor(start, v));
+    EXPECT_FALSE(lines.fittedFor(start, -v));
+    EXPECT_FALSE(lines.fittedFor(fitted, v));
+    EXPECT_EQ(lines.cost(), motionCost(w.events, start, bearing, w.camera.focal(), motion, v, options));
+    const MotionReassignReport b =
+        reassignToMotionLines(w.events, prefitted, bearing, w.camera.focal(), motion, v, options, &lines);
+    EXPECT_FALSE(lines.fittedFor(start, v)) << "taken";
+    EXPECT_EQ(fitted, prefitted) << "join " << join_px;
+    EXPECT_NE(fitted, start) << "join " << join_px;
+    EXPECT_EQ(a.cost, b.cost);
+    EXPECT_EQ(a.n_moved, b.n_moved);
+    EXPECT_EQ(a.n_joined, b.n_joined);
+    EXPECT_EQ(a.n_removed, b.n_removed);
+    EXPECT_EQ(a.n_lines, b.n_lines);
+  }
+}
+
 }  // namespace
 }  // namespace celc

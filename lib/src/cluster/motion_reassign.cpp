@@ -302,24 +302,62 @@ double windowCost(const std::vector<Event>& events, const std::vector<int>& labe
 
 }  // namespace
 
+/// The fitted lines a MotionLines holds.
+struct MotionLinesFit {
+  WindowLines w;
+};
+
+MotionLines::MotionLines() = default;
+MotionLines::~MotionLines() = default;
+MotionLines::MotionLines(MotionLines&&) noexcept = default;
+MotionLines& MotionLines::operator=(MotionLines&&) noexcept = default;
+
+bool MotionLines::fittedFor(const std::vector<int>& labels, const Vec3& v) const {
+  return lines_ && v_ == v && labels_ == labels;
+}
+
+/// reassignToMotionLines' hold on a MotionLines' fitted lines.
+struct MotionLinesAccess {
+  static std::unique_ptr<MotionLinesFit> take(MotionLines& m) { return std::move(m.lines_); }
+};
+
+MotionLines fitMotionLines(const std::vector<Event>& events, const std::vector<int>& labels,
+                           const BearingFunction& bearing, double focal_px, const MotionModel& motion, const Vec3& v,
+                           const ClusterOptions& options) {
+  MotionLines out;
+  auto fit = std::make_unique<MotionLinesFit>();
+  if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, fit->w)) return out;
+  out.cost_ = windowCost(events, labels, bearing, fit->w);
+  out.lines_ = std::move(fit);
+  out.labels_ = labels;
+  out.v_ = v;
+  return out;
+}
+
 double motionCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
                   double focal_px, const MotionModel& motion, const Vec3& v, const ClusterOptions& options) {
-  WindowLines w;
-  if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, w)) return NAN;
-  return windowCost(events, labels, bearing, w);
+  return fitMotionLines(events, labels, bearing, focal_px, motion, v, options).cost();
 }
 
 MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std::vector<int>& labels,
                                            const BearingFunction& bearing, double focal_px,
-                                           const MotionModel& motion, const Vec3& v, const ClusterOptions& options) {
+                                           const MotionModel& motion, const Vec3& v, const ClusterOptions& options,
+                                           MotionLines* prefit) {
   MotionReassignReport report;
-  WindowLines w;
-  if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, w)) return report;
+  std::unique_ptr<MotionLinesFit> taken;
+  if (prefit && prefit->fittedFor(labels, v)) {
+    report.cost = prefit->cost();
+    taken = MotionLinesAccess::take(*prefit);
+  } else {
+    taken = std::make_unique<MotionLinesFit>();
+    if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, taken->w)) return report;
+    report.cost = windowCost(events, labels, bearing, taken->w);
+  }
+  WindowLines& w = taken->w;
   const double threshold = w.threshold;
   const int n_labels = w.n_labels;
   const double t_lo = w.t_lo, t_hi = w.t_hi;
   std::vector<Group>& groups = w.groups;
-  report.cost = windowCost(events, labels, bearing, w);
   for (const Group& g : groups) {
     report.n_lines += g.fitted ? 1 : 0;
     report.n_unexplained += g.fitted && !g.explained ? 1 : 0;

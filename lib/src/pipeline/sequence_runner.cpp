@@ -120,15 +120,17 @@ struct SequenceRunner::Impl {
   /// `drawn_from` holds the clusters' labels (clustersFromLabels') a kept
   /// redraw built `obs` from, empty before one is kept: a redraw that gives
   /// them again would give the same observations, answer and cost, so it is
-  /// not kept, without solving again.
+  /// not kept, without solving again. `lines`: the kept redraw's clusters'
+  /// lines under its answer, which the next redraw starts from.
   bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
                          const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
                          SolverResult& first, std::vector<int>& labels, ObservationReport& report,
-                         WindowObservations& obs, SharedSolves& solves, std::vector<int>& drawn_from) const {
+                         WindowObservations& obs, SharedSolves& solves, std::vector<int>& drawn_from,
+                         MotionLines& lines) const {
     auto to_bearing = [&](const Vec2& p) { return bearing(p); };
     std::vector<int> redrawn = report.event_clusters;
-    const MotionReassignReport redraw =
-        reassignToMotionLines(events, redrawn, to_bearing, calib.camera.focal(), motion, first.v, cluster_options);
+    const MotionReassignReport redraw = reassignToMotionLines(events, redrawn, to_bearing, calib.camera.focal(),
+                                                              motion, first.v, cluster_options, &lines);
     const ClusterResult clusters = clustersFromLabels(events, redrawn);
     if (clusters.labels == drawn_from) {
       spdlog::debug("window {}: clusters under the motion: unchanged, not kept", index);
@@ -144,9 +146,11 @@ struct SequenceRunner::Impl {
     // The window's cost per event (every event: the same set both times)
     // under each answer with its clusters.
     const double cost_before = redraw.cost;
-    const double cost_after = after.ok() ? motionCost(events, redrawn_report.event_clusters, to_bearing,
-                                                      calib.camera.focal(), motion, after.v, cluster_options)
-                                         : NAN;
+    MotionLines lines_after;
+    if (after.ok())
+      lines_after = fitMotionLines(events, redrawn_report.event_clusters, to_bearing, calib.camera.focal(), motion,
+                                   after.v, cluster_options);
+    const double cost_after = lines_after.cost();
     const bool keep = cost_after < cost_before;
     spdlog::debug("window {}: clusters under the motion: {} joined, {} moved, {} ambiguous, {} removed, "
                   "{} of {} lines unexplained; {}: {:.2f} deg from the first answer, cost per event {:.4f} -> {:.4f}: "
@@ -158,6 +162,7 @@ struct SequenceRunner::Impl {
     if (!keep) return false;
     first = after;
     drawn_from = clusters.labels;
+    lines = std::move(lines_after);
     labels = clusters.labels;
     report = std::move(redrawn_report);
     obs = std::move(redrawn_obs);
@@ -511,9 +516,10 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     rec.times.solve = secondsSince(start);
     start = Clock::now();
     std::vector<int> drawn_from;
+    MotionLines lines;
     for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {
       if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer, solved_labels,
-                               report, obs, solves, drawn_from))
+                               report, obs, solves, drawn_from, lines))
         break;
       rec.n_clusters = report.n_used;
       rec.n_line_fit_failed = report.n_line_fit_failed;

@@ -20,6 +20,7 @@
 /// extrapolates over the whole window, and two fragments of one edge fit
 /// one line.
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
@@ -27,6 +28,39 @@
 #include "celc/geometry/motion_model.hpp"
 
 namespace celc {
+
+struct MotionLinesFit;
+
+/// A window's clusters with their lines under one motion and velocity, as
+/// reassignToMotionLines fits them (step 1 below), and the window's cost
+/// under them (motionCost). Made by fitMotionLines; a redraw of the same
+/// labels under the same v takes it instead of fitting the lines again.
+class MotionLines {
+ public:
+  MotionLines();
+  ~MotionLines();
+  MotionLines(MotionLines&&) noexcept;
+  MotionLines& operator=(MotionLines&&) noexcept;
+  /// motionCost of the labels under v; NaN when nothing was fitted.
+  double cost() const { return cost_; }
+  /// Whether these are the lines of `labels` under `v`.
+  bool fittedFor(const std::vector<int>& labels, const Vec3& v) const;
+
+ private:
+  friend MotionLines fitMotionLines(const std::vector<Event>&, const std::vector<int>&, const BearingFunction&,
+                                    double, const MotionModel&, const Vec3&, const ClusterOptions&);
+  friend struct MotionLinesAccess;
+  std::unique_ptr<MotionLinesFit> lines_;  ///< null when nothing was fitted
+  std::vector<int> labels_;
+  Vec3 v_ = Vec3::Constant(NAN);
+  double cost_ = NAN;
+};
+
+/// The lines of the clusters `labels` under the motion and `v`, and the
+/// window's cost under them (the arguments as for motionCost).
+MotionLines fitMotionLines(const std::vector<Event>& events, const std::vector<int>& labels,
+                           const BearingFunction& bearing, double focal_px, const MotionModel& motion, const Vec3& v,
+                           const ClusterOptions& options);
 
 /// What reassignToMotionLines did to a window's clusters.
 struct MotionReassignReport {
@@ -62,10 +96,13 @@ struct MotionReassignReport {
 ///     them would lower the cost of a wrong answer as much as of a right one.
 /// Ids of the result are compact (0 .. n-1, in order of first event). Does
 /// nothing when the threshold is 0 or v is not finite. Deterministic; never
-/// throws on data.
+/// throws on data. `prefit`: the lines of step 1 when fittedFor(labels, v)
+/// (made with the same events, bearing, focal, motion and options), taken
+/// (moved from) instead of fitted again; the same result either way.
 MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std::vector<int>& labels,
                                            const BearingFunction& bearing, double focal_px,
-                                           const MotionModel& motion, const Vec3& v, const ClusterOptions& options);
+                                           const MotionModel& motion, const Vec3& v, const ClusterOptions& options,
+                                           MotionLines* prefit = nullptr);
 
 /// The window's cost under the motion (R(t), P(t)) and the unit velocity
 /// `v` with the clusters `labels`: each cluster's line fitted as in
