@@ -2,10 +2,13 @@
 // row-by-row evaluation of the same sums.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "solver/irls_kernel.hpp"
+#include "solver/robust_nullspace.hpp"
 #include "solver/sampling.hpp"
 
 using namespace celc;
@@ -165,4 +168,38 @@ TEST(IrlsKernel, KthSmallestEqualsNthElementWhateverTheGuess) {
     }
   }
   EXPECT_EQ(checked, 6 * 4 * 3 * 6);
+}
+
+// The grid's best starts (gridStarts: medians selected only for directions
+// that can still rank among the best) are those of ranking every direction
+// by its median squared residual on the same strided rows: rows with noise
+// around one direction (found up to its sign: the lattice is a hemisphere),
+// pure noise, and rows of which every 7th has N = 0.
+TEST(GridStarts, BestDirectionsOfTheFullRanking) {
+  std::mt19937_64 rng(99);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int trial = 0; trial < 6; ++trial) {
+    std::vector<ConstraintRow> rows = randomRows(1000 + 37 * trial, true, rng);
+    const Vec3 truth = Vec3(g(rng), g(rng), std::abs(g(rng)) + 0.1).normalized();
+    if (trial % 2 == 0)  // a^T truth about 0: the rows hold a solution
+      for (auto& r : rows) r.a -= truth * (r.a.dot(truth) + 0.01 * g(rng));
+    const PackedRows packed(rows);
+    for (const auto& [n, keep, scored] : {std::tuple{256, 4, 200}, std::tuple{64, 1, 1000}, std::tuple{100, 8, 50}}) {
+      const PackedRows sub = packed.strided(packed.size() / static_cast<size_t>(scored));
+      std::vector<std::pair<double, int>> all;
+      std::vector<double> r2;
+      const std::vector<Vec3>& dirs = detail::hemisphereDirections(n);
+      for (int i = 0; i < n; ++i) {
+        sub.squaredResiduals(dirs[i], 1e300, r2);
+        std::nth_element(r2.begin(), r2.begin() + static_cast<long>(r2.size() / 2), r2.end());
+        all.emplace_back(r2[r2.size() / 2], i);
+      }
+      std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      const std::vector<Vec3> best = detail::gridStarts(packed, n, keep, scored);
+      ASSERT_EQ(best.size(), static_cast<size_t>(keep)) << "trial " << trial;
+      for (int k = 0; k < keep; ++k)
+        EXPECT_EQ(best[k], dirs[all[k].second]) << "trial " << trial << ", n " << n << ", rank " << k;
+      if (trial % 2 == 0) EXPECT_GT(std::abs(best[0].dot(truth)), 0.95) << "trial " << trial << ", n " << n;
+    }
+  }
 }

@@ -201,26 +201,43 @@ NullspaceSolution irlsFrom(const PackedRows& P, Vec3 v, const LinearOptions& opt
   return out;
 }
 
-// The best `keep` directions of a hemisphere grid of n, ranked by the median
-// squared geometric residual (as the MAD ranks) on a strided subset of `rows` rows.
+}  // namespace
+
+// Once `keep` directions are scored, a direction with at most half its
+// residuals within the keep-th smallest median so far has a larger median
+// and cannot be among the best: one counting pass rejects it, without the
+// selection of its median.
 std::vector<Vec3> gridStarts(const PackedRows& P, int n, int keep_max, int rows) {
   const PackedRows sub = P.strided(P.size() / static_cast<size_t>(std::max(1, rows)));
   std::vector<std::pair<double, Vec3>> scored;
-  std::vector<double> r2;
+  std::vector<double> r2, medians;
+  const size_t wanted = static_cast<size_t>(std::max(0, keep_max));
+  double bound = std::numeric_limits<double>::infinity();  // the wanted-th smallest median so far
   for (const Vec3& d : hemisphereDirections(n)) {
     sub.squaredResiduals(d, 1e300, r2);
-    auto mid = r2.begin() + static_cast<long>(r2.size() / 2);
+    const size_t half = r2.size() / 2;
+    if (scored.size() >= wanted && bound < std::numeric_limits<double>::infinity()) {
+      size_t within = 0;
+      for (double x : r2) within += x <= bound ? 1 : 0;
+      if (within <= half) continue;  // its median (the half-th smallest) exceeds the bound
+    }
+    auto mid = r2.begin() + static_cast<long>(half);
     std::nth_element(r2.begin(), mid, r2.end());
     scored.emplace_back(*mid, d);
+    if (wanted > 0 && scored.size() >= wanted) {
+      medians.clear();
+      for (const auto& entry : scored) medians.push_back(entry.first);
+      std::nth_element(medians.begin(), medians.begin() + static_cast<long>(wanted - 1), medians.end());
+      bound = medians[wanted - 1];
+    }
   }
-  const size_t keep = std::min(scored.size(), static_cast<size_t>(keep_max));
+  const size_t keep = std::min(scored.size(), wanted);
   std::partial_sort(scored.begin(), scored.begin() + static_cast<long>(keep), scored.end(),
                     [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Vec3> out;
   for (size_t i = 0; i < keep; ++i) out.push_back(scored[i].second);
   return out;
 }
-}  // namespace
 
 const std::vector<Vec3>& hemisphereDirections(int n) {
   thread_local std::map<int, std::vector<Vec3>> lattices;  // nodes: references stay valid

@@ -39,6 +39,12 @@ NullspaceSolution robustNullspace(const PackedRows& rows, const LinearOptions& o
 NullspaceSolution robustNullspace(const std::vector<ConstraintRow>& rows,
                                   const LinearOptions& options);
 
+/// The best keep directions of hemisphereDirections(n), ranked by the median
+/// squared geometric residual (a^T v)^2 / |N v|^2 (as the MAD ranks; rows
+/// with |N v| = 0 count as 1e300) over every step-th row, step = size / rows
+/// (at least 1), the smallest first.
+std::vector<Vec3> gridStarts(const PackedRows& rows, int n, int keep, int rows_scored);
+
 /// n directions of a Fibonacci lattice on the upper hemisphere (z > 0): v and
 /// -v are one solution of a homogeneous system. Computed once per thread and
 /// n (celc_ml's screen asks for the same 100 in every window); the reference
