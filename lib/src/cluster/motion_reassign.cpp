@@ -183,6 +183,32 @@ double medianDistance(const std::vector<MotionPoint>& pts, const MotionLine& lin
   return *mid;
 }
 
+/// Sorts keys ascending, the order std::sort gives: LSD radix passes of 11
+/// bits, each a stable counting sort, over the bits some key sets (a
+/// window's cell-and-group marks use about 40 of 64).
+void sortKeys(std::vector<std::uint64_t>& keys) {
+  if (keys.size() < 1024) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  std::uint64_t used = 0;
+  for (std::uint64_t k : keys) used |= k;
+  std::vector<std::uint64_t> moved(keys.size());
+  std::vector<std::size_t> start(2049);
+  for (int shift = 0; shift < 64;) {
+    if (((used >> shift) & 1u) == 0) {
+      ++shift;
+      continue;
+    }
+    std::fill(start.begin(), start.end(), 0);
+    for (std::uint64_t k : keys) ++start[((k >> shift) & 2047u) + 1];
+    for (std::size_t d = 1; d < start.size(); ++d) start[d] += start[d - 1];
+    for (std::uint64_t k : keys) moved[start[(k >> shift) & 2047u]++] = k;
+    keys.swap(moved);
+    shift += 11;
+  }
+}
+
 struct UnionFind {
   std::vector<int> parent;
   explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
@@ -464,7 +490,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
             marks.push_back(static_cast<std::uint64_t>(cell) << 32 | static_cast<std::uint32_t>(a));
           }
   }
-  std::sort(marks.begin(), marks.end());
+  sortKeys(marks);
   marks.erase(std::unique(marks.begin(), marks.end()), marks.end());
   std::unordered_map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> range;  // cell -> [begin, end) of marks
   range.reserve(marks.size() / 2 + 1);
