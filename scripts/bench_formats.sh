@@ -5,7 +5,7 @@
 # 1,000,000-event windows, it prints a Markdown table: events/s end to end,
 # events/s per stage (events over the summed time of the stage: reading
 # without the probes, the parallax probes, clustering, undistortion + lines,
-# solvers; M events/s), the peak resident set and the bound
+# solvers, the redraws under the motion; M events/s), the peak resident set and the bound
 # 2 x (largest window's events) x 24 B + 150 MB. The stage times are summed
 # over the windows; with 2 threads they overlap (and share the cores).
 #   scripts/bench_formats.sh [SECONDS (default 5)]
@@ -48,7 +48,7 @@ run() {
   cat "$out.time"
 }
 
-echo "| input | threads | windows | events | M events/s |${old:+ CELC_OLD_BUILD M events/s (ratio) |} reading | probes | clustering | lines | solvers | peak RSS [MB] | bound [MB] |"
+echo "| input | threads | windows | events | M events/s |${old:+ CELC_OLD_BUILD M events/s (ratio) |} reading | probes | clustering | lines | solvers | redraws | peak RSS [MB] | bound [MB] |"
 echo "|---|---|---|---|---|${old:+---|}---|---|---|---|---|---|---|"
 status=0
 for input in text aedat4 bag hdf5; do
@@ -69,14 +69,14 @@ for input in text aedat4 bag hdf5; do
       fi
       read -r wall rss < <(run "$build" "$in" "$work/new-$tag" "${pargs[@]}" --threads "$threads")
       line="$(grep -o 'stage seconds: .*' "$work/new-$tag.log" | tail -1)"
-      # reading R (of which parallax probes P), clustering C, undistortion+lines L, solvers S, ...; N events in W s
+      # reading R (of which parallax probes P), clustering C, undistortion+lines L, solvers S, redraws D, ...; N events in W s
       python3 - "$line" "$wall" "$rss" "$work/new-$tag/windows.csv" "$input" "$threads" "$policy" \
         "${old:+$work/old-$tag}" "${old_wall:-}" <<'PY'
 import csv, re, sys
 line, wall, rss, windows, name, threads, policy, old_dir, old_wall = sys.argv[1:10]
 num = lambda key: float(re.search(key + r" ([0-9.]+)", line).group(1))
-read, probe, clus, lines, solve = (num("reading"), num("parallax probes"), num("clustering"),
-                                   num("undistortion\\+lines"), num("solvers"))
+read, probe, clus, lines, solve, redraw = (num("reading"), num("parallax probes"), num("clustering"),
+                                           num("undistortion\\+lines"), num("solvers"), num("redraws"))
 events = int(re.search(r"; (\d+) events", line).group(1))
 with open(windows) as f:
     rows = list(csv.DictReader(f))
@@ -91,9 +91,9 @@ if old_dir:
     old = " %.2f (%.2fx) |" % (o, e2e / o)
 bound = 2 * max(sizes.values()) * 24 / 1e6 + 150
 label = "default" if policy == "default" else "1 M events"
-print("| %s, %s windows | %s | %d | %.2f M | %.2f |%s %s | %s | %s | %s | %s | %.0f | %.0f |" % (
+print("| %s, %s windows | %s | %d | %.2f M | %.2f |%s %s | %s | %s | %s | %s | %s | %.0f | %.0f |" % (
     name, label, threads, len(sizes), events / 1e6, e2e, old, rate(read - probe), rate(probe) if probe > 0 else "-",
-    rate(clus), rate(lines), rate(solve), float(rss) / 1024, bound))
+    rate(clus), rate(lines), rate(solve), rate(redraw) if redraw > 0 else "-", float(rss) / 1024, bound))
 PY
       if [ -n "$old" ] && ! python3 "$root/scripts/same_windows.py" "$work/old-$tag" "$work/new-$tag" > "$work/same-$tag"; then
         cat "$work/same-$tag" >&2

@@ -674,10 +674,10 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   stats.seconds_total = secondsSince(start);
   const StageTimes& st = stats.stage_seconds;
   spdlog::debug("stage seconds: reading {:.3f} (of which parallax probes {:.3f}), clustering {:.3f}, "
-                "undistortion+lines {:.3f}, solvers {:.3f}, ground truth {:.3f}, truth labels {:.3f}; "
+                "undistortion+lines {:.3f}, solvers {:.3f}, redraws {:.3f}, ground truth {:.3f}, truth labels {:.3f}; "
                 "{} events in {:.3f} s",
-                stats.seconds_reading, stats.seconds_probing, st.cluster, st.lines, st.solve, st.groundtruth,
-                st.truth, stats.events_processed, stats.seconds_total);
+                stats.seconds_reading, stats.seconds_probing, st.cluster, st.lines, st.solve, st.redraw,
+                st.groundtruth, st.truth, stats.events_processed, stats.seconds_total);
   return stats;
 }
 
