@@ -199,7 +199,9 @@ TEST(GridStarts, BestDirectionsOfTheFullRanking) {
       ASSERT_EQ(best.size(), static_cast<size_t>(keep)) << "trial " << trial;
       for (int k = 0; k < keep; ++k)
         EXPECT_EQ(best[k], dirs[all[k].second]) << "trial " << trial << ", n " << n << ", rank " << k;
-      if (trial % 2 == 0) EXPECT_GT(std::abs(best[0].dot(truth)), 0.95) << "trial " << trial << ", n " << n;
+      if (trial % 2 == 0) {
+        EXPECT_GT(std::abs(best[0].dot(truth)), 0.95) << "trial " << trial << ", n " << n;
+      }
     }
   }
 }
