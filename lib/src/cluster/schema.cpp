@@ -12,6 +12,11 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
   v.field({"c_min_px_per_s", "px/s", "lower clamp of the estimated time scale", above(0)}, o.c_min_px_per_s);
   v.field({"c_max_px_per_s", "px/s", "upper clamp of the estimated time scale", above(0)}, o.c_max_px_per_s);
   v.field({"separate_polarity", "", "cluster ON and OFF events separately (paper)"}, o.separate_polarity);
+  v.field({"derotate", "",
+           "celc run: cluster the events turned back by the gyro's rotation to the window's middle (an edge "
+           "sweeping across the image stays one slowly moving line); false = as recorded (the parallax probes "
+           "and later stages always use the recorded events)"},
+          o.derotate);
   v.field({"neighbours", "events", "pcl: k nearest neighbours", within(3, 1000)}, o.neighbours);
   v.field({"pcl_normal_radius_px", "px", "pcl: normals from this radius in (x, y, c*t); 0 = k nearest", within(0, 50)},
           o.pcl_normal_radius_px);

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "celc/cluster/derotate.hpp"
 #include "celc/cluster/line_split.hpp"
 #include "celc/cluster/motion_reassign.hpp"
 #include "celc/core/parallel.hpp"
@@ -444,9 +445,12 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
 
   // Clustering in pixel space-time.
   start = Clock::now();
-  ClusterResult clusters = clusterEvents(events, cluster_options);
-  splitByMovingLines(events, clusters, [&](const Vec2& p) { return m.bearing(p); }, m.calib.camera.focal(), &motion,
-                     cluster_options);
+  auto bearing = [&](const Vec2& p) { return m.bearing(p); };
+  ClusterResult clusters =
+      cluster_options.derotate
+          ? clusterEvents(derotateEvents(events, bearing, m.calib.camera, motion, 0.5 * (t0 + t1)), cluster_options)
+          : clusterEvents(events, cluster_options);
+  splitByMovingLines(events, clusters, bearing, m.calib.camera.focal(), &motion, cluster_options);
   rec.times.cluster = secondsSince(start);
   // The clusters `celc solve` reproduces the window's answers from (dump_windows).
   auto dump = [&](const std::vector<int>& labels) {
@@ -465,7 +469,6 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   // Undistorted bearings and boundary lines per cluster.
   start = Clock::now();
   const CameraModel& cam = m.calib.camera;
-  auto bearing = [&](const Vec2& p) { return m.bearing(p); };
   ObservationReport report;
   WindowObservations obs = toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
   rec.n_clusters = report.n_used;  // with lines; npt also gets the others

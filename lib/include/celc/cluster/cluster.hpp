@@ -53,6 +53,13 @@ struct ClusterOptions {
   double c_min_px_per_s = 20.0;
   double c_max_px_per_s = 20000.0;
   bool separate_polarity = true;  ///< cluster ON and OFF events separately (paper)
+  /// `celc run` clusters the window's events turned back by the gyro's
+  /// rotation to the window's middle (derotate.hpp), so that an edge sweeping
+  /// across the image stays one slowly moving line; the parallax probes and
+  /// every later stage use the events as recorded. Off by default: on the
+  /// held-out scenes it makes more edges whole but fewer clusters pure, and
+  /// celc_ml no closer to the oracle (docs/clustering.md).
+  bool derotate = false;
 
   // Neighbourhoods.
   int neighbours = 30;          ///< Pcl: k nearest neighbours for growing (and normals if pcl_normal_radius_px = 0) [events]
