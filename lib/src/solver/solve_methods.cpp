@@ -322,17 +322,18 @@ std::vector<double> answerObservable(std::vector<SolverResult>& out, const std::
   return floor_deg;
 }
 
-/// Per result: whether it is an answer of the celc family that puts the
-/// clusters' lines behind the camera (sign margin below u.cheiral_min, with
-/// u.enabled).
+/// Per result: whether it is an answer of the celc family (celc_acc's too:
+/// an acceleration bends the camera's path by a fraction of what v moves
+/// it) that puts the clusters' lines behind the camera (sign margin below
+/// u.cheiral_min, with u.enabled).
 std::vector<bool> behindCamera(const std::vector<SolverResult>& out, const std::vector<Method>& methods,
                                const WindowObservations& obs, const MotionModel& motion,
                                const UncertaintyOptions& u, const detail::WindowFrames& frames) {
   std::vector<bool> behind(out.size(), false);
   if (!(u.enabled && u.cheiral_min > 0.0)) return behind;
   for (size_t i = 0; i < out.size(); ++i) {
-    const bool celc_family =
-        methods[i] == Method::Celc || methods[i] == Method::CelcOpt || methods[i] == Method::CelcMl;
+    const bool celc_family = methods[i] == Method::Celc || methods[i] == Method::CelcOpt ||
+                             methods[i] == Method::CelcMl || methods[i] == Method::CelcAcc;
     behind[i] = celc_family && out[i].ok() &&
                 std::abs(detail::resolveSign(obs, motion, out[i].v, frames).margin) < u.cheiral_min;
   }
@@ -355,7 +356,10 @@ double sigmaScale(Method m, const UncertaintyOptions& u) {
 /// What every method shares (the window's parallax and lines), and each
 /// estimate's sigma_deg at its own direction, at least its floor_deg (NaN
 /// where it is no answer or u is off). celc_acc's accelerating answer keeps
-/// its own spread (celc_acc.hpp: the bound assumes a constant v).
+/// its own spread (celc_acc.hpp: the bound assumes a constant v), in
+/// quadrature with the model-error budget at its direction: the gyro's and
+/// the calibration's errors move an accelerating answer as they move a
+/// constant velocity's (the budget is that shift).
 void setUncertainties(std::vector<SolverResult>& out, const std::vector<Method>& methods,
                       const SolverResult& window, const std::vector<double>& floor_deg, UncertaintyModel& model,
                       const UncertaintyOptions& u) {
@@ -364,7 +368,12 @@ void setUncertainties(std::vector<SolverResult>& out, const std::vector<Method>&
     r.parallax = window.parallax;
     r.n_lines = window.n_lines;
     if (methods[i] == Method::CelcAcc && r.acceleration_seen) {
-      if (!r.ok() || !u.enabled) r.sigma_deg = NAN;
+      if (!r.ok() || !u.enabled) {
+        r.sigma_deg = NAN;
+        continue;
+      }
+      r.sigma_budget_deg = model.budgetDeg(r.v);
+      r.sigma_deg = std::isnan(r.sigma_budget_deg) ? INFINITY : std::hypot(r.sigma_deg, r.sigma_budget_deg);
       continue;
     }
     r.sigma_deg = NAN;
