@@ -145,9 +145,8 @@ TEST(EndToEnd, DenseRecordingGetsWindowsShorterThanTheMaximum) {
 //   a window of its own, and the parallax policy's verdict reaches it: its D,
 //   measured on the whole window, is 8.7 px, below windows.no_parallax_px
 //   set to 10 here, so every method is `degenerate / no_parallax` there, as
-//   at max_seconds. (At the default 7 it is solved: celc_ml 0.12 rad off at
-//   sigma_deg 61, celc 1.46 at 1.0.) Solving such short last windows gives
-//   confident wrong answers (docs/decisions.md).
+//   at max_seconds. (At the default, 3 px, it is solved: celc_ml 0.08 rad
+//   off at sigma_deg 10.9, celc 1.46 rad at 83 deg.)
 TEST(EndToEnd, ShortLastWindowIsJoinedOrWithoutParallaxNotSolved) {
   const fs::path d = test::freshTempDir("e2e_last_window");
   ASSERT_EQ(renderEditedScene(d, "sample_davis346_room.yaml", {{"duration:", "duration: 0.29"}}), "");
@@ -196,8 +195,8 @@ TEST(EndToEnd, ShortLastWindowIsJoinedOrWithoutParallaxNotSolved) {
 // rad): to 1 s (slow_turn_max_seconds), where D is ~22 px and celc_ml is
 // 0.009 rad off (measured; 0.1 rad is the D study's tolerance at 15-25 px).
 // With the extension off (slow_turn_max_seconds = max_seconds, both 0.2 s
-// here: at 0.3 s D is 7.0 px, at the default no_parallax_px) the first
-// window stops at 0.2 s, `no_parallax` (D 4.3 px).
+// here) the first window stops at 0.2 s with D 4.3 px, `no_parallax` below
+// a no_parallax_px of 7 px.
 TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
   const fs::path d = test::freshTempDir("e2e_slow_turn");
   ASSERT_EQ(renderEditedScene(d, "slow_deep.yaml", {{"duration:", "duration: 1.05"}}), "");
@@ -215,8 +214,10 @@ TEST(EndToEnd, SlowlyTurningCameraGetsWindowsLongerThanMaxSeconds) {
   EXPECT_EQ(grown.status, "ok") << grown.reason;
   EXPECT_GE(grown.translation_px, 15.0);
   EXPECT_LT(grown.phi, 0.1);
-  const auto capped = firstWindow("--set windows.max_seconds=0.2 --set windows.slow_turn_max_seconds=0.2");
+  const auto capped = firstWindow(
+      "--set windows.max_seconds=0.2 --set windows.slow_turn_max_seconds=0.2 --set windows.no_parallax_px=7");
   EXPECT_NEAR(capped.t_end - capped.t_start, 0.2, 1e-6);
+  EXPECT_LT(capped.translation_px, 7.0);
   EXPECT_EQ(capped.reason, "no_parallax");
   fs::remove_all(d);
 }

@@ -38,8 +38,9 @@ struct ParallaxWindowOptions {
   double target_px = 25.0;     ///< grow until the lines' translation D reaches this [px]
   /// A window grown to its longest (max_seconds, or slow_turn_max_seconds
   /// where the camera turns slowly) with D below this [px] is degenerate
-  /// (no_parallax) for every method; between it and target_px it is solved.
-  double no_parallax_px = 7.0;
+  /// (no_parallax) for every method; between it and target_px it is solved,
+  /// and sigma_deg (8-12 deg at 3-5 px) says how little it shows.
+  double no_parallax_px = 3.0;
   double min_seconds = 0.05;   ///< first (shortest) window tried [s]
   double max_seconds = 0.3;    ///< longest window [s]; see no_parallax_px and the next two
   /// A window that turns slowly may grow past max_seconds, up to this [s]:
