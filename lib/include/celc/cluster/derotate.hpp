@@ -6,7 +6,7 @@
 /// px in a 0.3 s window) and its events form a surface in (x, y, t) that
 /// bends with the rotation; the growing then cuts it into pieces of a few
 /// hundredths of a second each. Turned back by the gyro's rotation, an edge
-/// moves only by the translation's parallax (the window's D, 7-25 px under
+/// moves only by the translation's parallax (the window's D, 3-25 px under
 /// the parallax policy) and its events over the whole window lie on one
 /// slowly moving line. Each event's bearing f = (x, y, 1) (undistorted) is
 /// turned by R(t_ref)^T R(t) (motion_model.hpp: R(t) = R_ref_t) and projected
