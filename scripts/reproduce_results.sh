@@ -13,6 +13,7 @@
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
 #   derotate    clusters and speeds again with cluster.derotate true: clusters_derotate.md (5 min after their renders)
+#   fast        clusters and speeds again with -c config/fast.yaml: fast.md (4 min after their renders)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
 #   accelerometer scripts/accelerometer_table.sh: accelerometer.md (the scenes with a still IMU start; 15 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
@@ -32,7 +33,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds derotate acceleration accelerometer studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds derotate fast acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -112,6 +113,18 @@ for name in "${names[@]}"; do
         echo "At 1 m/s (clusters_speeds.md):"; $tables table 1 < "$work/derotate1.txt"; echo;
         echo "At 3 m/s:"; $tables table 1 < "$work/derotate3.txt"; } |
         put clusters_derotate.md derotate "scripts/cluster_table.sh [as for clusters, speeds] -- --set cluster.derotate=true"
+      ;;
+    fast)
+      on=(-- -c config/fast.yaml)
+      scripts/cluster_table.sh "$work/clusters" "${on[@]}" > "$work/fast30.txt"
+      for v in 1 3; do
+        scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 "${on[@]}" \
+          > "$work/fast$v.txt"
+      done
+      { echo "The 12 scenes of clusters.md (seed 30000):"; $tables table 1 < "$work/fast30.txt"; echo;
+        echo "At 1 m/s (clusters_speeds.md):"; $tables table 1 < "$work/fast1.txt"; echo;
+        echo "At 3 m/s:"; $tables table 1 < "$work/fast3.txt"; } |
+        put fast.md fast "scripts/cluster_table.sh [as for clusters, speeds] -- -c config/fast.yaml"
       ;;
     acceleration)
       scripts/acceleration_sweep.sh 200 "$work/acceleration" > "$work/acceleration.txt"

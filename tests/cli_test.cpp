@@ -214,6 +214,58 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
   }
 }
 
+// config/fast.yaml (only celc_ml, clusters not redrawn) on the bundled
+// sample: celc_ml answers both windows as it does among all six methods with
+// the redraw off (its starts from celc and npt are still computed), within
+// 0.05 rad of the truth (its sigma_deg there is 1.5-3 deg), and the summary
+// shows no time in the redraw.
+TEST(Cli, FastConfigurationIsCelcMlWithoutTheRedraw) {
+  const fs::path d = tempDir("fast");
+  const std::string fast = (d / "fast").string(), full = (d / "full").string();
+  const std::string common = "run '" CELC_SOURCE_DIR "/data/sample_seq' -q --no-plots --truth-labels none -o ";
+  ASSERT_EQ(runCelc(common + "'" + fast + "' -c '" CELC_SOURCE_DIR "/config/fast.yaml'", d).status, 0);
+  ASSERT_EQ(runCelc(common + "'" + full + "' --set cluster.motion_reassign_px=0", d).status, 0);
+  // window -> (method, v, phi) rows of windows.csv
+  struct Row {
+    std::string method, status;
+    Vec3 v;
+    double phi;
+  };
+  auto rows = [](const std::string& path) {
+    std::vector<std::pair<int, Row>> out;
+    std::istringstream in(readAll(path));
+    std::string line;
+    std::getline(in, line);  // window,t_start,t_end,n_events,n_clusters,method,status,vx,vy,vz,gt..,eps,phi
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::stringstream ss(line);
+      for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+      if (f.size() < 15) continue;
+      Row r{f[5], f[6], Vec3::Zero(), NAN};
+      if (r.status == "ok") r.v = Vec3(std::stod(f[7]), std::stod(f[8]), std::stod(f[9])), r.phi = std::stod(f[14]);
+      out.emplace_back(std::stoi(f[0]), r);
+    }
+    return out;
+  };
+  const auto fast_rows = rows(fast + "/windows.csv"), full_rows = rows(full + "/windows.csv");
+  ASSERT_EQ(fast_rows.size(), 2u);
+  for (const auto& [window, r] : fast_rows) {
+    ASSERT_EQ(r.method, "celc_ml");
+    ASSERT_EQ(r.status, "ok") << "window " << window;
+    EXPECT_LT(r.phi, 0.05) << "window " << window;
+    bool compared = false;
+    for (const auto& [w, q] : full_rows)
+      if (w == window && q.method == "celc_ml") {
+        EXPECT_LT(angleBetween(r.v, q.v), 1e-9) << "window " << window;
+        compared = true;
+      }
+    EXPECT_TRUE(compared) << "window " << window;
+  }
+  EXPECT_NE(readAll(fast + "/summary.md").find("clusters redrawn under the motion and solved again 0%"),
+            std::string::npos);
+  fs::remove_all(d);
+}
+
 // `celc --version` names the release and the git revision it was built from
 // (a hexadecimal hash, "-dirty" for a modified tree, or "unknown" outside a
 // git checkout).
