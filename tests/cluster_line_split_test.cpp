@@ -77,6 +77,9 @@ TEST(LineSplit, TwoLinesInOneClusterComeApartAndNoiseLeaves) {
     const LineSplitReport rep = split(w, r);
     ASSERT_EQ(r.status, ClusterStatus::Ok);
     EXPECT_GE(rep.n_split, w.n_lines() / 2 - 1) << "seed " << seed;
+    // Every event was in a cluster: what the cut took out is counted as such.
+    EXPECT_EQ(r.left_out.off_moving_lines, rep.n_removed);
+    EXPECT_EQ(r.n_clustered + r.left_out.off_moving_lines, static_cast<int>(w.events.size()));
     const SplitScore s = score(w, r);
     lines += s.lines, recovered += s.recovered, noise += s.noise, noise_kept += s.noise_kept;
   }

@@ -111,6 +111,52 @@ TEST(ClusterQuality, StatsDescribeClusters) {
     }
 }
 
+// Where the unclustered events went (ClusterResult::left_out) adds up with
+// the clustered ones to the window, for both growers; and each count takes
+// what its own check removes: events with non-finite fields or off the
+// sensor are invalid, regions all below min_cluster_size are small, planes
+// all sparser than min_density_per_px2 fail the checks. The grown regions
+// hold at least 90% of the line events (measured: 99.8% in this window).
+TEST(ClusterQuality, LeftOutEventsAddUpToTheWindow) {
+  LabelledWindow w = window(4, 20000);
+  w.events.push_back({std::numeric_limits<double>::quiet_NaN(), 10.0f, 10.0f, true});
+  w.events.push_back({0.01, -5.0f, 10.0f, false});
+  w.labels.push_back(-1), w.labels.push_back(-1);
+  const int line_events = static_cast<int>(std::count_if(w.labels.begin(), w.labels.end(), [](int l) { return l >= 0; }));
+  auto left = [](const ClusterResult& r) {
+    const ClusterLosses& l = r.left_out;
+    return l.invalid + l.no_region + l.small_region + l.failed_checks + l.off_planes + l.off_moving_lines;
+  };
+  for (ClusterMethod m : {ClusterMethod::Grid, ClusterMethod::Pcl}) {
+    ClusterOptions opt;
+    opt.method = m;
+    const ClusterResult r = clusterEvents(w.events, opt);
+    ASSERT_EQ(r.status, ClusterStatus::Ok) << toString(m);
+    EXPECT_EQ(r.n_clustered + left(r), r.n_events) << toString(m);
+    EXPECT_EQ(r.left_out.invalid, 2) << toString(m);
+    EXPECT_EQ(r.left_out.off_moving_lines, 0) << toString(m);  // no cut in clusterEvents
+  }
+  ClusterOptions small;  // one group of 20,000 events; every line's region is smaller than 15,000
+  small.separate_polarity = false;
+  small.min_cluster_size = 15000;
+  const ClusterResult rs = clusterEvents(w.events, small);
+  EXPECT_EQ(rs.status, ClusterStatus::NoClusters);
+  EXPECT_EQ(rs.n_clustered + left(rs), rs.n_events);
+  EXPECT_GE(rs.left_out.small_region, 0.9 * line_events);
+  EXPECT_EQ(rs.left_out.failed_checks + rs.left_out.off_planes, 0);
+  ClusterOptions sparse;
+  sparse.min_density_per_px2 = 1e9;
+  const ClusterResult rd = clusterEvents(w.events, sparse);
+  EXPECT_EQ(rd.status, ClusterStatus::NoClusters);
+  EXPECT_EQ(rd.n_clustered + left(rd), rd.n_events);
+  EXPECT_GE(rd.left_out.failed_checks, 0.9 * line_events);
+  // Too few valid events to grow: all of them in no region.
+  std::vector<Event> few(10, Event{0.0, 5.0f, 5.0f, true});
+  const ClusterResult rf = clusterEvents(few, ClusterOptions{});
+  EXPECT_EQ(rf.left_out.no_region, 10);
+  EXPECT_EQ(rf.n_clustered + left(rf), 10);
+}
+
 // The median normal-flow speed of the true lines (per event, from the generator's
 // geometry) against the automatic c.
 TEST(ClusterQuality, AutomaticTimeScaleMatchesLineSpeeds) {

@@ -72,16 +72,19 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   wo.events_per_window = a.window_events;
   WindowSource source(*reader, wo);
   if (!a.dump.empty()) std::filesystem::create_directories(a.dump);
-  std::cout << "window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms,smoothness_deg\n";
+  std::cout << "window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms,smoothness_deg,"
+               "left_invalid,left_no_region,left_small_region,left_failed_checks,left_off_planes\n";
   EventWindow win;
   for (size_t window = 0; source.next(win); ++window) {
     if (a.max_windows > 0 && window >= a.max_windows) break;
     const std::vector<Event>& ev = win.events;
     const ClusterResult r = clusterEvents(ev, opt);
     char row[256];
-    std::snprintf(row, sizeof row, "%zu,%.6f,%.6f,%zu,%s,%.1f,%zu,%d,%.1f,%.2f", window, ev.front().t,
+    const ClusterLosses& left = r.left_out;
+    std::snprintf(row, sizeof row, "%zu,%.6f,%.6f,%zu,%s,%.1f,%zu,%d,%.1f,%.2f,%d,%d,%d,%d,%d", window, ev.front().t,
                   ev.back().t, ev.size(), toString(r.status).c_str(), r.c_px_per_s, r.clusters.size(),
-                  r.n_clustered, r.ms_total, r.smoothness_deg);
+                  r.n_clustered, r.ms_total, r.smoothness_deg, left.invalid, left.no_region, left.small_region,
+                  left.failed_checks, left.off_planes);
     std::cout << row << "\n";
     if (!a.dump.empty()) {
       char name[64];
@@ -106,7 +109,9 @@ void registerCluster(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "cluster",
       "Space-time clustering of an event file's windows into line clusters; prints one CSV row "
-      "per window (window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms,smoothness_deg)");
+      "per window (window,t_start,t_end,n_events,status,c_px_per_s,n_clusters,n_clustered,runtime_ms,smoothness_deg,"
+      "left_invalid,left_no_region,left_small_region,left_failed_checks,left_off_planes: where the unclustered "
+      "events went, docs/clustering.md)");
   cmd->add_option("EVENTS", args->events, "an event file or recording in any format celc run reads (text 't x y p', AEDAT, bag, HDF5)")
       ->required();
   cmd->add_option("--window-events", args->window_events, "events per window [events]")

@@ -169,6 +169,7 @@ struct GroupOutput {
   std::vector<std::vector<int>> clusters;  // event indices
   std::vector<ClusterStats> stats;
   int n_regions = 0, n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
+  ClusterLosses left_out;  // invalid stays 0: a group holds valid events only
   double ms_normals = 0.0, ms_grow = 0.0, ms_post = 0.0;
   double smoothness_deg = 0.0;  // the growing's angle (0: the group did not grow)
 };
@@ -178,7 +179,10 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
                          const ClusterOptions& opt, int threads,
                          detail::GridNormals* normals = nullptr) {
   GroupOutput out;
-  if (static_cast<int>(g.size()) < opt.min_cluster_size) return out;
+  if (static_cast<int>(g.size()) < opt.min_cluster_size) {  // not grown
+    out.left_out.no_region = static_cast<int>(g.size());
+    return out;
+  }
   auto t_start = Clock::now();
   const Regions regions = opt.method == ClusterMethod::Pcl || index == nullptr
                               ? detail::growPcl(g, c, opt, threads)
@@ -200,7 +204,13 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
       lists.back().reserve(sizes[r]);
     } else if (sizes[r] > 0) {
       ++out.n_rejected_small;
+      out.left_out.small_region += sizes[r];
     }
+  }
+  int in_lists = 0;  // events of the regions checked below
+  for (int l : regions.label) {
+    if (l < 0) ++out.left_out.no_region;
+    else if (slot[l] >= 0) ++in_lists;
   }
   for (size_t i = 0; i < regions.label.size(); ++i) {
     const int l = regions.label[i];
@@ -211,6 +221,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
   auto accept = [&](std::vector<int>&& idx, const PlaneFit& f) {
     if (static_cast<int>(idx.size()) < opt.min_cluster_size) {
       ++out.n_rejected_small;
+      out.left_out.failed_checks += static_cast<int>(idx.size());
       return;
     }
     double t_lo = 1e300, t_hi = -1e300;
@@ -223,6 +234,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
     if (t_hi - t_lo < opt.min_time_span_s || extent < opt.min_extent_px ||
         density < opt.min_density_per_px2) {
       ++out.n_rejected_small;
+      out.left_out.failed_checks += static_cast<int>(idx.size());
       return;
     }
     ClusterStats s;
@@ -263,6 +275,9 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
     }
     if (!any) ++out.n_rejected_planar;
   }
+  int accepted = 0;
+  for (const auto& c : out.clusters) accepted += static_cast<int>(c.size());
+  out.left_out.off_planes = in_lists - accepted - out.left_out.failed_checks;
   out.ms_post = msSince(t_start);
   return out;
 }
@@ -317,7 +332,9 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   int n_valid = 0;
   for (const Event& e : events)
     if (validEvent(e)) t0 = std::min(t0, e.t), ++n_valid;
+  res.left_out.invalid = res.n_events - n_valid;
   if (n_valid < opt.min_cluster_size) {
+    res.left_out.no_region = n_valid;  // not grown
     res.status = n_valid == 0 ? ClusterStatus::EmptyWindow : ClusterStatus::TooFewEvents;
     res.message = std::to_string(n_valid) + " valid events, fewer than min_cluster_size";
     return res;
@@ -386,6 +403,10 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
     res.n_split += o.n_split;
     res.n_rejected_planar += o.n_rejected_planar;
     res.n_rejected_small += o.n_rejected_small;
+    res.left_out.no_region += o.left_out.no_region;
+    res.left_out.small_region += o.left_out.small_region;
+    res.left_out.failed_checks += o.left_out.failed_checks;
+    res.left_out.off_planes += o.left_out.off_planes;
     res.ms_normals += o.ms_normals;
     res.ms_grow += o.ms_grow;
     res.ms_post += o.ms_post;

@@ -258,6 +258,7 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
   std::vector<Part> all;
   for (std::size_t c = 0; c < k; ++c) {
     report.n_removed += removed[c];
+    clusters.left_out.off_moving_lines += removed[c];
     if (parts_of[c].empty()) ++report.n_dropped;
     if (parts_of[c].size() > 1) ++report.n_split;
     for (Part& p : parts_of[c]) all.push_back(std::move(p));

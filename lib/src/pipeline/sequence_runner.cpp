@@ -452,6 +452,11 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
           : clusterEvents(events, cluster_options);
   splitByMovingLines(events, clusters, bearing, m.calib.camera.focal(), &motion, cluster_options);
   rec.times.cluster = secondsSince(start);
+  const ClusterLosses& left = clusters.left_out;
+  spdlog::debug("window {}: {} of {} events clustered; left out: {} invalid, {} in no region, {} in regions under "
+                "cluster.min_cluster_size, {} failing the checks, {} off the planes, {} off the moving lines",
+                index, clusters.n_clustered, clusters.n_events, left.invalid, left.no_region, left.small_region,
+                left.failed_checks, left.off_planes, left.off_moving_lines);
   // The clusters `celc solve` reproduces the window's answers from (dump_windows).
   auto dump = [&](const std::vector<int>& labels) {
     if (!m.dump) return;

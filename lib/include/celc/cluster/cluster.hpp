@@ -147,6 +147,18 @@ struct ClusterStats {
   double speed_px_per_s = 0.0;
 };
 
+/// Where the events that joined no cluster went [events]: with n_clustered
+/// they add up to n_events.
+struct ClusterLosses {
+  int invalid = 0;        ///< non-finite fields or pixels outside [0, 4096) px
+  int no_region = 0;      ///< no normal (too few neighbours, or on one spot or line) or grown into no region
+  int small_region = 0;   ///< in a region of fewer than min_cluster_size (or more than max_cluster_size) events
+  int failed_checks = 0;  ///< in a region or plane shorter, smaller or sparser than min_time_span_s,
+                          ///< min_extent_px, min_density_per_px2
+  int off_planes = 0;     ///< in a non-planar region, on none of the planes split from it
+  int off_moving_lines = 0;  ///< taken out by the moving-line cut (splitByMovingLines, line_split.hpp)
+};
+
 struct ClusterResult {
   ClusterStatus status = ClusterStatus::EmptyWindow;
   std::string message;             ///< reason when not Ok
@@ -156,6 +168,7 @@ struct ClusterResult {
   int n_events = 0, n_clustered = 0;
   int n_regions = 0;               ///< regions grown before the checks
   int n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
+  ClusterLosses left_out;          ///< where the unclustered events went
   /// The smoothness angle the growing used [deg] (the larger of the polarities'
   /// with separate_polarity; ClusterOptions::smoothness_noise_factor).
   double smoothness_deg = 0.0;
