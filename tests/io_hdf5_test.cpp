@@ -344,3 +344,52 @@ TEST(IoHdf5, ChunkedLayoutWithoutChunkSizesIsAnErrorNotADivisionByZero) {
                      ": object header of /events/t: chunk size 0 in dimension 0");
   }
 }
+
+// The hdf5 fuzz target's fifth finding: a chunk index (version 1 B-tree)
+// whose leaf pointed at the undefined address made libhdf5 copy from NULL
+// (SIGSEGV in H5Dget_num_chunks) on an 11 KB file. Every node of a chunked
+// dataset's index is walked first: it must lie in the file, be a chunk node
+// ("TREE", type 1) and point inside the file.
+TEST(IoHdf5, DamagedChunkIndexIsAnErrorNotACrash) {
+  CELC_REQUIRE_IO_FIXTURES();
+  std::ifstream in(fixture("seq_dsec.h5"), std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  celc::detail::BinFile raw(fixture("seq_dsec.h5"));
+  const celc::detail::Hdf5Superblock sb = celc::detail::readHdf5Superblock(raw);
+  ASSERT_EQ(sb.offset_bytes, 8);
+  const auto messages = celc::detail::checkHdf5ObjectHeader(
+      raw, sb, celc::detail::hdf5LinkAddress(fixture("seq_dsec.h5"), "/events/t"), "/events/t");
+  const auto layout = std::find_if(messages.begin(), messages.end(), [](const auto& m) { return m.type == 0x08; });
+  ASSERT_NE(layout, messages.end());
+  const std::size_t at = layout->data_byte;
+  ASSERT_EQ(int(good[at]), 3) << "layout version 3: a version 1 B-tree index";
+  ASSERT_EQ(int(good[at + 1]), 2) << "a chunked layout";
+  const std::size_t rank = std::uint8_t(good[at + 2]);
+  RootHeap bytes{good, 0};
+  const std::uint64_t node = bytes.load(at + 3);
+  ASSERT_EQ(good.substr(node, 4), "TREE");
+  ASSERT_EQ(int(good[node + 4]), 1) << "a chunk node";
+  ASSERT_GE(bytes.file[node + 6], 1) << "a node with a chunk";
+  const std::size_t child0 = node + 8 + 2 * 8 + (8 + 8 * rank);  // after the header and key 0
+  const std::string file_end = " beyond the file's end (" + std::to_string(good.size()) + " bytes)";
+  celc::test::TempDir dir;
+  // A leaf's chunk at the undefined address (the fuzz target's file).
+  RootHeap bad = bytes;
+  bad.store(child0, ~0ull);
+  auto [e, path] = errorOnPatched(bad.file, dir);
+  EXPECT_EQ(e, path + ": byte " + std::to_string(child0) + ": object header of /events/t: chunk index: child 0 at address " +
+                   std::to_string(~0ull) + "," + file_end);
+  // The root node beyond the file's end.
+  bad = bytes;
+  bad.store(at + 3, good.size() + 64);
+  std::tie(e, path) = errorOnPatched(bad.file, dir);
+  EXPECT_NE(e.find(": object header of /events/t: chunk index: a node of "), std::string::npos) << e;
+  EXPECT_NE(e.find(" at address " + std::to_string(good.size() + 64) + " passes the file's end"), std::string::npos) << e;
+  // A node that is not a chunk node.
+  bad = bytes;
+  bad.file[node + 4] = 0;
+  std::tie(e, path) = errorOnPatched(bad.file, dir);
+  EXPECT_EQ(e, path + ": byte " + std::to_string(node + 4) +
+                   ": object header of /events/t: chunk index: a node of type 0, not a chunk node (1)");
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -32,6 +34,9 @@ std::string withoutRuntime(const std::string& l) {
 
 // Small windows over the first 0.12 s keep every run here to about a second.
 const std::string kFast = " -q --threads 2 --window-events 15000 --set windows.t_end=0.12 ";
+// The share of the sample's events in a cluster with kFast's windows is
+// 86.6%; most of the rest lie in regions smaller than min_cluster_size.
+constexpr double kMinClusteredPercent = 75.0;
 }  // namespace
 
 TEST(RunConfig, ShippedFileEqualsDefaults) {
@@ -87,7 +92,22 @@ TEST(Pipeline, RunOnBundledSampleWritesRowsAndGroundTruth) {
   }
   for (const auto& [w, n] : per_window) EXPECT_EQ(n, static_cast<int>(n_methods)) << "window " << w;
   EXPECT_TRUE(fs::exists(d / "o" / "summary.md"));
-  EXPECT_NE(readAll(d / "o" / "summary.md").find("| celc_opt |"), std::string::npos);
+  const std::string summary = readAll(d / "o" / "summary.md");
+  EXPECT_NE(summary.find("| celc_opt |"), std::string::npos);
+  // Where the events went: the clustered share and the ones left out add up
+  // to 100% (each printed to 3 digits).
+  const std::size_t at = summary.find("events in a cluster: ");
+  ASSERT_NE(at, std::string::npos) << summary;
+  const std::string line = summary.substr(at, summary.find('\n', at) - at);
+  const std::regex share(R"(([0-9.e+-]+)% )");
+  double total = 0.0, clustered = NAN;
+  for (auto it = std::sregex_iterator(line.begin(), line.end(), share); it != std::sregex_iterator(); ++it) {
+    const double x = std::stod((*it)[1].str());
+    if (std::isnan(clustered)) clustered = x;
+    total += x;
+  }
+  EXPECT_NEAR(total, 100.0, 0.5) << line;
+  EXPECT_GT(clustered, kMinClusteredPercent) << line;
   EXPECT_NE(readAll(d / "o" / "config.yaml").find("events: 15000"), std::string::npos);
   EXPECT_NE(r.out.find("| celc |"), std::string::npos);
   // An existing output folder is refused without --force / --resume.

@@ -10,6 +10,7 @@ constexpr char kSignature[] = "\x89HDF\r\n\x1a\n";
 constexpr int kContinuation = 0x10;
 constexpr int kLayout = 0x08;       ///< a dataset's storage: compact, contiguous or chunked (and its chunk's sizes)
 constexpr int kSymbolTable = 0x11;  ///< an old-style group: its B-tree's and local heap's addresses
+constexpr int kBtreeK = 0x13;       ///< superblock extension: the B-trees' K values
 constexpr std::size_t kMaxChunks = 4096;  ///< chunks walked per header (a loop of continuations ends here)
 
 /// Little-endian unsigned integer of `n` (1-8) bytes.
@@ -90,6 +91,60 @@ void checkLocalHeap(BinFile& file, const Hdf5Superblock& sb, std::uint64_t addre
   }
 }
 
+/// A chunked dataset's index in layout versions 1-3: a version 1 B-tree of
+/// node type 1. A node is "TREE", its type, its level, the entries it uses
+/// (u16), its left and right siblings' addresses, then 2K + 1 keys (chunk size
+/// u32, filter mask u32, an offset u64 per dimension of the layout's rank)
+/// alternating with 2K child addresses: chunk nodes one level down, or at
+/// level 0 the chunks. The library reads each node whole, sized by K, before
+/// it looks at it. Each node is visited once; a tree has at most one node per
+/// node size of the file.
+void checkChunkBtree(BinFile& file, const Hdf5Superblock& sb, std::uint64_t root, std::size_t rank,
+                     const std::string& what) {
+  if (hdf5Undefined(sb, root)) return;  // no chunk written yet
+  const std::uint64_t o = std::uint64_t(sb.offset_bytes), k = std::uint64_t(sb.chunk_btree_k);
+  const std::uint64_t key = 8 + 8 * std::uint64_t(rank);
+  const std::uint64_t node_bytes = 8 + 2 * o + 2 * k * o + (2 * k + 1) * key;
+  const std::uint64_t in_file = file.size() - std::min(file.size(), sb.base);
+  const std::string tree = what + ": chunk index";
+  struct Node {
+    std::uint64_t address;
+    int level;  // expected; -1 for the root
+  };
+  std::vector<Node> todo{{root, -1}};
+  std::set<std::uint64_t> seen;
+  for (std::size_t n = 0; n < todo.size(); ++n) {
+    const Node node = todo[n];
+    if (node.address > in_file || node_bytes > in_file - node.address)
+      file.fail(sb.base, tree + ": a node of " + std::to_string(node_bytes) + " bytes at address " +
+                             std::to_string(node.address) + " passes the file's end (" + std::to_string(file.size()) +
+                             " bytes)");
+    if (!seen.insert(node.address).second) continue;
+    if (seen.size() > in_file / node_bytes)
+      file.fail(sb.base + node.address, tree + ": more nodes than the file holds (it loops)");
+    const std::uint64_t at = sb.base + node.address;
+    const std::vector<unsigned char> b = bytesAt(file, at, node_bytes, tree);
+    if (std::memcmp(b.data(), "TREE", 4) != 0) file.fail(at, tree + ": a node without its TREE signature");
+    if (b[4] != 1) file.fail(at + 4, tree + ": a node of type " + std::to_string(b[4]) + ", not a chunk node (1)");
+    const int level = b[5];
+    if (node.level >= 0 && level != node.level)
+      file.fail(at + 5, tree + ": a node at level " + std::to_string(level) + " under one at level " +
+                            std::to_string(node.level + 1));
+    const std::uint64_t entries = loadUnsigned(&b[6], 2);
+    if (entries > 2 * k)
+      file.fail(at + 6, tree + ": a node using " + std::to_string(entries) + " entries, more than 2K = " +
+                            std::to_string(2 * k));
+    for (std::uint64_t e = 0; e < entries; ++e) {
+      const std::uint64_t child_at = 8 + 2 * o + (e + 1) * key + e * o;
+      const std::uint64_t child = loadUnsigned(&b[child_at], sb.offset_bytes);
+      if (child >= in_file)
+        file.fail(at + child_at, tree + ": child " + std::to_string(e) + " at address " + std::to_string(child) +
+                                     ", beyond the file's end (" + std::to_string(file.size()) + " bytes)");
+      if (level > 0) todo.push_back({child, level - 1});
+    }
+  }
+}
+
 /// A chunked layout's chunk sizes must be positive and its rank (the dataset's
 /// plus one, for the element size) at least 2: the library divides the
 /// dataset's sizes by them. Layout message versions 1-2: version, rank, class,
@@ -102,13 +157,16 @@ void checkLayout(BinFile& file, const Hdf5Superblock& sb, const Hdf5Message& m, 
   const int version = d[0];
   const std::size_t o = std::size_t(sb.offset_bytes);
   std::size_t first = 0, rank = 0, width = 4;
+  std::size_t index = 0;  // the chunk B-tree's address (layout versions 1-3)
   if (version == 1 || version == 2) {
     if (d.size() < 8 || d[2] != 2) return;
     rank = d[1];
+    index = 8;
     first = 8 + o;
   } else if (version == 3) {
     if (d[1] != 2 || d.size() < 3) return;
     rank = d[2];
+    index = 3;
     first = 3 + o;
   } else if (version == 4) {
     if (d[1] != 2 || d.size() < 5) return;
@@ -127,6 +185,7 @@ void checkLayout(BinFile& file, const Hdf5Superblock& sb, const Hdf5Message& m, 
     if (loadUnsigned(&d[at], int(width)) == 0)
       file.fail(m.data_byte + at, what + ": chunk size 0 in dimension " + std::to_string(k));
   }
+  if (index > 0) checkChunkBtree(file, sb, loadUnsigned(&d[index], sb.offset_bytes), rank, what);
 }
 
 }  // namespace
@@ -134,6 +193,16 @@ void checkLayout(BinFile& file, const Hdf5Superblock& sb, const Hdf5Message& m, 
 bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address) {
   const std::uint64_t ones = sb.offset_bytes >= 8 ? ~0ull : (std::uint64_t(1) << (8 * sb.offset_bytes)) - 1;
   return address == ones;
+}
+
+void readHdf5ChunkBtreeK(BinFile& file, Hdf5Superblock& sb, const std::vector<Hdf5Message>& extension) {
+  // B-tree K message: version, chunk K (u16), group internal K (u16), group leaf K (u16).
+  for (const Hdf5Message& m : extension) {
+    if (m.type != kBtreeK || m.size < 3) continue;
+    const std::vector<unsigned char> d = bytesAt(file, m.data_byte, 3, "the superblock extension's B-tree K message");
+    sb.chunk_btree_k = int(loadUnsigned(&d[1], 2));
+    if (sb.chunk_btree_k == 0) file.fail(m.data_byte + 1, "the superblock extension: a chunk B-tree K of 0");
+  }
 }
 
 Hdf5Superblock readHdf5Superblock(BinFile& file) {
@@ -171,6 +240,10 @@ Hdf5Superblock readHdf5Superblock(BinFile& file) {
   const std::size_t root_field = sb.version <= 1 ? addresses + 5 * o : addresses + 3 * o;
   if (root_field + o > h.size()) file.fail(at, "truncated HDF5 superblock");
   sb.root_header = loadUnsigned(&h[root_field], sb.offset_bytes);
+  if (sb.version == 1) {  // after the group K values and the consistency flags
+    sb.chunk_btree_k = int(loadUnsigned(&h[24], 2));
+    if (sb.chunk_btree_k == 0) file.fail(at + 24, "HDF5 superblock: a chunk B-tree K of 0");
+  }
   if (sb.version >= 2) sb.extension = loadUnsigned(&h[addresses + o], sb.offset_bytes);
   if (sb.version <= 1 || hdf5Undefined(sb, sb.extension)) sb.extension = ~0ull;
   return sb;

@@ -7,7 +7,10 @@
 //  - an old-style group's local heap sizes its data segment the same way
 //    (88 TB), a heap at the undefined address is read through NULL, and a
 //    free list that loops is followed until memory runs out;
-//  - a chunked layout of rank 0 is divided by (SIGFPE in H5Dopen2).
+//  - a chunked layout of rank 0 is divided by (SIGFPE in H5Dopen2);
+//  - a chunk B-tree node is read whole from its address: one that passes the
+//    file's end, or that is not a chunk node, is copied from NULL (SIGSEGV in
+//    H5Dget_num_chunks).
 // The reader checks every object header it is about to open with these
 // functions: every chunk of the header, its local heap and its layout.
 //
@@ -38,6 +41,9 @@ struct Hdf5Superblock {
   int length_bytes = 8;             ///< size of a length [bytes]
   std::uint64_t root_header = 0;    ///< address of the root group's object header
   std::uint64_t extension = ~0ull;  ///< address of the superblock extension's header (~0: none)
+  /// Chunk B-trees' K: a node holds up to 2K chunks (the library's default
+  /// 32; superblock version 1 or the extension's B-tree K message say otherwise).
+  int chunk_btree_k = 32;
 };
 
 /// One message of an object header, as found in the file.
@@ -54,10 +60,17 @@ Hdf5Superblock readHdf5Superblock(BinFile& file);
 /// True for the all-ones "undefined address" of `sb`'s address size.
 bool hdf5Undefined(const Hdf5Superblock& sb, std::uint64_t address);
 
+/// Takes the chunk B-trees' K from the superblock extension's messages (a B-tree
+/// K message, type 0x13), where there is one; a K of 0 throws IoError.
+void readHdf5ChunkBtreeK(BinFile& file, Hdf5Superblock& sb, const std::vector<Hdf5Message>& extension);
+
 /// Checks the object header of `object` at file address `address`: its
 /// prefix, every chunk it reaches through continuation messages, and an
 /// old-style group's local heap (its symbol table message) must lie inside the
-/// file; a chunked layout's chunk sizes must be positive. Throws IoError "FILE: byte N: object header of OBJECT: ...".
+/// file; a chunked layout's chunk sizes must be positive, and every node of its
+/// chunk index (a version 1 B-tree, layout versions 1-3) must lie in the file,
+/// be a chunk node one level above its children and hold at most 2K entries.
+/// Throws IoError "FILE: byte N: object header of OBJECT: ...".
 /// Returns the messages of every chunk (in chunk order).
 std::vector<Hdf5Message> checkHdf5ObjectHeader(BinFile& file, const Hdf5Superblock& sb, std::uint64_t address,
                                                const std::string& object);

@@ -101,8 +101,12 @@ class Hdf5Reader final : public EventReader {
     // extension's) when it opens the file: they are checked first.
     raw_ = std::make_unique<BinFile>(path);
     superblock_ = readHdf5Superblock(*raw_);
+    if (superblock_.extension != ~0ull) {  // first: it may set the chunk B-trees' K
+      checked_.insert(superblock_.extension);
+      readHdf5ChunkBtreeK(*raw_, superblock_,
+                          checkHdf5ObjectHeader(*raw_, superblock_, superblock_.extension, "the superblock extension"));
+    }
     checkHeader(superblock_.root_header, "/");
-    if (superblock_.extension != ~0ull) checkHeader(superblock_.extension, "the superblock extension");
     file_ = H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!file_.valid()) throw IoError(path + ": byte 0: not a readable HDF5 file (damaged or truncated?)");
     file_bytes_ = raw_->size();

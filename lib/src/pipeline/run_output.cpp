@@ -379,6 +379,28 @@ void runInto(SequenceRunner& runner, RunOutput& output, const SequenceJob& job,
   }
   if (s.reader_warnings > 0)
     out.notes.push_back(std::to_string(s.reader_warnings) + " reader warnings (see celc info)");
+  if (const RunClusterTotals& c = s.clustering; c.events() > 0) {
+    const double n = static_cast<double>(c.events());
+    std::ostringstream cl;
+    cl.precision(3);
+    cl << "events in a cluster: " << 100 * c.clustered / n << "% of the clustered windows' events; left out: ";
+    const std::pair<std::uint64_t, const char*> parts[] = {
+        {c.no_region, "in no region"},
+        {c.small_region, "in regions under cluster.min_cluster_size"},
+        {c.failed_checks, "failing the checks"},
+        {c.off_planes, "off the planes"},
+        {c.off_moving_lines, "off the moving lines"},
+        {c.invalid, "invalid"}};
+    bool first = true;
+    for (const auto& [count, what] : parts) {
+      if (count == 0) continue;
+      cl << (first ? "" : ", ") << 100 * count / n << "% " << what;
+      first = false;
+    }
+    if (first) cl << "none";
+    cl << " (docs/clustering.md)";
+    out.notes.push_back(cl.str());
+  }
   if (s.clusters_line_fit_failed > 0)
     out.notes.push_back(std::to_string(s.clusters_line_fit_failed) +
                         " clusters whose start / end lines could not be fitted: used by npt only "

@@ -453,6 +453,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   splitByMovingLines(events, clusters, bearing, m.calib.camera.focal(), &motion, cluster_options);
   rec.times.cluster = secondsSince(start);
   const ClusterLosses& left = clusters.left_out;
+  rec.n_events_clustered = clusters.n_clustered;
+  rec.left_out = left;
   spdlog::debug("window {}: {} of {} events clustered; left out: {} invalid, {} in no region, {} in regions under "
                 "cluster.min_cluster_size, {} failing the checks, {} off the planes, {} off the moving lines",
                 index, clusters.n_clustered, clusters.n_events, left.invalid, left.no_region, left.small_region,
@@ -553,6 +555,15 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     }
   }
   return rec;
+}
+
+void RunClusterTotals::add(const WindowRecord& rec) {
+  auto count = [](int n) { return static_cast<std::uint64_t>(std::max(n, 0)); };
+  const ClusterLosses& l = rec.left_out;
+  clustered += count(rec.n_events_clustered);
+  invalid += count(l.invalid), no_region += count(l.no_region), small_region += count(l.small_region);
+  failed_checks += count(l.failed_checks), off_planes += count(l.off_planes);
+  off_moving_lines += count(l.off_moving_lines);
 }
 
 RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
@@ -674,6 +685,7 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
         stats.stage_seconds.redraw += rec.times.redraw;
         stats.stage_seconds.groundtruth += rec.times.groundtruth;
         stats.clusters_line_fit_failed += static_cast<std::uint64_t>(rec.n_line_fit_failed);
+        stats.clustering.add(rec);
         sink(rec);
         if (progress) progress(stats.windows_processed, stats.events_processed);
       });

@@ -61,6 +61,10 @@ struct WindowRecord {
   std::size_t n_events = 0;
   int n_clusters = 0;          ///< clusters handed to the solvers with lines
   int n_line_fit_failed = 0;   ///< clusters whose l1 / l3 could not be fitted (npt still uses them)
+  /// The clustering and the moving-line cut (before any redraw): events in a
+  /// cluster, and where the others went (0 where the window was not clustered).
+  int n_events_clustered = 0;
+  ClusterLosses left_out;
   /// The lines' translation D over the window [px] (pipeline/window_policy.hpp); NaN: not measured.
   double translation_px = NAN;
   /// Empty when the window reached the solvers; else why no method ran
@@ -92,6 +96,17 @@ struct WindowFilter {
   int shard_count = 1;
 };
 
+/// WindowRecord::n_events_clustered and left_out summed over a run [events].
+struct RunClusterTotals {
+  std::uint64_t clustered = 0, invalid = 0, no_region = 0, small_region = 0, failed_checks = 0, off_planes = 0,
+                off_moving_lines = 0;
+  void add(const WindowRecord& rec);
+  /// Every event of the windows that were clustered.
+  std::uint64_t events() const {
+    return clustered + invalid + no_region + small_region + failed_checks + off_planes + off_moving_lines;
+  }
+};
+
 struct RunStats {
   std::uint64_t windows_read = 0, windows_processed = 0;
   std::uint64_t events_read = 0, events_processed = 0;
@@ -100,6 +115,7 @@ struct RunStats {
   StageTimes stage_seconds;  ///< summed over windows
   std::uint64_t reader_warnings = 0;
   std::uint64_t clusters_line_fit_failed = 0;  ///< summed WindowRecord::n_line_fit_failed
+  RunClusterTotals clustering;  ///< where the clustered windows' events went
   WindowTail tail;           ///< the last, partial window: processed or not, and its events
 };
 
