@@ -40,6 +40,20 @@ put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   echo "wrote docs/results/$1" >&2
 }
 
+heldout_again() {  # heldout_again NAME PAGE ARGS...: the clusters and speeds sets again, celc run with ARGS
+  local name="$1" page="$2"
+  shift 2
+  scripts/cluster_table.sh "$work/clusters" -- "$@" > "$work/${name}30.txt"
+  for v in 1 3; do
+    scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 -- "$@" \
+      > "$work/$name$v.txt"
+  done
+  { echo "The 12 scenes of clusters.md (seed 30000):"; $tables table 1 < "$work/${name}30.txt"; echo;
+    echo "At 1 m/s (clusters_speeds.md):"; $tables table 1 < "$work/${name}1.txt"; echo;
+    echo "At 3 m/s:"; $tables table 1 < "$work/${name}3.txt"; } |
+    put "$page" "$name" "scripts/cluster_table.sh [as for clusters, speeds] -- $*"
+}
+
 for name in "${names[@]}"; do
   case "$name" in
     simulation)
@@ -103,28 +117,10 @@ for name in "${names[@]}"; do
         put clusters_speeds.md speeds "scripts/cluster_table.sh --seed 50000 --count 8 --speed V,V --rate 0.3,3, V = 1 and 3"
       ;;
     derotate)
-      on=(-- --set cluster.derotate=true)
-      scripts/cluster_table.sh "$work/clusters" "${on[@]}" > "$work/derotate30.txt"
-      for v in 1 3; do
-        scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 "${on[@]}" \
-          > "$work/derotate$v.txt"
-      done
-      { echo "The 12 scenes of clusters.md (seed 30000):"; $tables table 1 < "$work/derotate30.txt"; echo;
-        echo "At 1 m/s (clusters_speeds.md):"; $tables table 1 < "$work/derotate1.txt"; echo;
-        echo "At 3 m/s:"; $tables table 1 < "$work/derotate3.txt"; } |
-        put clusters_derotate.md derotate "scripts/cluster_table.sh [as for clusters, speeds] -- --set cluster.derotate=true"
+      heldout_again derotate clusters_derotate.md --set cluster.derotate=true
       ;;
     fast)
-      on=(-- -c config/fast.yaml)
-      scripts/cluster_table.sh "$work/clusters" "${on[@]}" > "$work/fast30.txt"
-      for v in 1 3; do
-        scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 "${on[@]}" \
-          > "$work/fast$v.txt"
-      done
-      { echo "The 12 scenes of clusters.md (seed 30000):"; $tables table 1 < "$work/fast30.txt"; echo;
-        echo "At 1 m/s (clusters_speeds.md):"; $tables table 1 < "$work/fast1.txt"; echo;
-        echo "At 3 m/s:"; $tables table 1 < "$work/fast3.txt"; } |
-        put fast.md fast "scripts/cluster_table.sh [as for clusters, speeds] -- -c config/fast.yaml"
+      heldout_again fast fast.md -c config/fast.yaml
       ;;
     acceleration)
       scripts/acceleration_sweep.sh 200 "$work/acceleration" > "$work/acceleration.txt"
