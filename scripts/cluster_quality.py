@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The clusters against the truth over runs of `celc synth` sequences.
 
-usage: cluster_quality.py RUNDIR [--method celc_ml]
+usage: cluster_quality.py RUNDIR [--method celc_ml] [--scenes DIR]
 
 RUNDIR holds one `celc run` output folder per sequence (RUNDIR/<name>/
 windows.csv), run on sequences with labels.txt, so that windows.csv carries
@@ -15,6 +15,13 @@ clusters of the same window (within max(1.5x, +1 deg)), and per sequence
 where the oracle's median phi is at most 0.02 rad whether the method's
 median phi is at most 0.05 rad (a refused window counts as pi in both
 medians of the method).
+
+With --scenes (the folder of the sequences, DIR/<name>/events.txt and
+labels.txt), also the share of edges one of whose polarities holds 80% of
+their events in the window. The others change polarity along them (a
+chessboard's grid line); the growing keeps ON and OFF apart
+(cluster.separate_polarity), so such an edge is complete only where the
+fragment join (observations.merge_px) joins its ON and OFF clusters.
 """
 import argparse
 import csv
@@ -33,10 +40,35 @@ def within_gap(phi, oracle):
     return phi <= max(1.5 * oracle, oracle + math.radians(1.0))
 
 
+def one_polarity_edges(seq_dir, spans, min_edge_events=20, share=0.8):
+    """Per window span (t_start, t_end) [s]: (edges with at least
+    min_edge_events events, of them those whose ON or OFF events are at least
+    `share` of theirs), from the sequence's events.txt and labels.txt (the
+    windows of cluster_quality.hpp: events with t_start <= t <= t_end)."""
+    counts = [dict() for _ in spans]  # per window: edge -> [off, on]
+    with open(os.path.join(seq_dir, "events.txt")) as fe, open(os.path.join(seq_dir, "labels.txt")) as fl:
+        for line, label in zip(fe, fl):
+            edge = int(label)
+            if edge < 0:
+                continue
+            t, _, _, p = line.split()[:4]
+            t = float(t)
+            for w, (t0, t1) in enumerate(spans):
+                if t0 <= t <= t1:
+                    c = counts[w].setdefault(edge, [0, 0])
+                    c[1 if p == "1" else 0] += 1
+    out = []
+    for c in counts:
+        sizes = [(off + on, max(off, on)) for off, on in c.values() if off + on >= min_edge_events]
+        out.append((len(sizes), sum(1 for n, m in sizes if m >= share * n)))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("rundir")
     ap.add_argument("--method", default="celc_ml", help="the pipeline's method compared with the oracle")
+    ap.add_argument("--scenes", help="the sequences' folder: also the share of edges of one polarity")
     a = ap.parse_args()
     rows = []
     for path in sorted(glob.glob(os.path.join(a.rundir, "*", "windows.csv"))):
@@ -93,6 +125,18 @@ def main():
     print(f"| windows with at most one cluster below 95% purity | {share(impure_ok):.2f} | >= 0.90 |")
     print(f"| edges with >= 80% of their events in one cluster | "
           f"{(edges_complete / edges if edges else math.nan):.2f} ({edges_complete} / {edges}) | >= 0.80 |")
+    if a.scenes:
+        one_polarity = counted = 0
+        for name in sorted({n for n, _ in rows}):
+            spans = [(num(r["t_start"]), num(r["t_end"])) for n, r in rows if n == name]
+            for n_edges, n_one in one_polarity_edges(os.path.join(a.scenes, name), spans):
+                counted += n_edges
+                one_polarity += n_one
+        if counted != edges:
+            raise SystemExit(f"{a.scenes}: {counted} edges in the sequences' windows, {edges} in windows.csv")
+        print(f"| edges with >= 80% of their events of one polarity (the others are complete only where "
+              f"the fragment join joins their ON and OFF clusters) | "
+              f"{one_polarity / edges if edges else math.nan:.2f} ({one_polarity} / {edges}) | |")
     print(f"| coverage of edge events, median window | {med(coverage):.3f} | >= 0.95 |")
     print(f"| windows where {a.method} is within max(1.5x, +1 deg) of the oracle | {share(gaps):.2f} "
           f"({sum(gaps)} / {len(gaps)}) | >= 0.80 |")

@@ -46,4 +46,4 @@ for f in "$out"/scenes/*.yaml; do
   fi
   "$celc" run "$seq" -o "$out/run/$name" --force -q --no-plots "${extra[@]}" > /dev/null
 done
-/usr/bin/python3 "$root/scripts/cluster_quality.py" "$out/run"
+/usr/bin/python3 "$root/scripts/cluster_quality.py" "$out/run" --scenes "$out/scenes"

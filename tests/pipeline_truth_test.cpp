@@ -5,7 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "celc/eval/run_tables.hpp"
 #include "cli_util.hpp"
@@ -62,6 +67,80 @@ TEST(RunTruth, SampleWindowsCarryClusterQualityAndTheOracle) {
                                  d);
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.err.find("labels.txt: 2 labels for more than"), std::string::npos) << bad.err;
+  fs::remove_all(d);
+}
+
+
+// stdout of a shell command, and its exit status.
+std::pair<int, std::string> shell(const std::string& command) {
+  std::string out;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) return {-1, out};
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  return {WEXITSTATUS(pclose(p)), out};
+}
+
+// The two scripts that read a run against the truth, on the bundled sample:
+// cluster_quality.py --scenes counts the edges of one polarity over the
+// windows' own edges; cluster_variants.py solves each dumped window again by
+// its `celc solve` command, so its "pipeline" column is the run's phi (the
+// dump's contract) and its "true_all" column, celc_ml on the true edges with
+// the same seed, is the oracle's phi (0.5 deg allowed: the script finds an
+// event's label by its pixel and microsecond, the run by its index).
+TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
+  const fs::path d = test::freshTempDir("run_truth_scripts");
+  const fs::path run = d / "sample_seq";
+  const auto r = test::runCelc("run '" CELC_SOURCE_DIR "/data/sample_seq' -q --no-plots -o '" + run.string() +
+                                   "' --dump-windows '" + (run / "windows").string() + "'",
+                               d);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<int, WindowsCsvRow> ml;
+  int edges = 0;
+  for (const WindowsCsvRow& row : readWindowsCsv((run / "windows.csv").string(), false))
+    if (row.method == "celc_ml") ml[row.window] = row, edges += row.edges;
+  ASSERT_EQ(ml.size(), 2u);
+
+  const auto quality = shell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_quality.py' '" + d.string() +
+                             "' --scenes '" CELC_SOURCE_DIR "/data'");
+  ASSERT_EQ(quality.first, 0) << quality.second;
+  const auto at = quality.second.find("of their events of one polarity");
+  ASSERT_NE(at, std::string::npos) << quality.second;
+  const std::string line = quality.second.substr(at, quality.second.find('\n', at) - at);
+  int one = -1, counted = -1;
+  ASSERT_EQ(std::sscanf(line.substr(line.find('(', line.find("| ")) + 1).c_str(), "%d / %d", &one, &counted), 2)
+      << line;
+  EXPECT_EQ(counted, edges) << line;
+  EXPECT_GE(one, 0);
+  EXPECT_LE(one, counted);
+
+  const auto variants = shell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_variants.py' '" + run.string() +
+                              "' '" CELC_SOURCE_DIR "/data/sample_seq'");
+  ASSERT_EQ(variants.first, 0) << variants.second;
+  std::istringstream lines(variants.second);
+  std::string row_text;
+  int rows = 0;
+  while (std::getline(lines, row_text)) {
+    int w;
+    double run_phi, oracle, pipeline, pure, true_kept, true_all, kept;
+    if (std::sscanf(row_text.c_str(), "| %d | %lf | %lf | %lf | %lf | %lf | %lf | %lf |", &w, &run_phi, &oracle,
+                    &pipeline, &pure, &true_kept, &true_all, &kept) != 8)
+      continue;
+    ++rows;
+    ASSERT_EQ(ml.count(w), 1u) << row_text;
+    const double deg = 180.0 / M_PI;
+    EXPECT_NEAR(run_phi, ml[w].phi * deg, 0.01) << row_text;
+    EXPECT_NEAR(oracle, ml[w].oracle_phi * deg, 0.01) << row_text;
+    EXPECT_NEAR(pipeline, run_phi, 0.02) << row_text;
+    EXPECT_NEAR(true_all, oracle, 0.5) << row_text;
+    for (double phi : {pure, true_kept}) EXPECT_LT(phi, 5.0) << row_text;  // clean clusters: a few degrees at most
+    EXPECT_NEAR(kept, ml[w].coverage, 0.02) << row_text;
+  }
+  EXPECT_EQ(rows, 2) << variants.second;
+  EXPECT_NE(variants.second.find("Windows where the pipeline's clusters are beyond the oracle gap: 0"),
+            std::string::npos)
+      << variants.second;
   fs::remove_all(d);
 }
 

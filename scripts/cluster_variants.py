@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""Where a window's gap to the oracle comes from: its clusters changed one way at a time.
+
+usage: cluster_variants.py RUNDIR SEQDIR [--method celc_ml] [--windows 0,3]
+
+RUNDIR is a `celc run SEQDIR -o RUNDIR --dump-windows RUNDIR/windows` of a
+`celc synth` sequence (SEQDIR holds events.txt and labels.txt). Each dumped
+window is solved again by its own `celc solve` command (window_NNNNN.sh,
+the run's options, gyro and seed) on four labellings of the same events:
+  pipeline      the run's clusters, as dumped;
+  pure          the run's clusters with every event not of the cluster's
+                majority edge left out (impurity removed, fragments kept);
+  true_kept     the true edges, on the events the run clustered (fragments
+                joined and impurity removed, the run's coverage kept);
+  true_all      the true edges on every edge event (the oracle's clusters).
+Prints phi [deg] of the method for each (the pipeline's is the run's own,
+up to the undistortion table's rounding, which can tip a window whose
+basins are tied: docs/running.md), the share of edge events the run
+clustered, and then over the windows beyond the oracle gap
+(max(1.5x, +1 deg)) how many each labelling brings within it. Needs
+Debian's python3 only.
+"""
+import argparse
+import csv
+import glob
+import math
+import os
+import subprocess
+import sys
+import tempfile
+from collections import Counter, defaultdict
+
+
+def within_gap(phi, oracle):
+    return phi <= max(1.5 * oracle, oracle + math.radians(1.0))
+
+
+def angle(v, g):
+    """Angle between two directions [rad], the sign included."""
+    dot = sum(a * b for a, b in zip(v, g))
+    n = math.sqrt(sum(a * a for a in v) * sum(b * b for b in g))
+    return math.acos(max(-1.0, min(1.0, dot / n)))
+
+
+def edge_labels(seq):
+    """(t in microseconds, x, y) -> true edge, from events.txt and labels.txt."""
+    out = {}
+    with open(os.path.join(seq, "events.txt")) as fe, open(os.path.join(seq, "labels.txt")) as fl:
+        for line, label in zip(fe, fl):
+            t, x, y = line.split()[:3]
+            out[(round(float(t) * 1e6), int(x), int(y))] = int(label)
+    return out
+
+
+def solve(script, csv_path, variant_path, method):
+    """The method's unit velocity from the window's `celc solve` command on another labelling; None if refused."""
+    command = open(script).read()
+    quoted = [t for t in command.split() if t.startswith("'") and t.endswith("/" + os.path.basename(csv_path) + "'")]
+    if len(quoted) != 1:
+        raise SystemExit(f"{script}: does not name {os.path.basename(csv_path)} once")
+    command = command.replace(quoted[0], "'" + variant_path + "'")
+    with tempfile.NamedTemporaryFile("w", suffix=".sh", delete=False) as f:
+        f.write(command)
+    try:
+        done = subprocess.run(["sh", f.name, "--methods", method], capture_output=True, text=True)
+    finally:
+        os.unlink(f.name)
+    if done.returncode != 0:
+        raise SystemExit(f"{script}: celc solve failed: {done.stderr.strip().splitlines()[-1:]}")
+    for line in done.stdout.splitlines():
+        fields = line.split(",")
+        if fields[0] == method:
+            return [float(x) for x in fields[2:5]] if fields[1] == "ok" else None
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("rundir")
+    ap.add_argument("seqdir")
+    ap.add_argument("--method", default="celc_ml")
+    ap.add_argument("--windows", help="comma-separated window indices (default: every dumped window)")
+    a = ap.parse_args()
+    dump = os.path.join(os.path.abspath(a.rundir), "windows")
+    scripts = sorted(glob.glob(os.path.join(dump, "window_*.sh")))
+    if not scripts:
+        raise SystemExit(f"{dump}: no window_NNNNN.sh (run celc run with --dump-windows RUNDIR/windows)")
+    rows = {}
+    with open(os.path.join(a.rundir, "windows.csv"), newline="") as f:
+        for r in csv.DictReader(f):
+            if r["method"] == a.method:
+                rows[int(r["window"])] = r
+    wanted = {int(w) for w in a.windows.split(",")} if a.windows else None
+    labels = edge_labels(a.seqdir)
+    names = ["pipeline", "pure", "true_kept", "true_all"]
+    print(f"| window | run phi | oracle phi | " + " | ".join(names) + " | edge events clustered |")
+    print("|---" * (len(names) + 4) + "|")
+    beyond = Counter()
+    n_beyond = 0
+    for script in scripts:
+        w = int(os.path.basename(script)[len("window_"):-len(".sh")])
+        r = rows.get(w)
+        if (wanted is not None and w not in wanted) or r is None or r["gt_vx"] == "" or r["oracle_phi"] == "":
+            continue
+        gt = [float(r["gt_vx"]), float(r["gt_vy"]), float(r["gt_vz"])]
+        csv_path = script[:-3] + ".csv"
+        with open(csv_path, newline="") as f:
+            reader = csv.reader(f)
+            header = next(reader)
+            events = [row for row in reader]
+        edge = [labels.get((round(float(e[0]) * 1e6), int(float(e[1])), int(float(e[2]))), -1) for e in events]
+        cluster = [int(e[3]) for e in events]
+        counts = defaultdict(Counter)
+        for c, e in zip(cluster, edge):
+            if c >= 0:
+                counts[c][e] += 1
+        majority = {c: k.most_common(1)[0][0] for c, k in counts.items()}
+        variants = {
+            "pipeline": cluster,
+            "pure": [c if c >= 0 and e == majority[c] and e >= 0 else -1 for c, e in zip(cluster, edge)],
+            "true_kept": [e if c >= 0 and e >= 0 else -1 for c, e in zip(cluster, edge)],
+            "true_all": [e if e >= 0 else -1 for e in edge],
+        }
+        n_edge = sum(1 for e in edge if e >= 0)
+        kept = sum(1 for c, e in zip(cluster, edge) if c >= 0 and e >= 0)
+        phis = {}
+        with tempfile.TemporaryDirectory() as tmp:
+            for name, cl in variants.items():
+                path = os.path.join(tmp, f"{name}.csv")
+                with open(path, "w") as f:
+                    f.write(",".join(header) + "\n")
+                    for ev, c in zip(events, cl):
+                        f.write(f"{ev[0]},{ev[1]},{ev[2]},{c}\n")
+                v = solve(script, csv_path, path, a.method)
+                phis[name] = angle(v, gt) if v else math.pi
+        run_phi = float(r["phi"]) if r["phi"] else math.pi
+        oracle = float(r["oracle_phi"])
+        deg = lambda x: "%.2f" % math.degrees(x)
+        print(f"| {w} | {deg(run_phi)} | {deg(oracle)} | " + " | ".join(deg(phis[n]) for n in names) +
+              f" | {kept / n_edge if n_edge else math.nan:.2f} |")
+        if not within_gap(phis["pipeline"], oracle):
+            n_beyond += 1
+            for n in names[1:]:
+                beyond[n] += within_gap(phis[n], oracle)
+        sys.stdout.flush()
+    print()
+    print(f"Windows where the pipeline's clusters are beyond the oracle gap: {n_beyond}; brought within it by "
+          + ", ".join(f"{n} {beyond[n]}" for n in names[1:]))
+
+
+if __name__ == "__main__":
+    main()
