@@ -6,16 +6,18 @@ usage: cluster_variants.py RUNDIR SEQDIR [--method celc_ml] [--windows 0,3]
 RUNDIR is a `celc run SEQDIR -o RUNDIR --dump-windows RUNDIR/windows` of a
 `celc synth` sequence (SEQDIR holds events.txt and labels.txt). Each dumped
 window is solved again by its own `celc solve` command (window_NNNNN.sh,
-the run's options, gyro and seed) on four labellings of the same events:
+the run's options, gyro and seed) on five labellings of the same events:
   pipeline      the run's clusters, as dumped;
   pure          the run's clusters with every event not of the cluster's
                 majority edge left out (impurity removed, fragments kept);
+  joined        the run's clusters with the same majority edge joined
+                (fragments joined, impurity kept);
   true_kept     the true edges, on the events the run clustered (fragments
                 joined and impurity removed, the run's coverage kept);
   true_all      the true edges on every edge event (the oracle's clusters).
-Prints phi [deg] of the method for each (the pipeline's is the run's own,
-up to the undistortion table's rounding, which can tip a window whose
-basins are tied: docs/running.md), the share of edge events the run
+Prints phi [deg] of the method for each labelling (the pipeline's is the
+run's own, up to the undistortion table's rounding, which can tip a window
+whose basins are tied: docs/running.md), the share of edge events the run
 clustered, and then over the windows beyond the oracle gap
 (max(1.5x, +1 deg)) how many each labelling brings within it. Needs
 Debian's python3 only.
@@ -92,7 +94,7 @@ def main():
                 rows[int(r["window"])] = r
     wanted = {int(w) for w in a.windows.split(",")} if a.windows else None
     labels = edge_labels(a.seqdir)
-    names = ["pipeline", "pure", "true_kept", "true_all"]
+    names = ["pipeline", "pure", "joined", "true_kept", "true_all"]
     print(f"| window | run phi | oracle phi | " + " | ".join(names) + " | edge events clustered |")
     print("|---" * (len(names) + 4) + "|")
     beyond = Counter()
@@ -118,6 +120,7 @@ def main():
         variants = {
             "pipeline": cluster,
             "pure": [c if c >= 0 and e == majority[c] and e >= 0 else -1 for c, e in zip(cluster, edge)],
+            "joined": [majority[c] if c >= 0 and majority[c] >= 0 else -1 for c in cluster],
             "true_kept": [e if c >= 0 and e >= 0 else -1 for c, e in zip(cluster, edge)],
             "true_all": [e if e >= 0 else -1 for e in edge],
         }
