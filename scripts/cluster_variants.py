@@ -18,8 +18,9 @@ the run's options, gyro and seed) on five labellings of the same events:
 Prints phi [deg] of the method for each labelling (the pipeline's is the
 run's own, up to the undistortion table's rounding, which can tip a window
 whose basins are tied: docs/running.md), the share of edge events the run
-clustered, and then over the windows beyond the oracle gap
-(max(1.5x, +1 deg)) how many each labelling brings within it. Needs
+clustered, then how many windows each labelling puts within the oracle gap
+(max(1.5x, +1 deg)), and of those beyond it with the pipeline's clusters,
+how many each brings within it. Needs
 Debian's python3 only.
 """
 import argparse
@@ -97,8 +98,8 @@ def main():
     names = ["pipeline", "pure", "joined", "true_kept", "true_all"]
     print(f"| window | run phi | oracle phi | " + " | ".join(names) + " | edge events clustered |")
     print("|---" * (len(names) + 4) + "|")
-    beyond = Counter()
-    n_beyond = 0
+    beyond, within = Counter(), Counter()
+    n_beyond = n_windows = 0
     for script in scripts:
         w = int(os.path.basename(script)[len("window_"):-len(".sh")])
         r = rows.get(w)
@@ -141,12 +142,16 @@ def main():
         deg = lambda x: "%.2f" % math.degrees(x)
         print(f"| {w} | {deg(run_phi)} | {deg(oracle)} | " + " | ".join(deg(phis[n]) for n in names) +
               f" | {kept / n_edge if n_edge else math.nan:.2f} |")
+        n_windows += 1
+        for n in names:
+            within[n] += within_gap(phis[n], oracle)
         if not within_gap(phis["pipeline"], oracle):
             n_beyond += 1
             for n in names[1:]:
                 beyond[n] += within_gap(phis[n], oracle)
         sys.stdout.flush()
     print()
+    print(f"Within the oracle gap, of {n_windows} windows: " + ", ".join(f"{n} {within[n]}" for n in names))
     print(f"Windows where the pipeline's clusters are beyond the oracle gap: {n_beyond}; brought within it by "
           + ", ".join(f"{n} {beyond[n]}" for n in names[1:]))
 

@@ -212,6 +212,19 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
     ASSERT_TRUE(alone.count(method)) << method;
     EXPECT_LT(angleBetween(v, alone.at(method)), method == "ce3lc" ? 0.01 : 1e-6) << method;
   }
+  // A folder given relative to where celc ran: the command names its files
+  // absolutely, so it runs from any folder.
+  const std::string relative_run = "cd '" + d.string() + "' && CELC_NO_PLOTS=1 " CELC_BINARY
+                                   " run '" CELC_SOURCE_DIR "/data/sample_seq' -q -o rel --window-events 50000"
+                                   " --set windows.t_end=0.06 --dump-windows relwin > /dev/null 2>&1";
+  ASSERT_EQ(std::system(relative_run.c_str()), 0);
+  const std::string elsewhere = (d / "elsewhere.csv").string();
+  ASSERT_EQ(std::system(("cd / && sh '" + (d / "relwin" / "window_00000.sh").string() + "' -q --methods celc > '" +
+                         elsewhere + "' 2>&1")
+                            .c_str()),
+            0)
+      << readAll(elsewhere);
+  EXPECT_EQ(directions(elsewhere, false).count("celc"), 1u) << readAll(elsewhere);
 }
 
 // config/fast.yaml (only celc_ml, clusters not redrawn) on the bundled

@@ -326,7 +326,7 @@ SequenceOutcome runSequence(const SequenceJob& job,
     std::filesystem::create_directories(job.dump_windows, ec);
     if (ec) throw std::runtime_error(job.dump_windows + ": cannot create the folder (" + ec.message() + ")");
     WindowDumpContext context;
-    context.dir = job.dump_windows;
+    context.dir = std::filesystem::absolute(job.dump_windows).string();  // the commands run from any folder
     context.program = job.dump_program;
     context.config = std::filesystem::absolute(std::filesystem::path(job.outdir) / "config.yaml").string();
     runner.dumpWindows(context);
