@@ -46,6 +46,9 @@ def one_polarity_edges(seq_dir, spans, min_edge_events=20, share=0.8):
     `share` of theirs), from the sequence's events.txt and labels.txt (the
     windows of cluster_quality.hpp: events with t_start <= t <= t_end)."""
     counts = [dict() for _ in spans]  # per window: edge -> [off, on]
+    for name in ("events.txt", "labels.txt"):
+        if not os.path.isfile(os.path.join(seq_dir, name)):
+            raise SystemExit(f"{os.path.join(seq_dir, name)}: not found (--scenes names the sequences' folder)")
     with open(os.path.join(seq_dir, "events.txt")) as fe, open(os.path.join(seq_dir, "labels.txt")) as fl:
         for line, label in zip(fe, fl):
             edge = int(label)

@@ -23,6 +23,18 @@ inline std::string readAll(const std::filesystem::path& p) {
   return ss.str();
 }
 
+/// Runs a shell command, capturing its stdout (err stays empty) and exit status.
+inline CliRun runShell(const std::string& command) {
+  CliRun r;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  r.status = WEXITSTATUS(pclose(p));
+  return r;
+}
+
 /// Runs `celc ARGS`, capturing stdout and (through DIR/stderr.txt) stderr.
 /// Without `plots` the automatic plots (python3-matplotlib, seconds per run)
 /// are off (CELC_NO_PLOTS=1); tests of the plots pass plots = true.
@@ -30,13 +42,7 @@ inline CliRun runCelc(const std::string& args, const std::filesystem::path& dir,
   const std::filesystem::path err = dir / "stderr.txt";
   const std::string cmd = std::string(plots ? "" : "CELC_NO_PLOTS=1 ") + CELC_BINARY + " " + args + " 2> '" +
                           err.string() + "'";
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  r.status = WEXITSTATUS(pclose(p));
+  CliRun r = runShell(cmd);
   r.err = readAll(err);
   return r;
 }

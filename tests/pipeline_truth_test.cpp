@@ -71,17 +71,6 @@ TEST(RunTruth, SampleWindowsCarryClusterQualityAndTheOracle) {
 }
 
 
-// stdout of a shell command, and its exit status.
-std::pair<int, std::string> shell(const std::string& command) {
-  std::string out;
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) return {-1, out};
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  return {WEXITSTATUS(pclose(p)), out};
-}
-
 // The two scripts that read a run against the truth, on the bundled sample:
 // cluster_quality.py --scenes counts the edges of one polarity over the
 // windows' own edges; cluster_variants.py solves each dumped window again by
@@ -102,12 +91,12 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
     if (row.method == "celc_ml") ml[row.window] = row, edges += row.edges;
   ASSERT_EQ(ml.size(), 2u);
 
-  const auto quality = shell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_quality.py' '" + d.string() +
+  const auto quality = test::runShell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_quality.py' '" + d.string() +
                              "' --scenes '" CELC_SOURCE_DIR "/data'");
-  ASSERT_EQ(quality.first, 0) << quality.second;
-  const auto at = quality.second.find("of their events of one polarity");
-  ASSERT_NE(at, std::string::npos) << quality.second;
-  const std::string line = quality.second.substr(at, quality.second.find('\n', at) - at);
+  ASSERT_EQ(quality.status, 0) << quality.out;
+  const auto at = quality.out.find("of their events of one polarity");
+  ASSERT_NE(at, std::string::npos) << quality.out;
+  const std::string line = quality.out.substr(at, quality.out.find('\n', at) - at);
   int one = -1, counted = -1;
   ASSERT_EQ(std::sscanf(line.substr(line.find('(', line.find("| ")) + 1).c_str(), "%d / %d", &one, &counted), 2)
       << line;
@@ -115,10 +104,10 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   EXPECT_GE(one, 0);
   EXPECT_LE(one, counted);
 
-  const auto variants = shell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_variants.py' '" + run.string() +
+  const auto variants = test::runShell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_variants.py' '" + run.string() +
                               "' '" CELC_SOURCE_DIR "/data/sample_seq'");
-  ASSERT_EQ(variants.first, 0) << variants.second;
-  std::istringstream lines(variants.second);
+  ASSERT_EQ(variants.status, 0) << variants.out;
+  std::istringstream lines(variants.out);
   std::string row_text;
   int rows = 0;
   while (std::getline(lines, row_text)) {
@@ -138,10 +127,10 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
     for (double phi : {pure, joined, true_kept}) EXPECT_LT(phi, 5.0) << row_text;
     EXPECT_NEAR(kept, ml[w].coverage, 0.02) << row_text;
   }
-  EXPECT_EQ(rows, 2) << variants.second;
-  EXPECT_NE(variants.second.find("Windows where the pipeline's clusters are beyond the oracle gap: 0"),
+  EXPECT_EQ(rows, 2) << variants.out;
+  EXPECT_NE(variants.out.find("Windows where the pipeline's clusters are beyond the oracle gap: 0"),
             std::string::npos)
-      << variants.second;
+      << variants.out;
   fs::remove_all(d);
 }
 
