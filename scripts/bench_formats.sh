@@ -48,8 +48,8 @@ run() {
   cat "$out.time"
 }
 
-echo "| input | threads | windows | events | M events/s |${old:+ CELC_OLD_BUILD M events/s (ratio) |} reading | probes | clustering | lines | solvers | redraws | peak RSS [MB] | bound [MB] |"
-echo "|---|---|---|---|---|${old:+---|}---|---|---|---|---|---|---|"
+echo "| input | threads | windows | events | M events/s end to end |${old:+ CELC_OLD_BUILD M events/s (ratio) |} reading [M events/s] | probes | clustering | lines | solvers | redraws | peak RSS [MB] | bound [MB] |"
+echo "|---|---|---|---|---|${old:+---|}---|---|---|---|---|---|---|---|"
 status=0
 for input in text aedat4 bag hdf5; do
   case "$input" in

@@ -18,8 +18,9 @@ struct CliRun {
   std::string out;
 };
 
-CliRun runCelc(const std::string& args) {
-  const std::string cmd = std::string(CELC_BINARY) + " " + args + " 2>&1";
+/// Runs a shell command with stderr joined to stdout.
+CliRun runCommand(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   CliRun r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -29,6 +30,8 @@ CliRun runCelc(const std::string& args) {
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
 }
+
+CliRun runCelc(const std::string& args) { return runCommand(std::string(CELC_BINARY) + " " + args); }
 
 fs::path tempDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("celc_cluster_cli_" + name);
@@ -102,6 +105,19 @@ TEST(ClusterCli, EmptyFileIsNotAnError) {
   std::ofstream(f) << "# nothing\n";
   const CliRun r = runCelc("cluster " + f.string());
   EXPECT_EQ(r.status, 0) << r.out;
+}
+
+// PCL is no dependency of the executable: the pcl method's library is loaded
+// when options name it, so other runs neither map nor relocate PCL.
+TEST(ClusterCli, PclIsLoadedOnlyForThePclMethod) {
+  const CliRun deps = runCommand("ldd '" + std::string(CELC_BINARY) + "'");
+  ASSERT_EQ(deps.status, 0) << deps.out;
+  EXPECT_NE(deps.out.find("libcelc_cluster.so"), std::string::npos) << deps.out;
+  EXPECT_EQ(deps.out.find("libpcl"), std::string::npos) << deps.out;
+  const std::string sample = std::string(CELC_SOURCE_DIR) + "/data/sample_seq";
+  const CliRun pcl = runCelc("cluster '" + sample + "' --method pcl --window-events 20000 --max-windows 1 -q");
+  ASSERT_EQ(pcl.status, 0) << pcl.out;
+  EXPECT_NE(pcl.out.find(",ok,"), std::string::npos) << pcl.out;  // the PCL grower ran and found clusters
 }
 
 }  // namespace

@@ -41,6 +41,9 @@ std::string ClusterOptions::validate() const {
   std::string e = rangeProblemsOf(*this);
   if (!(c_max_px_per_s >= c_min_px_per_s)) e += "c_max_px_per_s: must be >= c_min_px_per_s; ";
   if (max_cluster_size < min_cluster_size) e += "max_cluster_size: must be >= min_cluster_size; ";
+  // The pcl method's library is loaded here, on the first options that name it.
+  if (method == ClusterMethod::Pcl)
+    if (const std::string why = detail::pclGrowerError(); !why.empty()) e += why + "; ";
   return e;
 }
 

@@ -3,6 +3,7 @@
 /// Shared pieces of the clustering methods (not a public header).
 #include <algorithm>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
@@ -145,8 +146,16 @@ double growingAngleDeg(const GridIndex& index, double c, const ClusterOptions& o
 Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, int threads,
                  GridNormals* normals = nullptr);
 
-/// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree, points (x, y, c*t).
+/// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree,
+/// points (x, y, c*t). Defined in libcelc_cluster_pcl.so (pcl/pcl_grower.cpp),
+/// which pcl_method.cpp loads on the first use; ClusterOptions::validate()
+/// checks pclGrowerError() before any clustering.
 Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads);
+
+/// Loads the PCL reference method's library (once per process) and returns
+/// why it cannot be used: empty when growPcl can be called, else a one-line
+/// reason naming the library file.
+std::string pclGrowerError();
 
 /// Median normal-flow speed [px/s] of sampled local planes, iterated from c0;
 /// 0 when fewer than 20 usable planes.

@@ -1,5 +1,7 @@
 // Reference method: PCL normals (k nearest neighbours from a kd-tree) and
-// pcl::RegionGrowing with the same criteria as the grid grower.
+// pcl::RegionGrowing with the same criteria as the grid grower. Built as its
+// own library, libcelc_cluster_pcl.so, which libcelc_cluster loads on the
+// method's first use (pcl_method.cpp): only runs that ask for it map PCL.
 #include <pcl/features/normal_3d_omp.h>
 #include <pcl/filters/radius_outlier_removal.h>
 #include <pcl/point_cloud.h>
@@ -14,7 +16,9 @@
 
 namespace celc::detail {
 
-Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads) {
+namespace {
+
+Regions growWithPcl(const Group& g, double c, const ClusterOptions& opt, int threads) {
   Regions out;
   const size_t n = g.size();
   out.label.assign(n, -1);
@@ -67,4 +71,13 @@ Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads
   return out;
 }
 
+}  // namespace
+
 }  // namespace celc::detail
+
+/// The library's one entry point: the address of the grower, a function of
+/// type celc::detail::PclGrowFunction (pcl_method.cpp looks it up by this
+/// unmangled name).
+extern "C" __attribute__((visibility("default"))) void* celc_cluster_pcl_grower() {
+  return reinterpret_cast<void*>(&celc::detail::growWithPcl);
+}
