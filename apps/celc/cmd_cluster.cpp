@@ -63,6 +63,7 @@ void run(const ClusterArgs& a, const CLI::App& cmd) {
   if (given("--max-plane-rms")) opt.max_plane_rms_px = a.max_plane_rms_px;
   if (const std::string err = opt.validate(); !err.empty())
     throw std::runtime_error("invalid clustering options: " + err);
+  if (const std::string why = clusterMethodProblem(opt.method); !why.empty()) throw std::runtime_error(why);
   // Any format the io module reads (text, AEDAT 2.0 / 3.1 / 4.0), window by window.
   ReaderOptions ro;
   ro.width = a.width;

@@ -37,13 +37,14 @@ std::string toString(ClusterStatus status) {
   return "unknown";
 }
 
+std::string clusterMethodProblem(ClusterMethod method) {
+  return method == ClusterMethod::Pcl ? detail::pclGrowerError() : std::string();
+}
+
 std::string ClusterOptions::validate() const {
   std::string e = rangeProblemsOf(*this);
   if (!(c_max_px_per_s >= c_min_px_per_s)) e += "c_max_px_per_s: must be >= c_min_px_per_s; ";
   if (max_cluster_size < min_cluster_size) e += "max_cluster_size: must be >= min_cluster_size; ";
-  // The pcl method's library is loaded here, on the first options that name it.
-  if (method == ClusterMethod::Pcl)
-    if (const std::string why = detail::pclGrowerError(); !why.empty()) e += why + "; ";
   return e;
 }
 
@@ -324,6 +325,11 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   if (!err.empty()) {
     res.status = ClusterStatus::InvalidOptions;
     res.message = err;
+    return res;
+  }
+  if (std::string why = clusterMethodProblem(opt.method); !why.empty()) {
+    res.status = ClusterStatus::InvalidOptions;
+    res.message = std::move(why);
     return res;
   }
   if (events.empty()) {

@@ -148,8 +148,8 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
 
 /// Reference: pcl::NormalEstimationOMP + pcl::RegionGrowing with a kd-tree,
 /// points (x, y, c*t). Defined in libcelc_cluster_pcl.so (pcl/pcl_grower.cpp),
-/// which pcl_method.cpp loads on the first use; ClusterOptions::validate()
-/// checks pclGrowerError() before any clustering.
+/// which pcl_method.cpp loads on the first use; clusterEvents checks
+/// clusterMethodProblem() before any clustering.
 Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads);
 
 /// Loads the PCL reference method's library (once per process) and returns

@@ -61,7 +61,7 @@ std::string pclGrowerError() { return grower().error; }
 
 Regions growPcl(const Group& g, double c, const ClusterOptions& opt, int threads) {
   const PclGrower& pcl = grower();
-  if (pcl.grow == nullptr) return Regions{std::vector<int>(g.size(), -1)};  // ClusterOptions::validate() said why
+  if (pcl.grow == nullptr) return Regions{std::vector<int>(g.size(), -1)};  // clusterEvents said why
   return pcl.grow(g, c, opt, threads);
 }
 

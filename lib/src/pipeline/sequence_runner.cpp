@@ -252,6 +252,8 @@ SequenceRunner::SequenceRunner(const RunInputs& in, const RunConfig& config)
   m.inputs = in;
   if (const std::string err = config.validate(); !err.empty())
     throw std::runtime_error("configuration: " + err);
+  if (const std::string why = clusterMethodProblem(config.cluster.method); !why.empty())
+    throw std::runtime_error("configuration: cluster.method: " + why);
   if (!fs::exists(in.events)) throw std::runtime_error(in.events + ": no such file or directory");
   if (fs::is_directory(in.events)) {  // a sequence directory: what the inputs do not name
     const SequenceLayout layout = resolveSequenceLayout(in.events);

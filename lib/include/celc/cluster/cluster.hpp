@@ -38,6 +38,12 @@ enum class ClusterMethod {
 /// "grid" / "pcl".
 ClusterMethod parseClusterMethod(const std::string& name);
 std::string toString(ClusterMethod method);
+/// Empty when `method` can run in this process, else why not in one line:
+/// the pcl method's library (libcelc_cluster_pcl.so, beside
+/// libcelc_cluster.so) is opened here, on the first call that names it, and
+/// may be missing. clusterEvents answers `invalid_options` with this reason;
+/// callers check it before a run to fail at once.
+std::string clusterMethodProblem(ClusterMethod method);
 
 struct ClusterOptions {
   ClusterMethod method = ClusterMethod::Grid;
