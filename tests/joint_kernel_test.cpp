@@ -2,7 +2,10 @@
 // against the same sums formed event by event with eventDistance.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <stdexcept>
 #include <random>
 
 #include "solver/joint_kernel.hpp"
@@ -149,4 +152,76 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
   EXPECT_EQ(checked, 2 * 3 * 3 * 3 * 2);
   EXPECT_GT(tukey_inside, 50);
   EXPECT_GT(tukey_beyond, 50);
+}
+
+// A problem's columns are written row by row (startRows, appendRow, room for
+// more rows than written) and strided from those rows (assignStrided): every
+// sum and distance equals the one from columns packed at that step from the
+// array of terms (assign), bit for bit, and term() gives each term back.
+TEST(JointKernel, RowsWrittenOnceGiveTheSameColumnsAsPacking) {
+  std::mt19937_64 rng(5);
+  const std::vector<EventTerm> terms = randomTerms(201, rng);
+  const std::vector<size_t> begin = {0, 61, 61, 201};
+  const double focal = 320.0;
+  for (bool acceleration : {false, true}) {
+    std::vector<Eigen::Vector2d> dq;
+    for (size_t k = 0; k < terms.size(); ++k) dq.emplace_back(0.01 * static_cast<double>(k), -0.02);
+    JointColumns full(JointColumns::Spare::Full);
+    full.startRows(2, acceleration);
+    full.appendRow(terms[0], dq[0]);
+    full.appendRow(terms[1], dq[1]);
+    EXPECT_THROW(full.appendRow(terms[2], dq[2]), std::logic_error);  // no room beyond max_rows
+    JointColumns rows(JointColumns::Spare::Full);
+    rows.startRows(terms.size() + 17, acceleration);
+    for (size_t k = 0; k < terms.size(); ++k) rows.appendRow(terms[k], dq[k]);
+    ASSERT_EQ(rows.size(), terms.size());
+    EXPECT_GE(rows.stride(), rows.size() + JointColumns::kPadding);
+    for (size_t k : {size_t{0}, size_t{100}, size_t{200}}) {
+      const EventTerm e = rows.term(k);
+      EXPECT_EQ(e.fp, terms[k].fp);
+      EXPECT_EQ(e.Rt01, terms[k].Rt01);
+      EXPECT_EQ(e.De, terms[k].De);
+      EXPECT_EQ(e.Ds, terms[k].Ds);
+    }
+    for (size_t step : {size_t{1}, size_t{3}, size_t{10}}) {
+      JointColumns packed, strided;
+      std::vector<size_t> packed_begin, strided_begin;
+      packed.assign(terms, begin, step, packed_begin, acceleration ? &dq : nullptr);
+      strided.assignStrided(rows, begin, step, strided_begin);
+      ASSERT_EQ(strided_begin, packed_begin);
+      ASSERT_EQ(strided.size(), packed.size());
+      EXPECT_EQ(strided.hasAcceleration(), acceleration);
+      const JointColumns& mine = step == 1 ? rows : strided;
+      const std::vector<size_t>& mine_begin = step == 1 ? begin : strided_begin;
+      const Vec3 v = randomVec(rng, 1.0).normalized();
+      const Vec3 m1 = randomVec(rng, 1.0).normalized(), m3 = randomVec(rng, 1.0).normalized();
+      const Vec3 a = randomVec(rng, 0.5);
+      const detail::Mat32 Bv = detail::tangentBasis(v), B1 = detail::tangentBasis(m1), B3 = detail::tangentBasis(m3);
+      for (size_t c = 0; c + 1 < begin.size(); ++c) {
+        const size_t n = packed_begin[c + 1] - packed_begin[c];
+        std::vector<double> got(n + 1, -1.0), want(n + 1, -1.0);
+        detail::jointDistances(mine, mine_begin[c], mine_begin[c + 1], v, m1, m3, focal, got.data(),
+                               acceleration ? &a : nullptr);
+        detail::jointDistances(packed, packed_begin[c], packed_begin[c + 1], v, m1, m3, focal, want.data(),
+                               acceleration ? &a : nullptr);
+        for (size_t i = 0; i < n; ++i) {
+          if (std::isfinite(want[i]) || std::isfinite(got[i])) {
+            EXPECT_EQ(got[i], want[i]) << "event " << i;
+          }
+        }
+        if (acceleration) continue;
+        const JointBlockSums s1 = detail::jointBlockSums(mine, mine_begin[c], mine_begin[c + 1], v, m1, m3,
+                                                         Bv.data(), B1.data(), B3.data(), focal,
+                                                         RobustLoss{RobustLoss::Type::Huber, 2.0});
+        const JointBlockSums s2 = detail::jointBlockSums(packed, packed_begin[c], packed_begin[c + 1], v, m1, m3,
+                                                         Bv.data(), B1.data(), B3.data(), focal,
+                                                         RobustLoss{RobustLoss::Type::Huber, 2.0});
+        static_assert(sizeof(JointBlockSums) == 27 * sizeof(double), "27 sums, no padding");
+        std::array<double, 27> a1, a2;
+        std::memcpy(a1.data(), &s1, sizeof s1);
+        std::memcpy(a2.data(), &s2, sizeof s2);
+        EXPECT_EQ(a1, a2);
+      }
+    }
+  }
 }

@@ -6,15 +6,50 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "isa_clones.hpp"
 #include "thread_buffer.hpp"
 
 namespace celc::detail {
 
-JointColumns::JointColumns() { borrowThreadVector<JointColumns>(data_); }
+namespace {
+/// The thread's spare for the full columns (the strided ones use JointColumns').
+struct FullColumnsSpare;
+}  // namespace
 
-JointColumns::~JointColumns() { returnThreadVector<JointColumns>(data_); }
+JointColumns::JointColumns(Spare spare) : spare_(spare) {
+  if (spare_ == Spare::Full)
+    borrowThreadVector<FullColumnsSpare>(data_);
+  else
+    borrowThreadVector<JointColumns>(data_);
+}
+
+JointColumns::~JointColumns() {
+  if (spare_ == Spare::Full)
+    returnThreadVector<FullColumnsSpare>(data_);
+  else
+    returnThreadVector<JointColumns>(data_);
+}
+
+void JointColumns::writeRow(size_t row, const EventTerm& e, const Eigen::Vector2d& dq) {
+  const size_t s = stride_;
+  double* c = data_.data() + row;
+  for (int j = 0; j < 3; ++j) {
+    c[static_cast<size_t>(j) * s] = e.fp(j);
+    c[static_cast<size_t>(3 + j) * s] = e.Rt01(0, j);
+    c[static_cast<size_t>(6 + j) * s] = e.Rt01(1, j);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      c[static_cast<size_t>(9 + 3 * i + j) * s] = e.De(i, j);
+      c[static_cast<size_t>(18 + 3 * i + j) * s] = e.Ds(i, j);
+    }
+  if (acceleration_) {
+    c[static_cast<size_t>(27) * s] = dq(0);
+    c[static_cast<size_t>(28) * s] = dq(1);
+  }
+}
 
 void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
                           std::vector<size_t>& strided_begin, const std::vector<Eigen::Vector2d>* dq) {
@@ -23,31 +58,68 @@ void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector
   for (size_t c = 0; c + 1 < begin.size(); ++c)
     strided_begin.push_back(strided_begin.back() + (begin[c + 1] - begin[c] + step - 1) / step);
   n_ = strided_begin.back();
+  stride_ = n_ + kPadding;
   acceleration_ = dq != nullptr;
-  const size_t s = stride();
   const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
-  reserveWithHeadroom(data_, columns * s);
-  data_.assign(columns * s, 0.0);
+  reserveWithHeadroom(data_, columns * stride_);
+  data_.assign(columns * stride_, 0.0);
   size_t row = 0;
   for (size_t cl = 0; cl + 1 < begin.size(); ++cl)
-    for (size_t k = begin[cl]; k < begin[cl + 1]; k += step, ++row) {
-      const EventTerm& e = terms[k];
-      double* c = data_.data() + row;
-      for (int j = 0; j < 3; ++j) {
-        c[static_cast<size_t>(j) * s] = e.fp(j);
-        c[static_cast<size_t>(3 + j) * s] = e.Rt01(0, j);
-        c[static_cast<size_t>(6 + j) * s] = e.Rt01(1, j);
-      }
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          c[static_cast<size_t>(9 + 3 * i + j) * s] = e.De(i, j);
-          c[static_cast<size_t>(18 + 3 * i + j) * s] = e.Ds(i, j);
-        }
-      if (acceleration_) {
-        c[static_cast<size_t>(27) * s] = (*dq)[k](0);
-        c[static_cast<size_t>(28) * s] = (*dq)[k](1);
-      }
+    for (size_t k = begin[cl]; k < begin[cl + 1]; k += step, ++row)
+      writeRow(row, terms[k], acceleration_ ? (*dq)[k] : Eigen::Vector2d::Zero().eval());
+}
+
+void JointColumns::assignStrided(const JointColumns& full, const std::vector<size_t>& begin, size_t step,
+                                 std::vector<size_t>& strided_begin) {
+  step = std::max<size_t>(1, step);
+  strided_begin.assign(1, 0);
+  for (size_t c = 0; c + 1 < begin.size(); ++c)
+    strided_begin.push_back(strided_begin.back() + (begin[c + 1] - begin[c] + step - 1) / step);
+  n_ = strided_begin.back();
+  stride_ = n_ + kPadding;
+  acceleration_ = full.acceleration_;
+  const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
+  reserveWithHeadroom(data_, columns * stride_);
+  data_.assign(columns * stride_, 0.0);
+  for (size_t j = 0; j < columns; ++j) {
+    const double* from = full.data_.data() + j * full.stride_;
+    double* to = data_.data() + j * stride_;
+    size_t row = 0;
+    for (size_t cl = 0; cl + 1 < begin.size(); ++cl)
+      for (size_t k = begin[cl]; k < begin[cl + 1]; k += step) to[row++] = from[k];
+  }
+}
+
+void JointColumns::startRows(size_t max_rows, bool acceleration) {
+  n_ = 0;
+  stride_ = max_rows + kPadding;
+  acceleration_ = acceleration;
+  const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
+  reserveWithHeadroom(data_, columns * stride_);
+  data_.assign(columns * stride_, 0.0);
+}
+
+void JointColumns::appendRow(const EventTerm& e, const Eigen::Vector2d& dq) {
+  if (n_ + kPadding >= stride_) throw std::logic_error("JointColumns::appendRow: more rows than startRows allowed");
+  writeRow(n_, e, dq);
+  ++n_;
+}
+
+EventTerm JointColumns::term(size_t i) const {
+  EventTerm e;
+  const size_t s = stride_;
+  const double* c = data_.data() + i;
+  for (int j = 0; j < 3; ++j) {
+    e.fp(j) = c[static_cast<size_t>(j) * s];
+    e.Rt01(0, j) = c[static_cast<size_t>(3 + j) * s];
+    e.Rt01(1, j) = c[static_cast<size_t>(6 + j) * s];
+  }
+  for (int i2 = 0; i2 < 3; ++i2)
+    for (int j = 0; j < 3; ++j) {
+      e.De(i2, j) = c[static_cast<size_t>(9 + 3 * i2 + j) * s];
+      e.Ds(i2, j) = c[static_cast<size_t>(18 + 3 * i2 + j) * s];
     }
+  return e;
 }
 
 namespace {

@@ -19,9 +19,11 @@ class JointColumns {
  public:
   static constexpr int kColumns = 27;
   static constexpr int kAccelerationColumns = 29;
-  /// The storage is the thread's spare columns, given back on destruction
-  /// (thread_buffer.hpp).
-  JointColumns();
+  /// Which of the thread's two spare buffers the storage comes from (and is
+  /// given back to on destruction, thread_buffer.hpp): a problem's full
+  /// columns and its strided ones are held at once.
+  enum class Spare { Strided, Full };
+  explicit JointColumns(Spare spare = Spare::Strided);
   ~JointColumns();
   JointColumns(const JointColumns&) = delete;
   JointColumns& operator=(const JointColumns&) = delete;
@@ -30,16 +32,31 @@ class JointColumns {
   /// (per term: q_e - q_k, q_s - q_k), the acceleration's columns too.
   void assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
               std::vector<size_t>& strided_begin, const std::vector<Eigen::Vector2d>* dq = nullptr);
+  /// The same from the rows of `full` (begin: its clusters' ranges): every
+  /// step-th row of each cluster, the values copied exactly.
+  void assignStrided(const JointColumns& full, const std::vector<size_t>& begin, size_t step,
+                     std::vector<size_t>& strided_begin);
+  /// Empty columns room for up to max_rows events, filled by appendRow (so
+  /// that a problem's terms are written once, with no array of structures).
+  void startRows(size_t max_rows, bool acceleration);
+  /// Appends an event's term (and with an acceleration dq = (q_e - q_k,
+  /// q_s - q_k)) as the next row; at most startRows' max_rows rows.
+  void appendRow(const EventTerm& e, const Eigen::Vector2d& dq = Eigen::Vector2d::Zero());
+  /// The term of row i, the values as stored.
+  EventTerm term(size_t i) const;
   /// Zero rows after the events, so that a pass may read a whole block of
   /// lanes past the last one.
   static constexpr size_t kPadding = 8;
   size_t size() const { return n_; }
   const double* data() const { return data_.data(); }
-  size_t stride() const { return n_ + kPadding; }  ///< between columns [doubles]
+  size_t stride() const { return stride_; }  ///< between columns [doubles], at least size() + kPadding
   bool hasAcceleration() const { return acceleration_; }
 
  private:
+  void writeRow(size_t row, const EventTerm& e, const Eigen::Vector2d& dq);
+  Spare spare_;
   size_t n_ = 0;
+  size_t stride_ = kPadding;
   bool acceleration_ = false;
   std::vector<double> data_;
 };

@@ -51,10 +51,9 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
   const std::vector<size_t> quota =
       rowQuota(sizes, static_cast<size_t>(std::max(0, max_events)), balance_clusters);
-  borrowThreadVector<JointProblem>(terms_);
   size_t total = 0;
   for (size_t q : quota) total += q;
-  reserveWithHeadroom(terms_, total);
+  terms_.startRows(total, acceleration_);
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const ClusterObservation& cl = obs.clusters[usable[ci]];
     const ClusterFrame& frame = frames[usable[ci]];
@@ -68,8 +67,7 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
       motion.pose(t, Rk, Pk);
       const EventTerm e = makeEventTerm(frame, Rk, Pk, f);
       if (!e.fp.allFinite() || !e.De.allFinite() || !e.Ds.allFinite()) continue;
-      terms_.push_back(e);
-      if (acceleration_) dq_.emplace_back(qe - q(t), qs - q(t));
+      terms_.appendRow(e, acceleration_ ? Eigen::Vector2d(qe - q(t), qs - q(t)) : Eigen::Vector2d::Zero());
     }
     if (terms_.size() == first) continue;
     begin_.push_back(terms_.size());
@@ -79,16 +77,19 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
 }
 
 const JointColumns& JointProblem::columns(int stride) const {
+  if (stride <= 1) {
+    column_begin_ = begin_;
+    column_stride_ = 1;
+    return terms_;
+  }
   if (stride != column_stride_) {
-    columns_.assign(terms_, begin_, static_cast<size_t>(stride), column_begin_, acceleration_ ? &dq_ : nullptr);
+    columns_.assignStrided(terms_, begin_, static_cast<size_t>(stride), column_begin_);
     column_stride_ = stride;
   }
   return columns_;
 }
 
-JointProblem::~JointProblem() {
-  returnThreadVector<JointProblem>(terms_);
-}
+JointProblem::~JointProblem() = default;
 
 size_t JointProblem::events() const { return terms_.size(); }
 
@@ -98,7 +99,7 @@ ResidualSpread JointProblem::spread(const State& s) const {
     d.reserve(terms_.size());
     for (size_t c = 0; c + 1 < begin_.size(); ++c)
       for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
-        d.push_back(eventDistance(terms_[k], s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
+        d.push_back(eventDistance(terms_.term(k), s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
     return residualSpread(std::move(d));
   }
   const JointColumns& cols = columns(1);

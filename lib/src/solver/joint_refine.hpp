@@ -138,16 +138,16 @@ class JointProblem {
   Result refineSteps(State s, int max_iterations, double function_tolerance, int stride,
                      const std::vector<State>& merge_into, double merge_rad) const;
   bool acceleration_ = false;
-  std::vector<Eigen::Vector2d> dq_;  // with an acceleration, per term: q_e - q_k, q_s - q_k
-  /// The terms of cluster c: terms_[begin_[c], begin_[c + 1]). The buffer's
+  /// The event terms as columns (joint_kernel.hpp), written once; the terms
+  /// of cluster c are its rows [begin_[c], begin_[c + 1]). The buffer's
   /// memory is kept per thread across problems: allocating and releasing it
   /// per window made the kernel map and unmap its pages every time, which
   /// cost more than building the terms.
-  std::vector<EventTerm> terms_;
+  JointColumns terms_{JointColumns::Spare::Full};
   std::vector<size_t> begin_{0};
-  /// Every stride-th event of terms_ as columns, for the passes of
-  /// joint_kernel.hpp, with the clusters' ranges in them; formed for the
-  /// stride of the last pass that asked (columns()).
+  /// Every stride-th event of terms_, with the clusters' ranges in them,
+  /// for a pass with a stride above 1; formed for the stride of the last
+  /// such pass that asked (columns()).
   mutable JointColumns columns_;
   mutable std::vector<size_t> column_begin_;
   mutable int column_stride_ = 0;
