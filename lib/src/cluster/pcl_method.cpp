@@ -1,6 +1,6 @@
 // The PCL reference method, loaded on its first use. PCL lives in its own
 // library, libcelc_cluster_pcl.so, beside libcelc_cluster.so: linked into
-// every process it cost about 35 MB of resident memory and most of the
+// every process it would cost about 35 MB of resident memory and half the
 // start-up time (the dynamic loader relocating PCL's template instances) of
 // every `celc` command, for a method only comparisons use (docs/decisions.md).
 #include <dlfcn.h>

@@ -51,18 +51,19 @@ void JointColumns::writeRow(size_t row, const EventTerm& e, const Eigen::Vector2
   }
 }
 
-void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
-                          std::vector<size_t>& strided_begin, const std::vector<Eigen::Vector2d>* dq) {
-  step = std::max<size_t>(1, step);
+void JointColumns::layOut(const std::vector<size_t>& begin, size_t step, std::vector<size_t>& strided_begin,
+                          bool acceleration) {
   strided_begin.assign(1, 0);
   for (size_t c = 0; c + 1 < begin.size(); ++c)
     strided_begin.push_back(strided_begin.back() + (begin[c + 1] - begin[c] + step - 1) / step);
+  startRows(strided_begin.back(), acceleration);
   n_ = strided_begin.back();
-  stride_ = n_ + kPadding;
-  acceleration_ = dq != nullptr;
-  const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
-  reserveWithHeadroom(data_, columns * stride_);
-  data_.assign(columns * stride_, 0.0);
+}
+
+void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector<size_t>& begin, size_t step,
+                          std::vector<size_t>& strided_begin, const std::vector<Eigen::Vector2d>* dq) {
+  step = std::max<size_t>(1, step);
+  layOut(begin, step, strided_begin, dq != nullptr);
   size_t row = 0;
   for (size_t cl = 0; cl + 1 < begin.size(); ++cl)
     for (size_t k = begin[cl]; k < begin[cl + 1]; k += step, ++row)
@@ -72,15 +73,8 @@ void JointColumns::assign(const std::vector<EventTerm>& terms, const std::vector
 void JointColumns::assignStrided(const JointColumns& full, const std::vector<size_t>& begin, size_t step,
                                  std::vector<size_t>& strided_begin) {
   step = std::max<size_t>(1, step);
-  strided_begin.assign(1, 0);
-  for (size_t c = 0; c + 1 < begin.size(); ++c)
-    strided_begin.push_back(strided_begin.back() + (begin[c + 1] - begin[c] + step - 1) / step);
-  n_ = strided_begin.back();
-  stride_ = n_ + kPadding;
-  acceleration_ = full.acceleration_;
+  layOut(begin, step, strided_begin, full.acceleration_);
   const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
-  reserveWithHeadroom(data_, columns * stride_);
-  data_.assign(columns * stride_, 0.0);
   for (size_t j = 0; j < columns; ++j) {
     const double* from = full.data_.data() + j * full.stride_;
     double* to = data_.data() + j * stride_;

@@ -14,7 +14,7 @@ namespace celc::detail {
 /// Event terms (EventTerm) as 27 columns: fp, the two rows of R_k^T, then De
 /// and Ds row by row; with an acceleration, two more: q_e - q_k and
 /// q_s - q_k, q(t) = (t - t_ref)^2 / 2 (celc_acc.hpp). Column j holds entry
-/// j of every event, then kPadding zeros.
+/// j of every event, then at least kPadding zeros.
 class JointColumns {
  public:
   static constexpr int kColumns = 27;
@@ -36,8 +36,9 @@ class JointColumns {
   /// step-th row of each cluster, the values copied exactly.
   void assignStrided(const JointColumns& full, const std::vector<size_t>& begin, size_t step,
                      std::vector<size_t>& strided_begin);
-  /// Empty columns room for up to max_rows events, filled by appendRow (so
-  /// that a problem's terms are written once, with no array of structures).
+  /// Empty columns with room for up to max_rows events, filled by appendRow
+  /// (so that a problem's terms are written once, with no array of
+  /// structures).
   void startRows(size_t max_rows, bool acceleration);
   /// Appends an event's term (and with an acceleration dq = (q_e - q_k,
   /// q_s - q_k)) as the next row; at most startRows' max_rows rows.
@@ -54,6 +55,9 @@ class JointColumns {
 
  private:
   void writeRow(size_t row, const EventTerm& e, const Eigen::Vector2d& dq);
+  /// Zeroed columns for every step-th event of each cluster [begin[c],
+  /// begin[c + 1]), their ranges into strided_begin; size() rows.
+  void layOut(const std::vector<size_t>& begin, size_t step, std::vector<size_t>& strided_begin, bool acceleration);
   Spare spare_;
   size_t n_ = 0;
   size_t stride_ = kPadding;
