@@ -9,27 +9,16 @@
 #include <sstream>
 #include <string>
 
+#include "cli_util.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;
-  std::string out;
-};
+using celc::test::CliRun;
 
-/// Runs a shell command with stderr joined to stdout.
-CliRun runCommand(const std::string& command) {
-  const std::string cmd = command + " 2>&1";
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) r.out += buf;
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+/// Runs a shell command with stderr joined to stdout (cli_util.hpp's runShell).
+CliRun runCommand(const std::string& command) { return celc::test::runShell(command + " 2>&1"); }
 
 CliRun runCelc(const std::string& args) { return runCommand(std::string(CELC_BINARY) + " " + args); }
 

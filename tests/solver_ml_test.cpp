@@ -386,6 +386,12 @@ TEST(CelcMl, DrawsItsOwnEventBudget) {
   const SolverResult all = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options)[0];
   ASSERT_TRUE(all.ok());
   EXPECT_EQ(all.rows_used, 3000);
+  // A budget whose share of each line rounds to 0 events draws all of them
+  // (the sampler's rule), as many rows as the budget names none of.
+  options.ml.max_events = 4;
+  const SolverResult tiny = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options)[0];
+  ASSERT_TRUE(tiny.ok()) << tiny.message;
+  EXPECT_EQ(tiny.rows_used, 3000);
   // The defaults (`celc run`'s) draw more than the paper's preset: recorded
   // windows hold 10^4-10^6 events (docs/method.md).
   EXPECT_GT(RunConfig{}.solver.ml.max_events, SolverOptions::paper().ml.max_events);

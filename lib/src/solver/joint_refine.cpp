@@ -51,8 +51,10 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
   for (int c : usable) sizes.push_back(obs.clusters[c].size());
   const std::vector<size_t> quota =
       rowQuota(sizes, static_cast<size_t>(std::max(0, max_events)), balance_clusters);
+  // sampleIndices' count per cluster: all of a cluster whose quota is 0 or
+  // above its size.
   size_t total = 0;
-  for (size_t q : quota) total += q;
+  for (size_t i = 0; i < quota.size(); ++i) total += quota[i] == 0 || quota[i] >= sizes[i] ? sizes[i] : quota[i];
   terms_.startRows(total, acceleration_);
   for (size_t ci = 0; ci < usable.size(); ++ci) {
     const ClusterObservation& cl = obs.clusters[usable[ci]];
@@ -77,9 +79,8 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
 }
 
 const JointColumns& JointProblem::columns(int stride) const {
-  if (stride <= 1) {
-    column_begin_ = begin_;
-    column_stride_ = 1;
+  if (stride <= 1) {  // the terms themselves
+    if (column_stride_ != 1) column_begin_ = begin_, column_stride_ = 1;
     return terms_;
   }
   if (stride != column_stride_) {
