@@ -11,7 +11,7 @@ packages=(build-essential cmake pkg-config
   libeigen3-dev libceres-dev libopencv-dev libpcl-dev libpng-dev libcli11-dev libyaml-cpp-dev
   libspdlog-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   liblz4-dev libzstd-dev libflatbuffers-dev flatbuffers-compiler
-  libbz2-dev libhdf5-dev hdf5-filter-plugin-blosc-serial
+  libbz2-dev zlib1g-dev libhdf5-dev hdf5-filter-plugin-blosc-serial
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pytest)
 

@@ -12,6 +12,7 @@
 
 #include "celc/io/event_reader.hpp"
 #include "h5_writer.hpp"
+#include "io/hdf5_chunk_filters.hpp"
 #include "io_test_util.hpp"
 
 using namespace celc;
@@ -112,6 +113,88 @@ TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
   ASSERT_TRUE(patchBytes(h5, key, 0, std::string("\x00\x00\x5F\x74", 4)));
   EXPECT_IO_ERROR(celc::test::drain(h5), "z.h5: dataset /events/x: compressed chunk 0 at byte",
                   "claims 1952382976 bytes, more than the file's");
+}
+
+TEST(IoRobustness, Hdf5CompressedChunkShorterThanItsLayoutIsAnError) {
+  // A DSEC file whose /events/x is stored in gzip chunks of 32 uint16 (64
+  // bytes decoded), written by libhdf5; then the layout message's chunk rows
+  // 32 -> 2080 (the CI fuzz run's change): unchecked, the HDF5 library inflates
+  // 64 bytes and copies 120 out of them (a heap overflow inside libhdf5).
+  TempDir d;
+  const std::string h5 = d.file("s.h5");
+  {
+    const std::size_t n = 60;
+    celc::test::h5::File f(h5);
+    celc::test::h5::DatasetOptions gzip;
+    gzip.chunks = {32};
+    gzip.gzip = 4;
+    f.write("events/x", range<std::uint16_t>(n), {}, gzip);
+    f.write("events/y", std::vector<std::uint16_t>(n, 0));
+    f.write("events/t", range<std::uint32_t>(n));
+    f.write("events/p", std::vector<std::uint8_t>(n, 1));
+  }
+  EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
+  // the layout message's dimensions: chunk rows, then the element size (uint32 each)
+  ASSERT_TRUE(patchBytes(h5, std::string("\x20\x00\x00\x00\x02\x00\x00\x00", 8), 1, "\x08"));
+  EXPECT_IO_ERROR(celc::test::drain(h5), "s.h5: dataset /events/x: the chunk at row 0 decodes to 64 bytes",
+                  "its layout's 4160 (damaged file)");
+}
+
+namespace {
+
+/// `bytes` as a zlib stream of one stored (uncompressed) deflate block.
+std::vector<unsigned char> storedZlib(const std::vector<unsigned char>& bytes) {
+  const auto n = std::uint16_t(bytes.size());
+  // zlib header (deflate, 32 KB window), a final stored block, its length and the length's complement
+  std::vector<unsigned char> z = {0x78, 0x01, 0x01};
+  for (std::uint16_t v : {n, std::uint16_t(~n)}) {
+    z.push_back(std::uint8_t(v));
+    z.push_back(std::uint8_t(v >> 8));
+  }
+  for (unsigned char c : bytes) z.push_back(c);
+  std::uint32_t a = 1, b = 0;  // Adler-32, big-endian after the data
+  for (unsigned char c : bytes) {
+    a = (a + c) % 65521;
+    b = (b + a) % 65521;
+  }
+  const std::uint32_t adler = b << 16 | a;
+  for (int shift : {24, 16, 8, 0}) z.push_back(std::uint8_t(adler >> shift));
+  return z;
+}
+
+}  // namespace
+
+TEST(IoHdf5ChunkFilters, DecodedSizeThroughDeflateShuffleFletcherAndBlosc) {
+  using celc::detail::decodedChunkBytes;
+  std::vector<unsigned char> scratch;
+  const std::vector<unsigned char> values(64, 7);
+  const std::vector<unsigned char> deflated = storedZlib(values);
+  // deflate alone, then with shuffle before it (size kept) and fletcher32 after it (4 bytes dropped)
+  EXPECT_EQ(decodedChunkBytes({1}, 0, deflated, 64, scratch), 64u);
+  EXPECT_EQ(decodedChunkBytes({1}, 0, deflated, 4160, scratch), 64u);  // the fuzzer's chunk: fewer than the layout's
+  EXPECT_EQ(decodedChunkBytes({1}, 0, deflated, 32, scratch), 33u);    // more than expected stops one byte past it
+  std::vector<unsigned char> with_checksum = deflated;
+  with_checksum.insert(with_checksum.end(), {1, 2, 3, 4});
+  EXPECT_EQ(decodedChunkBytes({2, 1, 3}, 0, with_checksum, 64, scratch), 64u);
+  // a skipped filter (bit i of the mask) is not decoded: the stored bytes are the values
+  EXPECT_EQ(decodedChunkBytes({1}, 1u, values, 64, scratch), 64u);
+  // blosc: its header's decoded size (bytes 4-7); its stored size (bytes 12-15) must fit the chunk
+  std::vector<unsigned char> blosc(40, 0);
+  blosc[4] = 0x40;   // 64 decoded bytes
+  blosc[12] = 40;    // 40 stored bytes
+  EXPECT_EQ(decodedChunkBytes({32001}, 0, blosc, 64, scratch), 64u);
+  blosc[12] = 41;
+  EXPECT_THROW(decodedChunkBytes({32001}, 0, blosc, 64, scratch), std::runtime_error);
+  // damaged or unknown: a cut deflate stream, a bad check value, a short blosc header, szip
+  const std::vector<unsigned char> cut(deflated.begin(), deflated.begin() + 30);
+  EXPECT_THROW(decodedChunkBytes({1}, 0, cut, 64, scratch), std::runtime_error);
+  std::vector<unsigned char> bad_check = deflated;
+  bad_check.back() ^= 1;
+  EXPECT_THROW(decodedChunkBytes({1}, 0, bad_check, 64, scratch), std::runtime_error);
+  EXPECT_THROW(decodedChunkBytes({32001}, 0, std::vector<unsigned char>(15, 0), 64, scratch), std::runtime_error);
+  EXPECT_THROW(decodedChunkBytes({4}, 0, values, 64, scratch), std::runtime_error);
+  EXPECT_FALSE(celc::detail::hdf5FilterSizeKnown(4));
+  EXPECT_TRUE(celc::detail::hdf5FilterSizeKnown(32001));
 }
 
 // ---- HDF5: dataset types and values checked as stored ----------------------------

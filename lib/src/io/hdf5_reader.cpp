@@ -24,6 +24,7 @@
 #include "celc/core/text.hpp"
 #include "io/aedat_readers.hpp"
 #include "io/binary_file.hpp"
+#include "io/hdf5_chunk_filters.hpp"
 #include "io/hdf5_object_header.hpp"
 
 namespace celc::detail {
@@ -56,11 +57,17 @@ class H5Id {
   herr_t (*close_)(hid_t) = nullptr;
 };
 
-/// A dataset opened with its shape.
+/// A dataset opened with its shape; a filtered (compressed) chunked dataset
+/// also with its filters, its chunk's shape and which of its chunks have had
+/// their decoded size checked (Hdf5Reader::checkChunks).
 struct Dataset {
   std::string name;
   H5Id id, space;
   std::vector<hsize_t> dims;
+  std::vector<int> filters;             ///< filter ids in pipeline order; empty when unfiltered
+  std::vector<hsize_t> chunk;           ///< chunk shape [elements per dimension] when filtered
+  std::uint64_t chunk_bytes = 0;        ///< a chunk's decoded size [bytes] when filtered
+  mutable std::vector<bool> checked;    ///< per chunk, row-major over the chunk grid
 };
 
 enum class Layout { Dsec, Mvsec };
@@ -228,6 +235,7 @@ class Hdf5Reader final : public EventReader {
     std::uint64_t idx = 0;
     H5Id mem(H5Screate_simple(1, std::vector<hsize_t>{1}.data(), nullptr), H5Sclose);
     hsize_t start = k, one = 1;
+    checkChunks(ms, k, 1);
     H5Sselect_hyperslab(ms.space.get(), H5S_SELECT_SET, &start, nullptr, &one, nullptr);
     if (H5Dread(ms.id.get(), H5T_NATIVE_UINT64, mem.get(), ms.space.get(), H5P_DEFAULT, &idx) < 0)
       fail(ms.name, "cannot read entry " + std::to_string(k));
@@ -334,6 +342,10 @@ class Hdf5Reader final : public EventReader {
       double bytes = type.valid() ? double(H5Tget_size(type.get())) : 8.0;
       if (H5Pget_chunk(plist.get(), rank, chunk.data()) == rank)
         for (hsize_t c : chunk) bytes *= double(c);
+      if (nf > 0) {
+        d.chunk = chunk;
+        d.chunk_bytes = std::uint64_t(bytes);
+      }
       if (bytes > double(options_.max_packet_bytes))
         fail(name, "chunks of " + byteCountText(bytes) +
                        " bytes, more than input.max_packet_bytes = " + std::to_string(options_.max_packet_bytes));
@@ -371,8 +383,14 @@ class Hdf5Reader final : public EventReader {
           fail(name, "compressed chunk " + std::to_string(i) + " at byte " + std::to_string(addr) + " claims " +
                          std::to_string(stored) + " bytes, more than the file's " + std::to_string(file_bytes_) +
                          " (damaged file)");
+        // deflate and blosc add at most a few bytes per kilobyte to data they cannot compress
+        if (nf > 0 && double(stored) > 2.0 * bytes + 4096.0)
+          fail(name, "compressed chunk " + std::to_string(i) + " at byte " + std::to_string(addr) + " claims " +
+                         std::to_string(stored) + " bytes for " + byteCountText(bytes) + " of values (damaged file)");
       }
     }
+    if (nf > 0 && (rank == 0 || d.chunk.size() != d.dims.size()))
+      fail(name, "filters on a dataset that is not chunked (damaged file)");
     for (int i = 0; i < nf; ++i) {
       unsigned flags = 0, cd[8];
       std::size_t ncd = 8;
@@ -381,13 +399,76 @@ class Hdf5Reader final : public EventReader {
       if (f >= 0 && H5Zfilter_avail(f) <= 0)
         fail(name, "compressed with filter " + std::to_string(int(f)) + " (" + printable(fname, 40) +
                        ") that this HDF5 library cannot load (blosc: install hdf5-filter-plugin-blosc-serial)");
+      // The library copies a decoded chunk's full size whatever the filter
+      // made of it: only filters whose decoded size the reader can find first
+      // are read (hdf5_chunk_filters.hpp).
+      if (!hdf5FilterSizeKnown(int(f)))
+        fail(name, "compressed with filter " + std::to_string(int(f)) + " (" + printable(fname, 40) +
+                       "), whose decoded chunk size this reader cannot check before the HDF5 library copies it "
+                       "(readable filters: deflate, shuffle, fletcher32, blosc; e.g. h5repack -f GZIP=4)");
+      d.filters.push_back(int(f));
     }
     return d;
+  }
+
+  /// Decodes the size of every chunk of the filtered dataset `d` that holds
+  /// rows [first, first + rows) and has not been checked yet, before the
+  /// library reads it: one that decodes to another size than its layout's is
+  /// an error naming its first row (hdf5_chunk_filters.hpp says why).
+  void checkChunks(const Dataset& d, hsize_t first, hsize_t rows) const {
+    if (d.filters.empty() || rows == 0) return;
+    const std::size_t rank = d.dims.size();
+    std::vector<hsize_t> grid(rank);  // chunks per dimension
+    std::size_t total = 1;
+    for (std::size_t k = 0; k < rank; ++k) {
+      grid[k] = (d.dims[k] + d.chunk[k] - 1) / d.chunk[k];
+      total *= std::size_t(grid[k]);
+    }
+    if (d.checked.size() != total) d.checked.assign(total, false);
+    std::vector<hsize_t> at(rank, 0), offset(rank, 0);  // a chunk's grid index and its first element
+    for (at[0] = first / d.chunk[0]; at[0] <= (first + rows - 1) / d.chunk[0]; ++at[0]) {
+      std::fill(at.begin() + 1, at.end(), 0);
+      for (;;) {  // every chunk of this row of chunks
+        std::size_t linear = 0;
+        for (std::size_t k = 0; k < rank; ++k) linear = linear * std::size_t(grid[k]) + std::size_t(at[k]);
+        if (!d.checked[linear]) {
+          checkChunk(d, at, offset);
+          d.checked[linear] = true;
+        }
+        std::size_t k = rank;
+        while (--k > 0 && ++at[k] == grid[k]) at[k] = 0;
+        if (k == 0) break;
+      }
+    }
+  }
+
+  /// checkChunks for the chunk at grid index `at` (`offset`: scratch).
+  void checkChunk(const Dataset& d, const std::vector<hsize_t>& at, std::vector<hsize_t>& offset) const {
+    for (std::size_t k = 0; k < at.size(); ++k) offset[k] = at[k] * d.chunk[k];
+    const std::string where = "the chunk at row " + std::to_string(offset[0]);
+    hsize_t stored = 0;
+    if (H5Dget_chunk_storage_size(d.id.get(), offset.data(), &stored) < 0)
+      fail(d.name, where + ": its stored size cannot be read (damaged file)");
+    chunk_stored_.resize(std::size_t(stored));
+    std::uint32_t skipped = 0;
+    if (H5Dread_chunk(d.id.get(), H5P_DEFAULT, offset.data(), &skipped, chunk_stored_.data()) < 0)
+      fail(d.name, where + ": cannot be read (damaged file)");
+    std::uint64_t decoded = 0;
+    try {
+      decoded = decodedChunkBytes(d.filters, skipped, chunk_stored_, d.chunk_bytes, chunk_decoded_);
+    } catch (const std::runtime_error& e) {
+      fail(d.name, where + ": " + e.what() + " (damaged file)");
+    }
+    if (decoded != d.chunk_bytes)
+      fail(d.name, where + " decodes to " + (decoded > d.chunk_bytes ? "more than " + std::to_string(d.chunk_bytes)
+                                                                       : std::to_string(decoded)) +
+                       " bytes, its layout's " + std::to_string(d.chunk_bytes) + " (damaged file)");
   }
 
   /// Every value of a small dataset (IMU, poses) as double, `cols` per row.
   std::vector<double> readAll(const Dataset& d, std::size_t cols) const {
     if (d.dims[0] > kMaxSideSamples) fail(d.name, "holds more than " + std::to_string(kMaxSideSamples) + " rows");
+    checkChunks(d, 0, d.dims[0]);
     std::vector<double> v(std::size_t(d.dims[0]) * cols);
     if (!v.empty() && H5Dread(d.id.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
       fail(d.name, "cannot be read as numbers");
@@ -398,6 +479,7 @@ class Hdf5Reader final : public EventReader {
   void readBlock(const Dataset& d, hid_t type, void* dst, hsize_t n) {
     hsize_t start[2] = {next_, 0}, count[2] = {n, d.dims.size() > 1 ? d.dims[1] : 1};
     const int rank = int(d.dims.size());
+    checkChunks(d, next_, n);
     H5Id mem(H5Screate_simple(rank, count, nullptr), H5Sclose);
     if (H5Sselect_hyperslab(d.space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0 ||
         H5Dread(d.id.get(), type, mem.get(), d.space.get(), H5P_DEFAULT, dst) < 0)
@@ -480,6 +562,7 @@ class Hdf5Reader final : public EventReader {
   H5Id file_;
   Layout layout_ = Layout::Dsec;
   std::uintmax_t file_bytes_ = 0;  ///< the file's size [bytes]
+  mutable std::vector<unsigned char> chunk_stored_, chunk_decoded_;  ///< checkChunk's buffers
   Dataset dsec_[4];  ///< x, y, t, p
   Dataset mvsec_;
   std::int64_t t_offset_us_ = 0;
