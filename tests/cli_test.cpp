@@ -225,6 +225,7 @@ TEST(Cli, DumpedWindowSolvesToTheRunsAnswers) {
             0)
       << readAll(elsewhere);
   EXPECT_EQ(directions(elsewhere, false).count("celc"), 1u) << readAll(elsewhere);
+  fs::remove_all(d);
 }
 
 // config/fast.yaml (only celc_ml, clusters not redrawn) on the bundled
