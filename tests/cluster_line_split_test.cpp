@@ -3,6 +3,7 @@
 // cluster of one line keeps its events.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 #include "celc/cluster/line_split.hpp"
@@ -11,9 +12,10 @@
 namespace celc {
 namespace {
 
-LabelledWindow window(unsigned seed) {
+LabelledWindow window(unsigned seed, double pixel_noise_px = LabelledWindowOptions{}.pixel_noise_px) {
   LabelledWindowOptions o;
   o.seed = seed;
+  o.pixel_noise_px = pixel_noise_px;
   o.omega_rad_per_s = 1.0;  // the rotation must be removed for a line to be one moving line
   return generateLabelledWindow(o);
 }
@@ -113,6 +115,59 @@ TEST(LineSplit, OffLeavesTheClustersAndIsDeterministic) {
   split(w, b);
   EXPECT_EQ(a.labels, b.labels);
   for (std::size_t k = 0; k < a.clusters.size(); ++k) EXPECT_EQ(a.clusters[k].id, static_cast<int>(k));
+}
+
+// Two edges that one moving line fits within line_split_px (in rendered
+// scenes, a corner's two edges grown into one region: purity 0.5-0.8, a
+// median distance to the part's line 2-4 times the window's median part's).
+// Here true line 0's events alternate 1.2 px to either side of it (along its
+// image normal at each event's time, rounded to pixels), two parallel edges
+// 2.4 px apart in one cluster, with 0.3 px of pixel noise as the renderer
+// gives. The cut keeps them as one part (median distance about 1.2 px, a
+// true line's about 0.3 px). With line_scale_ratio 2.5 that part is dropped
+// and every other line keeps its events; with 0 it stays.
+TEST(LineSplit, APartWiderThanTheWindowsLinesIsDropped) {
+  const LabelledWindow w = window(5, 0.3);
+  std::vector<Event> events = w.events;
+  int side = 1;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    if (w.labels[i] != 0) continue;
+    const Eigen::Vector2d normal = w.lineNormal(0, events[i].t).head<2>().normalized();
+    events[i].x = static_cast<float>(std::round(events[i].x + side * 1.2 * normal.x()));
+    events[i].y = static_cast<float>(std::round(events[i].y + side * 1.2 * normal.y()));
+    side = -side;
+  }
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  auto cut = [&](double ratio, LineSplitReport& report) {
+    ClusterResult r = clustersFromLabels(events, w.labels);
+    ClusterOptions options;
+    options.line_scale_ratio = ratio;
+    report = splitByMovingLines(events, r, [&](const Vec2& p) { return w.camera.bearing(p); }, w.camera.focal(),
+                                &motion, options);
+    return r;
+  };
+  // Per true line, the largest share of its events in one cluster.
+  auto largestShares = [&](const ClusterResult& r) {
+    std::map<std::pair<int, int>, int> joint;
+    std::vector<double> size(static_cast<std::size_t>(w.n_lines()), 0.0), share(size.size(), 0.0);
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      if (w.labels[i] < 0) continue;
+      ++size[static_cast<std::size_t>(w.labels[i])];
+      if (r.labels[i] >= 0) ++joint[{w.labels[i], r.labels[i]}];
+    }
+    for (const auto& [key, n] : joint) {
+      double& s = share[static_cast<std::size_t>(key.first)];
+      s = std::max(s, n / size[static_cast<std::size_t>(key.first)]);
+    }
+    return share;
+  };
+  LineSplitReport off_report, on_report;
+  const std::vector<double> off = largestShares(cut(0.0, off_report)), on = largestShares(cut(2.5, on_report));
+  EXPECT_EQ(off_report.n_wide, 0);
+  EXPECT_GE(off[0], 0.9);  // without the rule the two edges stay one part
+  EXPECT_EQ(on_report.n_wide, 1);
+  EXPECT_LT(on[0], 0.5);
+  for (int line = 1; line < w.n_lines(); ++line) EXPECT_GE(on[static_cast<std::size_t>(line)], 0.95) << "line " << line;
 }
 
 // Clusters of a handful of events: nothing to split, no crash; all gone -> NoClusters.

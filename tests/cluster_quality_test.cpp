@@ -414,6 +414,17 @@ TEST(ClusterDegenerate, InvalidOptions) {
     bad.c_speed_factor = factor;
     EXPECT_NE(bad.validate().find("c_speed_factor"), std::string::npos) << factor;
   }
+  // line_scale_ratio: 0 (off) or at least 1; below 1 it would drop most of a window's parts
+  for (double ratio : {0.5, -1.0, 1000.0, std::numeric_limits<double>::quiet_NaN()}) {
+    ClusterOptions bad;
+    bad.line_scale_ratio = ratio;
+    EXPECT_NE(bad.validate().find("line_scale_ratio"), std::string::npos) << ratio;
+  }
+  for (double ratio : {0.0, 1.0, 2.5}) {
+    ClusterOptions good;
+    good.line_scale_ratio = ratio;
+    EXPECT_EQ(good.validate(), "") << ratio;
+  }
   for (double merge : {-1.0, 50.0, std::numeric_limits<double>::quiet_NaN()}) {
     ObservationOptions bad;
     bad.merge_px = merge;

@@ -45,6 +45,8 @@ std::string ClusterOptions::validate() const {
   std::string e = rangeProblemsOf(*this);
   if (!(c_max_px_per_s >= c_min_px_per_s)) e += "c_max_px_per_s: must be >= c_min_px_per_s; ";
   if (max_cluster_size < min_cluster_size) e += "max_cluster_size: must be >= min_cluster_size; ";
+  if (line_scale_ratio > 0.0 && line_scale_ratio < 1.0)
+    e += "line_scale_ratio: 0 (off) or at least 1 (below 1 it drops most of a window's parts); ";
   return e;
 }
 

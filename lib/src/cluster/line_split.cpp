@@ -24,6 +24,11 @@ constexpr int kSample = 5;            // a moving line linear in time has 5 degr
 constexpr double kLooseFactor = 1.5;  // hypotheses (linear in time) are scored at this times the threshold
 constexpr double kRefineFactors[] = {3.0, 2.0, 1.5, 1.0, 1.0};  // the local optimisation's thresholds
 constexpr double kShadowFactor = 3.0;  // a part within this times the threshold of an earlier one is its residuals' tail
+constexpr std::size_t kMinPartsForScale = 6;  // parts a window needs before line_scale_ratio compares them
+// [px] the least median distance line_scale_ratio multiplies: events on whole
+// pixels lie a median 0.25 px from their line (an offset uniform in +-0.5
+// px), whatever the noise; an edge that barely moves gives less
+constexpr double kPixelFloorPx = 0.25;
 
 /// One event in the motion model's reference frame: g = R(t) f with
 /// f = (x, y, 1), z = R(t) e_z (the optical axis at t), t its time [s].
@@ -204,7 +209,32 @@ Parts splitCluster(const std::vector<LinePoint>& pts, double threshold, int min_
 struct Part {
   ClusterStats stats;
   std::vector<int> events;
+  double median_px = 0.0;  ///< median distance of its events to its moving line [px]
 };
+
+/// The parts of `all` whose median distance to their line exceeds `ratio`
+/// times the window's: the event-weighted median of the parts' medians (most
+/// of the window's events lie on single edges), at least kPixelFloorPx, when
+/// there are at least kMinPartsForScale parts.
+std::vector<bool> widerThanTheWindow(const std::vector<Part>& all, double ratio) {
+  std::vector<bool> wide(all.size(), false);
+  if (!(ratio > 0.0) || all.size() < kMinPartsForScale) return wide;
+  std::vector<std::pair<double, std::size_t>> m;  // (median, events)
+  m.reserve(all.size());
+  std::size_t total = 0;
+  for (const Part& p : all) m.emplace_back(p.median_px, p.events.size()), total += p.events.size();
+  std::sort(m.begin(), m.end());
+  std::size_t below = 0;
+  double window_px = m.back().first;
+  for (const auto& [median, n] : m)
+    if ((below += n) * 2 >= total) {
+      window_px = median;
+      break;
+    }
+  const double limit = ratio * std::max(window_px, kPixelFloorPx);
+  for (std::size_t q = 0; q < all.size(); ++q) wide[q] = all[q].median_px > limit;
+  return wide;
+}
 
 }  // namespace
 
@@ -250,6 +280,7 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
       Part part{clusters.clusters[c], {}};
       part.events.reserve(member.size());
       for (std::size_t j : member) part.events.push_back(source[j]);
+      part.median_px = medianDistance(pts, member, parts.lines[q]) * focal_px;
       kept += member.size();
       parts_of[c].push_back(std::move(part));
     }
@@ -263,6 +294,21 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
     if (parts_of[c].size() > 1) ++report.n_split;
     for (Part& p : parts_of[c]) all.push_back(std::move(p));
   }
+  // Two edges (a corner's) that one line fits within the threshold leave
+  // residuals spread across it: such a part is dropped.
+  const std::vector<bool> wide = widerThanTheWindow(all, options.line_scale_ratio);
+  std::vector<Part> narrow;
+  narrow.reserve(all.size());
+  for (std::size_t q = 0; q < all.size(); ++q) {
+    if (!wide[q]) {
+      narrow.push_back(std::move(all[q]));
+      continue;
+    }
+    ++report.n_wide;
+    report.n_removed += static_cast<int>(all[q].events.size());
+    clusters.left_out.off_moving_lines += static_cast<int>(all[q].events.size());
+  }
+  all.swap(narrow);
   // New clusters: each part keeps its cluster's plane statistics.
   for (Part& p : all) {
     double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;

@@ -43,6 +43,11 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
            "cut each cluster to the events one moving line explains within this distance (sequential RANSAC); "
            "0 = not cut", within(0, 50)},
           o.line_split_px);
+  v.field({"line_scale_ratio", "",
+           "after the cut, drop a part whose median distance to its moving line exceeds this many times the "
+           "window's (event-weighted median part, at least 0.25 px): two edges one line fits, at a corner; needs "
+           "6 parts; 0 = keep every part, else >= 1", within(0, 100)},
+          o.line_scale_ratio);
   v.field({"motion_reassign_px", "px",
            "after a first solve, each event joins the one cluster whose line under the window's estimated motion "
            "passes within this distance (kept where the first method still answers and the window's cost per "

@@ -102,6 +102,13 @@ struct ClusterOptions {
   /// distance [px], by sequential RANSAC (line_split.hpp; needs the camera and
   /// the rotation, so `celc run` does it after clusterEvents); 0 = not cut.
   double line_split_px = 2.0;
+  /// After the cut, a part whose median distance to its moving line [px]
+  /// exceeds this many times the window's (the event-weighted median part's,
+  /// at least 0.25 px; 6 parts at least) is dropped: a corner's two edges that
+  /// one line fits within line_split_px (line_split.hpp); 0 = every part
+  /// kept, else >= 1. Off: it raises purity without bringing celc_ml nearer
+  /// the oracle (docs/decisions.md).
+  double line_scale_ratio = 0.0;
   /// After a first solve, the clusters are redrawn under the window's
   /// estimated motion (motion_reassign.hpp; `celc run` keeps them where the
   /// first method still answers on them and they hold 95% of the events):

@@ -19,7 +19,12 @@
 /// ClusterOptions::max_split parts (2 max_split draws). Parts with fewer than
 /// min_cluster_size events, a part within 3 thresholds (median) of an
 /// earlier one's line (the tails of its residuals), and the events no line
-/// explains become noise.
+/// explains become noise. Last, with ClusterOptions::line_scale_ratio > 0 and
+/// at least 6 parts in the window, a part whose median distance to its line
+/// exceeds that many times the window's (the event-weighted median of the
+/// parts' medians, at least 0.25 px: whole-pixel rounding) is dropped: a
+/// corner's two edges that one line fits within the threshold spread their
+/// distances across it, where one edge's lie within its noise.
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
@@ -33,6 +38,7 @@ struct LineSplitReport {
   int n_split = 0;         ///< clusters cut into two or more moving lines
   int n_removed = 0;       ///< events taken out of clusters (no moving line within line_split_px)
   int n_dropped = 0;       ///< clusters left with fewer than min_cluster_size events explained
+  int n_wide = 0;          ///< parts dropped by ClusterOptions::line_scale_ratio (their events in n_removed)
 };
 
 /// Cuts every cluster of `clusters` to its moving lines (see the file
