@@ -33,8 +33,9 @@ std::uint64_t inflatedBytes(const unsigned char* in, std::uint64_t in_bytes, std
   inflateEnd(&z);
   if (status == Z_STREAM_END) return produced;
   if (produced >= limit) return limit;  // more than the caller asked about
-  throw std::runtime_error(status == Z_DATA_ERROR ? "a damaged deflate stream"
-                                                  : "a deflate stream that ends before its data does");
+  // Z_BUF_ERROR with output room left: the input ran out before the stream's end
+  throw std::runtime_error(status == Z_BUF_ERROR ? "a deflate stream that ends before its data does"
+                                                 : "a damaged deflate stream");
 }
 
 }  // namespace
