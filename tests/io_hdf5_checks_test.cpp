@@ -38,6 +38,28 @@ std::vector<double> mvsecEvents(std::size_t n, double t0, double dt) {
   return ev;
 }
 
+/// A DSEC file of 60 events written by libhdf5, /events/x = 0, 1, ... + x0
+/// stored as `x_storage` (y = 0, t = 0..59 us, p = 1); returns the stored
+/// size of /events/x's chunk 0 when it is chunked, else 0.
+unsigned long long writeDsecStoringX(const std::string& path, std::uint16_t x0,
+                                     const celc::test::h5::DatasetOptions& x_storage) {
+  const std::size_t n = 60;
+  celc::test::h5::File f(path);
+  f.write("events/x", range<std::uint16_t>(n, x0), {}, x_storage);
+  f.write("events/y", std::vector<std::uint16_t>(n, 0));
+  f.write("events/t", range<std::uint32_t>(n));
+  f.write("events/p", std::vector<std::uint8_t>(n, 1));
+  return x_storage.chunks.empty() ? 0 : f.chunkStoredSize("events/x", 0);
+}
+
+/// gzip (level 4) chunks of 32 values.
+celc::test::h5::DatasetOptions gzipChunksOf32() {
+  celc::test::h5::DatasetOptions gzip;
+  gzip.chunks = {32};
+  gzip.gzip = 4;
+  return gzip;
+}
+
 }  // namespace
 
 // ---- found by fuzz_hdf5: a chunk layout that disagrees with its stored chunks -------
@@ -69,16 +91,9 @@ TEST(IoRobustness, Hdf5CompactDataShorterThanItsDatasetIsAnError) {
   // bytes): unchecked, the HDF5 library copies the values from a null buffer.
   TempDir d;
   const std::string h5 = d.file("c.h5");
-  {
-    const std::size_t n = 60;
-    celc::test::h5::File f(h5);
-    celc::test::h5::DatasetOptions compact;
-    compact.compact = true;
-    f.write("events/x", range<std::uint16_t>(n, 0x4100), {}, compact);
-    f.write("events/y", std::vector<std::uint16_t>(n, 0));
-    f.write("events/t", range<std::uint32_t>(n));
-    f.write("events/p", std::vector<std::uint8_t>(n, 1));
-  }
+  celc::test::h5::DatasetOptions compact;
+  compact.compact = true;
+  writeDsecStoringX(h5, 0x4100, compact);
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the compact layout message: version 3, class 0, size 120 (uint16), then x = 0x4100, 0x4101, ...
   ASSERT_TRUE(patchBytes(h5, std::string("\x03\x00\x78\x00\x00\x41\x01\x41", 8), 2, std::string(1, '\0')));
@@ -93,19 +108,7 @@ TEST(IoRobustness, Hdf5CompressedChunkLargerThanTheFileIsAnError) {
   // the CI fuzz run): the HDF5 library allocated 1.9 GB to read it.
   TempDir d;
   const std::string h5 = d.file("z.h5");
-  unsigned long long size = 0;
-  {
-    const std::size_t n = 60;
-    celc::test::h5::File f(h5);
-    celc::test::h5::DatasetOptions gzip;
-    gzip.chunks = {32};
-    gzip.gzip = 4;
-    f.write("events/x", range<std::uint16_t>(n), {}, gzip);
-    f.write("events/y", std::vector<std::uint16_t>(n, 0));
-    f.write("events/t", range<std::uint32_t>(n));
-    f.write("events/p", std::vector<std::uint8_t>(n, 1));
-    size = f.chunkStoredSize("events/x", 0);
-  }
+  const unsigned long long size = writeDsecStoringX(h5, 0, gzipChunksOf32());
   // the chunk index entry: stored size, filter mask 0, offsets 0 (two uint64)
   std::string key(24, '\0');
   const auto size32 = std::uint32_t(size);
@@ -122,17 +125,7 @@ TEST(IoRobustness, Hdf5CompressedChunkShorterThanItsLayoutIsAnError) {
   // 64 bytes and copies 120 out of them (a heap overflow inside libhdf5).
   TempDir d;
   const std::string h5 = d.file("s.h5");
-  {
-    const std::size_t n = 60;
-    celc::test::h5::File f(h5);
-    celc::test::h5::DatasetOptions gzip;
-    gzip.chunks = {32};
-    gzip.gzip = 4;
-    f.write("events/x", range<std::uint16_t>(n), {}, gzip);
-    f.write("events/y", std::vector<std::uint16_t>(n, 0));
-    f.write("events/t", range<std::uint32_t>(n));
-    f.write("events/p", std::vector<std::uint8_t>(n, 1));
-  }
+  writeDsecStoringX(h5, 0, gzipChunksOf32());
   EXPECT_EQ(celc::test::drain(h5), 60u);  // the file as written reads
   // the layout message's dimensions: chunk rows, then the element size (uint32 each)
   ASSERT_TRUE(patchBytes(h5, std::string("\x20\x00\x00\x00\x02\x00\x00\x00", 8), 1, "\x08"));
