@@ -307,6 +307,40 @@ TEST(ClusterQuality, ObservationsJoinTheFragmentsOfOneEdge) {
   EXPECT_GE(joined, 0.9 * lines) << joined << " of " << lines << " lines joined";
 }
 
+// The observations' events dropped and restored from toObservations'
+// members are the very values, in the same order, merged fragments included.
+TEST(ClusterObservations, DroppedEventsAreRestoredBitForBit) {
+  const LabelledWindow w = window(3);
+  std::vector<int> fragment(w.events.size(), -1);
+  for (size_t i = 0; i < w.events.size(); ++i)  // each line in two halves by index: fragments to join
+    if (w.labels[i] >= 0) fragment[i] = 2 * w.labels[i] + static_cast<int>(i % 2);
+  const ClusterResult split = clustersFromLabels(w.events, fragment);
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
+  ObservationReport rep;
+  std::vector<std::vector<int>> members;
+  const WindowObservations made =
+      toObservations(w.events, split, bearing, w.camera.focal(), ObservationOptions{}, &motion, &rep, &members);
+  EXPECT_GT(rep.n_merged, 0);
+  ASSERT_EQ(members.size(), made.clusters.size());
+  WindowObservations obs = made;
+  dropObservationEvents(obs);
+  for (const ClusterObservation& c : obs.clusters) {
+    EXPECT_EQ(c.times.capacity(), 0u);
+    EXPECT_EQ(c.bearings.capacity(), 0u);
+  }
+  restoreObservationEvents(obs, w.events, members, bearing);
+  ASSERT_EQ(obs.clusters.size(), made.clusters.size());
+  for (size_t c = 0; c < obs.clusters.size(); ++c) {
+    const ClusterObservation &a = obs.clusters[c], &b = made.clusters[c];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.l1.normal, b.l1.normal);
+    EXPECT_EQ(a.times, b.times) << "cluster " << c;
+    ASSERT_EQ(a.bearings.size(), b.bearings.size());
+    for (size_t k = 0; k < a.bearings.size(); ++k) ASSERT_EQ(a.bearings[k], b.bearings[k]) << c << ", " << k;
+  }
+}
+
 // ---- degenerate windows: a status, never a crash --------------------------
 
 TEST(ClusterDegenerate, EmptyWindow) {

@@ -403,7 +403,7 @@ TEST(ConfigSchema, BatchFile) {
             ":3: unknown key 'sequences[1].config.windows.evnts' (allowed here: policy, events, seconds, overlap, "
             "t_start, t_end, read_batch, keep_partial, partial_min_share, max_windows_per_second, max_events, parallax_px, "
             "no_parallax_px, min_seconds, max_seconds, slow_turn_max_seconds, slow_turn_rad, step_seconds, "
-            "probe_events)");
+            "probe_events, max_events_in_flight)");
   write("sequences:\n  - {path: a/x}\n  - {path: b/x}\n");
   EXPECT_EQ(errorOf([&] { readBatch(path, base); }).substr(path.size()),
             ":3: key 'sequences[1].label': duplicate label 'x'");

@@ -48,43 +48,49 @@ TEST(CoreMemory, ExactReserveAndHugePageAdviceKeepTheContents) {
 struct Owner {};
 struct OtherOwner {};
 
-TEST(ThreadBuffer, MemoryIsKeptPerThreadAndOwner) {
+TEST(SpareBuffer, MemoryIsKeptPerOwnerAndSharedByTheThreads) {
   std::vector<int> a;
-  detail::borrowThreadVector<Owner>(a);
+  detail::borrowSpareVector<Owner>(a);
   EXPECT_TRUE(a.empty());
   reserveWithHeadroom(a, 100);
   a.assign(50, 3);
   const int* data = a.data();
-  detail::returnThreadVector<Owner>(a);
-  // The next borrower on this thread gets the same memory, emptied.
+  detail::returnSpareVector<Owner>(a);
+  EXPECT_EQ(a.capacity(), 0u);
+  // The next borrower gets the same memory, emptied.
   std::vector<int> b;
-  detail::borrowThreadVector<Owner>(b);
+  detail::borrowSpareVector<Owner>(b);
   EXPECT_EQ(b.data(), data);
   EXPECT_TRUE(b.empty());
   EXPECT_GE(b.capacity(), 100u);
   // A second borrower while b holds it gets an empty vector; another owner
-  // type has its own spare.
+  // type has its own spares.
   std::vector<int> c, d;
-  detail::borrowThreadVector<Owner>(c);
-  detail::borrowThreadVector<OtherOwner>(d);
+  detail::borrowSpareVector<Owner>(c);
+  detail::borrowSpareVector<OtherOwner>(d);
   EXPECT_EQ(c.capacity(), 0u);
   EXPECT_EQ(d.capacity(), 0u);
-  // Given back in any order, the larger buffer stays the thread's spare.
-  detail::returnThreadVector<Owner>(b);
-  detail::returnThreadVector<Owner>(c);
-  std::vector<int> e;
-  detail::borrowThreadVector<Owner>(e);
+  // Both given back (c grown smaller than b): the larger is handed out first.
+  c.reserve(10);
+  detail::returnSpareVector<Owner>(c);
+  detail::returnSpareVector<Owner>(b);
+  std::vector<int> e, f;
+  detail::borrowSpareVector<Owner>(e);
+  detail::borrowSpareVector<Owner>(f);
   EXPECT_EQ(e.data(), data);
-  detail::returnThreadVector<Owner>(e);
-  // Another thread has a spare of its own (empty at first).
-  std::size_t other_capacity = 1;
+  EXPECT_GE(f.capacity(), 10u);
+  EXPECT_LT(f.capacity(), 100u);
+  detail::returnSpareVector<Owner>(f);
+  detail::returnSpareVector<Owner>(e);
+  // Another thread borrows the same memory: the spares are the process's.
+  const int* other_data = nullptr;
   std::thread([&] {
-    std::vector<int> f;
-    detail::borrowThreadVector<Owner>(f);
-    other_capacity = f.capacity();
-    detail::returnThreadVector<Owner>(f);
+    std::vector<int> g;
+    detail::borrowSpareVector<Owner>(g);
+    other_data = g.data();
+    detail::returnSpareVector<Owner>(g);
   }).join();
-  EXPECT_EQ(other_capacity, 0u);
+  EXPECT_EQ(other_data, data);
 }
 
 }  // namespace

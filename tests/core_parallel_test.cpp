@@ -150,6 +150,76 @@ TEST(OrderedParallelMap, BoundsJobsInFlight) {
   }
 }
 
+namespace {
+
+// Jobs of the given weights through orderedParallelMap with a weight bound;
+// returns the largest weight held at once (from production to the end of
+// work) and checks the results' order. `at_produce` gets, for each job, the
+// weight held when it was produced.
+std::size_t heaviestHeld(const std::vector<std::size_t>& weights, int threads, std::size_t max_weight,
+                         std::vector<std::size_t>* at_produce = nullptr) {
+  std::mutex mu;
+  std::size_t held = 0, peak = 0;
+  std::size_t next = 0;
+  std::vector<std::size_t> out;
+  orderedParallelMap<Numbered, std::size_t>(
+      threads, 8, JobWeightBound<Numbered>{max_weight, [&](const Numbered& job) { return job.payload.size(); }},
+      [&](Numbered& job) {
+        if (next == weights.size()) return false;
+        job.index = static_cast<int>(next);
+        job.payload.assign(weights[next++], 1);
+        std::lock_guard<std::mutex> lock(mu);
+        if (at_produce) at_produce->push_back(held);
+        held += job.payload.size();
+        peak = std::max(peak, held);
+        return true;
+      },
+      [&](Numbered& job) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1 + job.index % 3));
+        std::lock_guard<std::mutex> lock(mu);
+        held -= job.payload.size();  // the pipeline releases the job after this
+        return static_cast<std::size_t>(job.index);
+      },
+      [&](std::size_t& index) { out.push_back(index); });
+  EXPECT_EQ(out.size(), weights.size());
+  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_EQ(out[i], i);
+  return peak;
+}
+
+}  // namespace
+
+TEST(OrderedParallelMap, WeightBoundLimitsTheJobsHeld) {
+  // Jobs of 7 under a bound of 20: two held at once, never three, whatever
+  // the number of threads.
+  const std::vector<std::size_t> sevens(40, 7);
+  for (int threads : {2, 4}) {
+    const std::size_t peak = heaviestHeld(sevens, threads, 20);
+    EXPECT_LE(peak, 20u) << threads << " threads";
+    EXPECT_EQ(peak, 14u) << threads << " threads: the bound admits two";
+  }
+  // Without a bound the count alone limits them (8 in flight).
+  EXPECT_GT(heaviestHeld(sevens, 4, 0), 14u);
+}
+
+TEST(OrderedParallelMap, AJobHeavierThanTheBoundGoesThroughAlone) {
+  std::vector<std::size_t> at_produce;
+  const std::size_t peak = heaviestHeld(std::vector<std::size_t>(10, 30), 3, 20, &at_produce);
+  EXPECT_EQ(peak, 30u);
+  for (std::size_t held : at_produce) EXPECT_EQ(held, 0u);  // each produced once the last is done
+}
+
+TEST(OrderedParallelMap, WeightBoundJudgesTheNextJobByTheLast) {
+  // Weights that change: a job is produced only when the held ones leave
+  // room for one as heavy as the last produced (or none is held).
+  const std::vector<std::size_t> weights = {5, 5, 5, 12, 3, 3, 3, 3, 9, 1, 1, 1, 1, 1, 1, 8, 8};
+  std::vector<std::size_t> at_produce;
+  heaviestHeld(weights, 4, 16, &at_produce);
+  ASSERT_EQ(at_produce.size(), weights.size());
+  for (std::size_t i = 1; i < weights.size(); ++i)
+    EXPECT_TRUE(at_produce[i] == 0 || at_produce[i] + weights[i - 1] <= 16)
+        << "job " << i << " produced with " << at_produce[i] << " held";
+}
+
 TEST(OrderedParallelMap, NoJobs) {
   std::vector<int> out;
   squares(0, 2, 4, out);

@@ -10,6 +10,8 @@
 #include <random>
 #include <unordered_map>
 
+#include "celc/core/parallel.hpp"
+
 namespace celc {
 
 namespace {
@@ -299,7 +301,10 @@ bool fitWindowLines(const std::vector<Event>& events, const std::vector<int>& la
   for (std::size_t i = 0; i < events.size(); ++i)
     if (labels[i] >= 0 && std::isfinite(events[i].t)) w.groups[labels[i]].events.push_back(static_cast<int>(i));
   w.table.emplace(motion, v.normalized(), w.t_lo, w.t_hi);
-  for (Group& g : w.groups) fitGroup(events, bearing, focal_px, options, w, g, nullptr);
+  // A cluster's line depends on its own events only: on options.threads
+  // threads the same lines.
+  parallelFor(w.groups.size(), options.threads,
+              [&](std::size_t a) { fitGroup(events, bearing, focal_px, options, w, w.groups[a], nullptr); });
   return true;
 }
 
@@ -509,40 +514,56 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
   std::vector<int> label_of(static_cast<std::size_t>(n_labels));  // input label -> its group
   for (int a = 0; a < n_labels; ++a) label_of[a] = joined.find(a);
   std::vector<int> out(events.size(), -1);
-  for (std::size_t i = 0; i < events.size(); ++i) {
-    const Event& e = events[i];
-    const int current = labels[i] >= 0 ? label_of[labels[i]] : -1;
-    if (current < 0 || !std::isfinite(e.t)) continue;  // unclustered events stay noise
-    if (!groups[current].explained) {                  // left as it was
-      out[i] = current;
-      continue;
-    }
-    const auto it = range.find(cellOf(e));
-    int best = -1;
-    double d1 = std::numeric_limits<double>::infinity(), d2 = d1, d_current = d1;
-    if (it != range.end()) {
-      MotionPoint p;
-      if (pointOf(events, bearing, w, static_cast<int>(i), p)) {
-        for (std::uint32_t k = it->second.first; k < it->second.second; ++k) {
-          const int a = static_cast<int>(marks[k] & 0xffffffffu);
-          const Group& g = groups[a];
-          if (options.separate_polarity && !(e.on ? g.on : g.off)) continue;
-          const double d = g.line.distance(p) / g.tolerance;  // 1 at the group's tolerance
-          if (a == current) d_current = d;
-          if (d < d1) d2 = d1, d1 = d, best = a;
-          else if (d < d2) d2 = d;
+  // Each event is judged alone: on options.threads threads, over contiguous
+  // parts of the events, the same labels and counts.
+  struct Counts {
+    int moved = 0, ambiguous = 0, removed = 0;
+  };
+  const std::size_t parts = static_cast<std::size_t>(std::max(1, options.threads));
+  std::vector<Counts> counts(parts);
+  parallelFor(parts, options.threads, [&](std::size_t part) {
+    Counts& count = counts[part];
+    const std::size_t i_end = events.size() * (part + 1) / parts;
+    for (std::size_t i = events.size() * part / parts; i < i_end; ++i) {
+      const Event& e = events[i];
+      const int current = labels[i] >= 0 ? label_of[labels[i]] : -1;
+      if (current < 0 || !std::isfinite(e.t)) continue;  // unclustered events stay noise
+      if (!groups[current].explained) {                  // left as it was
+        out[i] = current;
+        continue;
+      }
+      const auto it = range.find(cellOf(e));
+      int best = -1;
+      double d1 = std::numeric_limits<double>::infinity(), d2 = d1, d_current = d1;
+      if (it != range.end()) {
+        MotionPoint p;
+        if (pointOf(events, bearing, w, static_cast<int>(i), p)) {
+          for (std::uint32_t k = it->second.first; k < it->second.second; ++k) {
+            const int a = static_cast<int>(marks[k] & 0xffffffffu);
+            const Group& g = groups[a];
+            if (options.separate_polarity && !(e.on ? g.on : g.off)) continue;
+            const double d = g.line.distance(p) / g.tolerance;  // 1 at the group's tolerance
+            if (a == current) d_current = d;
+            if (d < d1) d2 = d1, d1 = d, best = a;
+            else if (d < d2) d2 = d;
+          }
         }
       }
+      if (d1 <= 1.0 && d2 > 1.0) {
+        out[i] = best;
+        if (current != best) ++count.moved;
+      } else if (d1 <= 1.0) {
+        if (d_current <= 1.0) out[i] = current;  // its own line is one of those in reach
+        ++count.ambiguous;
+      } else if (current >= 0) {
+        ++count.removed;
+      }
     }
-    if (d1 <= 1.0 && d2 > 1.0) {
-      out[i] = best;
-      if (current != best) ++report.n_moved;
-    } else if (d1 <= 1.0) {
-      if (d_current <= 1.0) out[i] = current;  // its own line is one of those in reach
-      ++report.n_ambiguous;
-    } else if (current >= 0) {
-      ++report.n_removed;
-    }
+  });
+  for (const Counts& c : counts) {
+    report.n_moved += c.moved;
+    report.n_ambiguous += c.ambiguous;
+    report.n_removed += c.removed;
   }
 
   // Groups left with too few events are noise; ids compact in order of first event.

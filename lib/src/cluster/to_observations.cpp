@@ -74,8 +74,9 @@ std::string ObservationOptions::validate() const { return lines.validate() + ran
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
                                   const ObservationOptions& options, const MotionModel* motion,
-                                  ObservationReport* report) {
+                                  ObservationReport* report, std::vector<std::vector<int>>* members_out) {
   WindowObservations out;
+  if (members_out) members_out->clear();
   out.focal_px = focal_px;
   ObservationReport rep;
   rep.n_clusters = static_cast<int>(clusters.clusters.size());
@@ -120,6 +121,7 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     attachLines(obs, fits.back());
     built.push_back(std::move(obs));
     built_members.push_back(std::move(used));
+    std::vector<int>().swap(idx);  // the cluster's indices are in `used` now
   }
   if (options.merge_px > 0.0) mergeFragments(built, fits, built_members, focal_px, options, motion, rep);
   if (report) {
@@ -140,8 +142,32 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     out.clusters.push_back(std::move(built[c]));
   }
   rep.n_used = static_cast<int>(rep.used_ids.size());
-  if (report) *report = rep;
+  if (report) *report = std::move(rep);
+  if (members_out) *members_out = std::move(built_members);
   return out;
+}
+
+void dropObservationEvents(WindowObservations& obs) {
+  for (ClusterObservation& c : obs.clusters) {
+    std::vector<double>().swap(c.times);
+    std::vector<Vec3>().swap(c.bearings);
+  }
+}
+
+void restoreObservationEvents(WindowObservations& obs, const std::vector<Event>& events,
+                              const std::vector<std::vector<int>>& members, const BearingFunction& bearing) {
+  for (std::size_t c = 0; c < obs.clusters.size() && c < members.size(); ++c) {
+    ClusterObservation& o = obs.clusters[c];
+    o.times.clear();
+    o.bearings.clear();
+    o.times.reserve(members[c].size());
+    o.bearings.reserve(members[c].size());
+    for (int i : members[c]) {
+      const Event& e = events[static_cast<std::size_t>(i)];
+      o.times.push_back(e.t);
+      o.bearings.push_back(bearing(Vec2(e.x, e.y)));
+    }
+  }
 }
 
 }  // namespace celc

@@ -73,6 +73,14 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
                      const std::function<bool(std::size_t)>& produce,
                      const std::function<void(std::size_t)>& work,
                      const std::function<void(std::size_t)>& consume) {
+  orderedPipeline(n_threads, max_in_flight, 0, {}, produce, work, consume);
+}
+
+void orderedPipeline(int n_threads, std::size_t max_in_flight, std::size_t max_weight,
+                     const std::function<std::size_t(std::size_t)>& weight,
+                     const std::function<bool(std::size_t)>& produce,
+                     const std::function<void(std::size_t)>& work,
+                     const std::function<void(std::size_t)>& consume) {
   const std::size_t cap = std::max<std::size_t>(1, max_in_flight);
   auto runInline = [&] {
     while (produce(0)) {
@@ -87,12 +95,19 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
   std::condition_variable work_ready, work_done;
   std::deque<std::size_t> queue;       // sequence numbers waiting for a worker
   std::vector<char> finished(cap, 0);  // per slot: worked on, waiting to be consumed
+  std::vector<std::size_t> weights(cap, 0);  // per slot: the job's weight (max_weight > 0)
+  std::size_t held_weight = 0;         // of the jobs produced and not yet worked on to the end
+  std::size_t last_weight = 0;         // of the last job produced: the estimate of the next one
   bool closed = false;                 // nothing more will be queued
   std::exception_ptr error;
   auto recordError = [&] {
     std::lock_guard<std::mutex> lock(mu);
     if (!error) error = std::current_exception();
   };
+  // With a weight bound, the next job is produced while the jobs held
+  // leave room for one as heavy as the last, and always when none is held.
+  // Called with `mu` held.
+  auto mayProduce = [&] { return max_weight == 0 || held_weight == 0 || held_weight + last_weight <= max_weight; };
 
   auto worker = [&] {
     for (;;) {
@@ -116,6 +131,7 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
       {
         std::lock_guard<std::mutex> lock(mu);
         finished[seq % cap] = 1;
+        held_weight -= weights[seq % cap];  // work() has released the job
       }
       work_done.notify_all();
     }
@@ -126,7 +142,8 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
   std::size_t produced = 0, consumed = 0;
   bool more = true;
   // Consumes finished jobs in sequence order. Waits for the next one when the
-  // pipeline is full or nothing more will be produced. False on error.
+  // pipeline is full (by count or by weight) or nothing more will be
+  // produced. False on error.
   auto consumeReady = [&]() -> bool {
     for (;;) {
       {
@@ -135,10 +152,11 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
         if (consumed == produced) return true;
         const std::size_t slot = consumed % cap;
         if (!finished[slot]) {
-          const bool must_wait = !more || produced - consumed >= cap;
-          if (!must_wait) return true;
-          work_done.wait(lock, [&] { return finished[slot] || error; });
+          auto mayGoOn = [&] { return more && produced - consumed < cap && mayProduce(); };
+          if (mayGoOn()) return true;
+          work_done.wait(lock, [&] { return finished[slot] || error || mayGoOn(); });
           if (error) return false;
+          if (!finished[slot]) return true;
         }
         finished[slot] = 0;
       }
@@ -152,8 +170,12 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
         more = false;  // the next consumeReady drains the rest
         continue;
       }
+      const std::size_t w = max_weight > 0 ? weight(produced % cap) : 0;
       {
         std::lock_guard<std::mutex> lock(mu);
+        weights[produced % cap] = w;
+        held_weight += w;
+        last_weight = w;
         queue.push_back(produced);
         ++produced;
       }

@@ -95,6 +95,11 @@ void describe(FieldVisitor& v, RunConfig& c) {
                   c.window_policy, {WindowPolicy::Parallax, WindowPolicy::Events, WindowPolicy::Seconds});
     describe(s, c.windows);
     describe(s, c.parallax);
+    s.field({"max_events_in_flight", "events",
+             "the windows read and not yet processed hold at most this many events together (a window is read "
+             "when they leave room for one like the last, and always when there are none; about 24 B per event, "
+             "100 B more while processed); 0 = no bound"},
+            c.max_events_in_flight);
   });
   v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) { describeMotion(s, c); });
   describeClustering(v, c.cluster, c.observations.lines);
@@ -154,7 +159,7 @@ std::string toYaml(const RunConfig& c) {
 }
 
 const std::vector<std::string>& resultNeutralKeys() {
-  static const std::vector<std::string> keys = {"cluster.threads", "windows.read_batch"};
+  static const std::vector<std::string> keys = {"cluster.threads", "windows.read_batch", "windows.max_events_in_flight"};
   return keys;
 }
 

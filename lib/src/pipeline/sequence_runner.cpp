@@ -113,8 +113,8 @@ struct SequenceRunner::Impl {
   /// The window's clusters redrawn under the witness's answer `first`
   /// (cluster/motion_reassign.hpp), with their observations. Kept, replacing
   /// `first` (by the witness's answer on them), `labels` (the clusters before
-  /// fragments join), `report`, `obs` and `solves` (the witness's shared
-  /// estimates on them), when
+  /// fragments join; when given), `report`, `obs`, `members` (toObservations')
+  /// and `solves` (the witness's shared estimates on them), when
   /// the witness answers on them and the window's cost per event under that
   /// answer and its clusters (motionCost) is below the first answer's with
   /// the first clusters. Returns whether it was kept.
@@ -123,24 +123,35 @@ struct SequenceRunner::Impl {
   /// them again would give the same observations, answer and cost, so it is
   /// not kept, without solving again. `lines`: the kept redraw's clusters'
   /// lines under its answer, which the next redraw starts from.
+  /// While the clusters are redrawn and their observations built and
+  /// solved, `obs` holds no events (dropObservationEvents): a redraw not
+  /// kept restores them from `members`, the very values, so that one set of
+  /// a window's events is held as observations at a time.
   bool redrawUnderMotion(const std::vector<Event>& events, const MotionModel& motion, const SampleSeeds& seeds,
                          const ClusterOptions& cluster_options, std::uint64_t index, Method witness,
-                         SolverResult& first, std::vector<int>& labels, ObservationReport& report,
-                         WindowObservations& obs, SharedSolves& solves, std::vector<int>& drawn_from,
-                         MotionLines& lines) const {
+                         SolverResult& first, std::vector<int>* labels, ObservationReport& report,
+                         WindowObservations& obs, std::vector<std::vector<int>>& members, SharedSolves& solves,
+                         std::vector<int>& drawn_from, MotionLines& lines) const {
     auto to_bearing = [&](const Vec2& p) { return bearing(p); };
+    dropObservationEvents(obs);
+    auto notKept = [&] {
+      restoreObservationEvents(obs, events, members, to_bearing);
+      return false;
+    };
     std::vector<int> redrawn = report.event_clusters;
     const MotionReassignReport redraw = reassignToMotionLines(events, redrawn, to_bearing, calib.camera.focal(),
                                                               motion, first.v, cluster_options, &lines);
-    const ClusterResult clusters = clustersFromLabels(events, redrawn);
+    ClusterResult clusters = clustersFromLabels(events, redrawn);
+    std::vector<int>().swap(redrawn);  // `clusters` holds them, renumbered
     if (clusters.labels == drawn_from) {
       spdlog::debug("window {}: clusters under the motion: unchanged, not kept", index);
-      return false;
+      return notKept();
     }
-    if (clusters.status != ClusterStatus::Ok) return false;
+    if (clusters.status != ClusterStatus::Ok) return notKept();
     ObservationReport redrawn_report;
+    std::vector<std::vector<int>> redrawn_members;
     WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
-                                                    config.observations, &motion, &redrawn_report);
+                                                    config.observations, &motion, &redrawn_report, &redrawn_members);
     SharedSolves redrawn_solves;
     const SolverResult after =
         solveMethods(redrawn_obs, motion, {witness}, witnessOptions(), seeds, redrawn_solves).front();
@@ -160,13 +171,17 @@ struct SequenceRunner::Impl {
                   redraw.n_unexplained, redraw.n_lines, toString(witness),
                   angleBetweenSignAgnostic(first.v, after.v) * 180.0 / M_PI, cost_before, cost_after,
                   keep ? "kept" : "not kept");
-    if (!keep) return false;
+    if (!keep) {
+      redrawn_obs = WindowObservations();
+      return notKept();
+    }
     first = after;
-    drawn_from = clusters.labels;
+    if (labels) *labels = clusters.labels;
+    drawn_from = std::move(clusters.labels);
     lines = std::move(lines_after);
-    labels = clusters.labels;
     report = std::move(redrawn_report);
     obs = std::move(redrawn_obs);
+    members = std::move(redrawn_members);
     solves = std::move(redrawn_solves);
     return true;
   }
@@ -479,7 +494,9 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   start = Clock::now();
   const CameraModel& cam = m.calib.camera;
   ObservationReport report;
-  WindowObservations obs = toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report);
+  std::vector<std::vector<int>> members;  // the observations' events (restoreObservationEvents)
+  WindowObservations obs =
+      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report, &members);
   rec.n_clusters = report.n_used;  // with lines; npt also gets the others
   rec.n_line_fit_failed = report.n_line_fit_failed;
   for (std::size_t k = 0; k < report.failed_ids.size(); ++k) {
@@ -520,7 +537,10 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   const SampleSeeds seeds{cfg.seed + index, cfg.seed + index};  // windows draw different subsets
   // The clusters redrawn under the witness's first answer, where kept; then
   // every method on the window's final clusters.
-  std::vector<int> solved_labels = clusters.labels;  // the final clusters, before fragments join
+  // The final clusters, before fragments join: kept for the dump only.
+  std::vector<int> solved_labels;
+  if (m.dump) solved_labels = std::move(clusters.labels);
+  clusters = ClusterResult();  // the observations hold what the solvers need
   // The witness's estimates on the final clusters, which the methods share (SharedSolves).
   SharedSolves solves;
   if (const std::optional<Method> witness = m.redrawWitness(cluster_options)) {
@@ -530,8 +550,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     std::vector<int> drawn_from;
     MotionLines lines;
     for (int round = 0; round < cluster_options.motion_redraw_rounds && answer.ok(); ++round) {
-      if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer, solved_labels,
-                               report, obs, solves, drawn_from, lines))
+      if (!m.redrawUnderMotion(events, motion, seeds, cluster_options, index, *witness, answer,
+                               m.dump ? &solved_labels : nullptr, report, obs, members, solves, drawn_from, lines))
         break;
       rec.n_clusters = report.n_used;
       rec.n_line_fit_failed = report.n_line_fit_failed;
@@ -593,9 +613,11 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
   WindowSource source(*m.reader, source_options);
   EventWindow window;
   // The cores stay busy where the windows alone would leave them idle: a
-  // probe while no window is worked on or waiting (the first window's), and
-  // the last window to start once every window is read, cluster with every
-  // worker's thread. The clusters do not depend on the thread count.
+  // probe while no window is worked on or waiting (the first window's), the
+  // last window to start once every window is read, and a window that leaves
+  // no room beside it for another of its size (windows.max_events_in_flight)
+  // cluster with every worker's thread. The clusters do not depend on the
+  // thread count.
   const int workers = resolveThreadCount(threads);
   const int all_threads = std::max(workers, cfg.cluster.threads);
   std::atomic<int> busy{0};           // windows being worked on
@@ -642,10 +664,13 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
       throw std::runtime_error(e.str());
     }
   };
-  // Windows read and not yet written: a bound on the memory held.
+  // Windows read and not yet written: a bound on the memory held, by count
+  // and by the events they hold (windows.max_events_in_flight).
   const std::size_t max_in_flight = static_cast<std::size_t>(resolveThreadCount(threads)) + 2;
+  const std::size_t max_events = cfg.max_events_in_flight;
+  const JobWeightBound<Job> by_events{max_events, [](const Job& job) { return job.events.size(); }};
   orderedParallelMap<Job, WindowRecord>(
-      threads, max_in_flight,
+      threads, max_in_flight, by_events,
       [&](Job& job) {  // the next wanted window, read on this thread
         for (;;) {
           const auto t_read = Clock::now();
@@ -675,7 +700,9 @@ RunStats SequenceRunner::run(int threads, const WindowFilter& filter,
       [&](Job& job) {
         const Busy working(busy);
         const bool last = --waiting == 0 && all_read.load();
-        return processWindow(job.index, job.t0, job.t1, job.events, job.probe_px, workers > 1 && last ? all_threads : 0);
+        const bool alone = max_events > 0 && 2 * job.events.size() > max_events;
+        return processWindow(job.index, job.t0, job.t1, job.events, job.probe_px,
+                             workers > 1 && (last || alone) ? all_threads : 0);
       },
       [&](WindowRecord& rec) {  // in window order, on this thread
         stats.windows_processed++;

@@ -39,7 +39,7 @@ constexpr double kShiftInlierScales = 3.0;
 DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel& motion, int max_events,
                                const BearingChange* bearing_change)
     : focal_px_(obs.focal_px) {
-  detail::borrowThreadVector<DirectionTerms>(terms_);
+  detail::borrowSpareVector<DirectionTerms>(terms_);
   std::size_t total = 0;
   for (const auto& c : obs.clusters) total += c.size();
   const std::size_t stride =
@@ -64,8 +64,8 @@ DirectionTerms::DirectionTerms(const WindowObservations& obs, const MotionModel&
 }
 
 DirectionTerms::~DirectionTerms() {
-  // Hand the memory back for the thread's next window.
-  detail::returnThreadVector<DirectionTerms>(terms_);
+  // Hand the memory back for the next window.
+  detail::returnSpareVector<DirectionTerms>(terms_);
 }
 
 DirectionInformation DirectionTerms::information(const Vec3& direction, bool keep_residuals) const {

@@ -14,22 +14,22 @@
 namespace celc::detail {
 
 namespace {
-/// The thread's spare for the full columns (the strided ones use JointColumns').
+/// The spares for the full columns (the strided ones use JointColumns').
 struct FullColumnsSpare;
 }  // namespace
 
 JointColumns::JointColumns(Spare spare) : spare_(spare) {
   if (spare_ == Spare::Full)
-    borrowThreadVector<FullColumnsSpare>(data_);
+    borrowSpareVector<FullColumnsSpare>(data_);
   else
-    borrowThreadVector<JointColumns>(data_);
+    borrowSpareVector<JointColumns>(data_);
 }
 
 JointColumns::~JointColumns() {
   if (spare_ == Spare::Full)
-    returnThreadVector<FullColumnsSpare>(data_);
+    returnSpareVector<FullColumnsSpare>(data_);
   else
-    returnThreadVector<JointColumns>(data_);
+    returnSpareVector<JointColumns>(data_);
 }
 
 void JointColumns::writeRow(size_t row, const EventTerm& e, const Eigen::Vector2d& dq) {

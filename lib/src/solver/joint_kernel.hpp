@@ -19,7 +19,7 @@ class JointColumns {
  public:
   static constexpr int kColumns = 27;
   static constexpr int kAccelerationColumns = 29;
-  /// Which of the thread's two spare buffers the storage comes from (and is
+  /// Which of the two kinds of spare buffers the storage comes from (and is
   /// given back to on destruction, thread_buffer.hpp): a problem's full
   /// columns and its strided ones are held at once.
   enum class Spare { Strided, Full };

@@ -140,7 +140,7 @@ class JointProblem {
   bool acceleration_ = false;
   /// The event terms as columns (joint_kernel.hpp), written once; the terms
   /// of cluster c are its rows [begin_[c], begin_[c + 1]). The buffer's
-  /// memory is kept per thread across problems: allocating and releasing it
+  /// memory is kept across problems (thread_buffer.hpp): allocating and releasing it
   /// per window made the kernel map and unmap its pages every time, which
   /// cost more than building the terms.
   JointColumns terms_{JointColumns::Spare::Full};

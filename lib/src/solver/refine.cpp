@@ -21,12 +21,12 @@ namespace detail {
 namespace {
 constexpr size_t kChunk = 256;  // events per residual block
 
-/// Holds the thread's event-term buffer for one call and gives it back
+/// Holds a spare event-term buffer for one call and gives it back
 /// (with whatever capacity it grew to) on every return.
 class BorrowedTerms {
  public:
-  BorrowedTerms() { borrowThreadVector<BorrowedTerms>(terms); }
-  ~BorrowedTerms() { returnThreadVector<BorrowedTerms>(terms); }
+  BorrowedTerms() { borrowSpareVector<BorrowedTerms>(terms); }
+  ~BorrowedTerms() { returnSpareVector<BorrowedTerms>(terms); }
   BorrowedTerms(const BorrowedTerms&) = delete;
   BorrowedTerms& operator=(const BorrowedTerms&) = delete;
   std::vector<EventTerm> terms;

@@ -82,9 +82,22 @@ LabelledObservations observeLabelledEvents(const std::vector<Event>& events, con
 /// `focal_px` converts normalised distances to pixels (fit thresholds are in px)
 /// and is stored in WindowObservations::focal_px. `motion` gives the rotation
 /// the line fit removes (line_fit.hpp; nullptr: no rotation). Never throws on data.
+/// `members`, when given: per output cluster, the indices into `events` of
+/// its times and bearings, in their order (restoreObservationEvents).
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
                                   const ObservationOptions& options, const MotionModel* motion,
-                                  ObservationReport* report = nullptr);
+                                  ObservationReport* report = nullptr,
+                                  std::vector<std::vector<int>>* members = nullptr);
+
+/// Frees the clusters' times and bearings (32 B per event), keeping their
+/// ids and lines: a window's observations while another set is built.
+void dropObservationEvents(WindowObservations& obs);
+
+/// Fills the clusters' times and bearings again from the window's events and
+/// toObservations' `members` (the same events and bearing function): the
+/// very values toObservations stored, in its order.
+void restoreObservationEvents(WindowObservations& obs, const std::vector<Event>& events,
+                              const std::vector<std::vector<int>>& members, const BearingFunction& bearing);
 
 }  // namespace celc

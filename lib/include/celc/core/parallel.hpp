@@ -6,7 +6,8 @@
 ///   shared counter (dynamic scheduling); the calling thread works too.
 /// - orderedParallelMap: a stream of jobs produced on the calling thread,
 ///   worked on in parallel, their results handed back on the calling thread
-///   in production order, with a bounded number of jobs in flight.
+///   in production order, with a bounded number of jobs in flight (and
+///   optionally a bound on their weight, e.g. the events they hold).
 ///
 /// Which thread runs a job is unspecified: results must depend on the job
 /// (its index, its data) only, never on the thread or on timing. That is what
@@ -43,6 +44,19 @@ void orderedPipeline(int n_threads, std::size_t max_in_flight,
                      const std::function<void(std::size_t)>& work,
                      const std::function<void(std::size_t)>& consume);
 
+/// The same with a bound on the jobs' weights (weight(slot), taken once the
+/// job is produced; max_weight 0 = none): a job weighs from its production
+/// until work(slot) returns (work releases the job's data). The next job is
+/// produced only while the jobs weighing leave room for one as heavy as the
+/// last produced, so they weigh at most max_weight together when the jobs
+/// weigh alike; with none weighing, the next job is produced whatever it
+/// weighs.
+void orderedPipeline(int n_threads, std::size_t max_in_flight, std::size_t max_weight,
+                     const std::function<std::size_t(std::size_t)>& weight,
+                     const std::function<bool(std::size_t)>& produce,
+                     const std::function<void(std::size_t)>& work,
+                     const std::function<void(std::size_t)>& consume);
+
 }  // namespace detail
 
 /// Streams jobs through `n_threads` workers (<= 0: hardware concurrency) and
@@ -64,6 +78,46 @@ void orderedParallelMap(int n_threads, std::size_t max_in_flight,
   std::vector<std::optional<Result>> results(max_in_flight);
   detail::orderedPipeline(
       n_threads, max_in_flight,
+      [&](std::size_t slot) {
+        jobs[slot].emplace();
+        if (produce(*jobs[slot])) return true;
+        jobs[slot].reset();
+        return false;
+      },
+      [&](std::size_t slot) {
+        results[slot].emplace(work(*jobs[slot]));
+        jobs[slot].reset();  // the job's data is no longer needed
+      },
+      [&](std::size_t slot) {
+        consume(*results[slot]);
+        results[slot].reset();
+      });
+}
+
+/// A bound on what the jobs in flight hold, by a weight per job (e.g. a
+/// window's events): see detail::orderedPipeline. max_weight 0 = none.
+template <typename Job>
+struct JobWeightBound {
+  std::size_t max_weight = 0;
+  std::function<std::size_t(const Job&)> weight;
+};
+
+/// orderedParallelMap with, besides the count, a bound on the weight of the
+/// jobs produced and not yet worked on to the end (JobWeightBound): a job is
+/// produced only while those leave room for one as heavy as the last; one
+/// job always goes through, whatever it weighs. With one thread jobs run one
+/// at a time and the bound changes nothing.
+template <typename Job, typename Result>
+void orderedParallelMap(int n_threads, std::size_t max_in_flight, const JobWeightBound<Job>& bound,
+                        const std::function<bool(Job&)>& produce,
+                        const std::function<Result(Job&)>& work,
+                        const std::function<void(Result&)>& consume) {
+  if (max_in_flight < 1) max_in_flight = 1;
+  std::vector<std::optional<Job>> jobs(max_in_flight);
+  std::vector<std::optional<Result>> results(max_in_flight);
+  detail::orderedPipeline(
+      n_threads, max_in_flight, bound.weight ? bound.max_weight : 0,
+      [&](std::size_t slot) { return bound.weight(*jobs[slot]); },
       [&](std::size_t slot) {
         jobs[slot].emplace();
         if (produce(*jobs[slot])) return true;

@@ -58,6 +58,17 @@ struct RunConfig {
     return w;
   }();
   ParallaxWindowOptions parallax;
+  /// A bound on the memory of the windows in flight, by their events
+  /// (SequenceRunner::run, core/parallel.hpp JobWeightBound): the next
+  /// window is read only while the windows read and not yet worked on to
+  /// the end leave room for one as large as the last, so that they hold at
+  /// most this many events together when the windows are alike; with none
+  /// in flight a window is read whatever it holds. 0 = no bound (only the
+  /// count, threads + 2). A window holds 24 B per event, and about 100 B
+  /// more per event while it is worked on (docs/performance.md). A window
+  /// that leaves no room beside it for another of its size clusters on
+  /// every worker's thread. Changes no result.
+  std::size_t max_events_in_flight = 1000000;
   /// The rotation within a window: the gyro's samples integrated
   /// (gyro_integrated, the default: a hand-held camera's rate changes within
   /// a window; docs/accuracy.md) or the window's mean rate (constant_twist,
@@ -116,7 +127,8 @@ std::string toYaml(const RunConfig& config);
 /// Keys that do not change a run's rows, left out of configuration
 /// comparisons (resume, table grouping): `cluster.threads` (the clustering of
 /// one window gives the same clusters on any number of threads; `--threads`
-/// sets it) and `windows.read_batch` (how many events are read at a time).
+/// sets it), `windows.read_batch` (how many events are read at a time) and
+/// `windows.max_events_in_flight` (how many windows are worked on at once).
 const std::vector<std::string>& resultNeutralKeys();
 
 /// The first field (in schema order, result-neutral keys left out) whose
