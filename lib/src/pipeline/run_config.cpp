@@ -96,9 +96,10 @@ void describe(FieldVisitor& v, RunConfig& c) {
     describe(s, c.windows);
     describe(s, c.parallax);
     s.field({"max_events_in_flight", "events",
-             "the windows read and not yet processed hold at most this many events together (a window is read "
-             "when they leave room for one like the last, and always when there are none; about 24 B per event, "
-             "100 B more while processed); 0 = no bound"},
+             "events of the windows read and not yet processed: a window is read when those in flight leave "
+             "room for one as large as the last read, and always when there are none (a window larger than the "
+             "last can pass the bound by the difference); about 24 B per event, 100 B more while processed; "
+             "0 = no bound"},
             c.max_events_in_flight);
   });
   v.section({"motion", "", "motion model and angular velocity"}, [&](FieldVisitor& s) { describeMotion(s, c); });
