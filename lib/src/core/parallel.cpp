@@ -69,13 +69,6 @@ void parallelFor(std::size_t n_jobs, int n_threads, const std::function<void(std
 
 namespace detail {
 
-void orderedPipeline(int n_threads, std::size_t max_in_flight,
-                     const std::function<bool(std::size_t)>& produce,
-                     const std::function<void(std::size_t)>& work,
-                     const std::function<void(std::size_t)>& consume) {
-  orderedPipeline(n_threads, max_in_flight, 0, {}, produce, work, consume);
-}
-
 void orderedPipeline(int n_threads, std::size_t max_in_flight, std::size_t max_weight,
                      const std::function<std::size_t(std::size_t)>& weight,
                      const std::function<bool(std::size_t)>& produce,

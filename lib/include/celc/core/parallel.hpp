@@ -39,14 +39,10 @@ namespace detail {
 /// sequence number s lives in slot s % max_in_flight. produce(slot) fills a
 /// free slot and returns false when there is nothing more; work(slot) runs on
 /// a worker; consume(slot) runs on the calling thread in sequence order.
-void orderedPipeline(int n_threads, std::size_t max_in_flight,
-                     const std::function<bool(std::size_t)>& produce,
-                     const std::function<void(std::size_t)>& work,
-                     const std::function<void(std::size_t)>& consume);
-
-/// The same with a bound on the jobs' weights (weight(slot), taken once the
-/// job is produced; max_weight 0 = none): a job weighs from its production
-/// until work(slot) returns (work releases the job's data). The next job is
+/// Besides the count, a bound on the jobs' weights (weight(slot), taken once
+/// the job is produced; max_weight 0 = none, weight then never called): a
+/// job weighs from its production until work(slot) returns (work releases
+/// the job's data). The next job is
 /// produced only while the jobs weighing leave room for one as heavy as the
 /// last produced, so they weigh at most max_weight together when the jobs
 /// weigh alike; with none weighing, the next job is produced whatever it
@@ -72,27 +68,7 @@ template <typename Job, typename Result>
 void orderedParallelMap(int n_threads, std::size_t max_in_flight,
                         const std::function<bool(Job&)>& produce,
                         const std::function<Result(Job&)>& work,
-                        const std::function<void(Result&)>& consume) {
-  if (max_in_flight < 1) max_in_flight = 1;
-  std::vector<std::optional<Job>> jobs(max_in_flight);
-  std::vector<std::optional<Result>> results(max_in_flight);
-  detail::orderedPipeline(
-      n_threads, max_in_flight,
-      [&](std::size_t slot) {
-        jobs[slot].emplace();
-        if (produce(*jobs[slot])) return true;
-        jobs[slot].reset();
-        return false;
-      },
-      [&](std::size_t slot) {
-        results[slot].emplace(work(*jobs[slot]));
-        jobs[slot].reset();  // the job's data is no longer needed
-      },
-      [&](std::size_t slot) {
-        consume(*results[slot]);
-        results[slot].reset();
-      });
-}
+                        const std::function<void(Result&)>& consume);
 
 /// A bound on what the jobs in flight hold, by a weight per job (e.g. a
 /// window's events): see detail::orderedPipeline. max_weight 0 = none.
@@ -132,6 +108,14 @@ void orderedParallelMap(int n_threads, std::size_t max_in_flight, const JobWeigh
         consume(*results[slot]);
         results[slot].reset();
       });
+}
+
+template <typename Job, typename Result>
+void orderedParallelMap(int n_threads, std::size_t max_in_flight,
+                        const std::function<bool(Job&)>& produce,
+                        const std::function<Result(Job&)>& work,
+                        const std::function<void(Result&)>& consume) {
+  orderedParallelMap<Job, Result>(n_threads, max_in_flight, JobWeightBound<Job>{}, produce, work, consume);
 }
 
 }  // namespace celc
