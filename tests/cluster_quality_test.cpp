@@ -341,6 +341,39 @@ TEST(ClusterObservations, DroppedEventsAreRestoredBitForBit) {
   }
 }
 
+// The clusters' events and lines built on two threads are those of one, in
+// the same order, merged fragments and report included.
+TEST(ClusterObservations, TwoThreadsBuildTheObservationsOfOne) {
+  const LabelledWindow w = window(5);
+  std::vector<int> fragment(w.events.size(), -1);
+  for (size_t i = 0; i < w.events.size(); ++i)
+    if (w.labels[i] >= 0) fragment[i] = 2 * w.labels[i] + static_cast<int>(i % 2);
+  const ClusterResult split = clustersFromLabels(w.events, fragment);
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
+  ObservationReport rep1, rep2;
+  std::vector<std::vector<int>> members1, members2;
+  const WindowObservations one = toObservations(w.events, split, bearing, w.camera.focal(), ObservationOptions{},
+                                                &motion, &rep1, &members1, 1);
+  const WindowObservations two = toObservations(w.events, split, bearing, w.camera.focal(), ObservationOptions{},
+                                                &motion, &rep2, &members2, 2);
+  ASSERT_GT(one.clusters.size(), 2u);
+  ASSERT_EQ(one.clusters.size(), two.clusters.size());
+  EXPECT_EQ(members1, members2);
+  EXPECT_EQ(rep1.used_ids, rep2.used_ids);
+  EXPECT_EQ(rep1.merged_ids, rep2.merged_ids);
+  EXPECT_EQ(rep1.event_clusters, rep2.event_clusters);
+  EXPECT_EQ(rep1.n_too_few_events, rep2.n_too_few_events);
+  for (size_t c = 0; c < one.clusters.size(); ++c) {
+    const ClusterObservation &a = one.clusters[c], &b = two.clusters[c];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.has_lines, b.has_lines);
+    EXPECT_EQ(a.l1.normal, b.l1.normal) << "cluster " << c;
+    EXPECT_EQ(a.l3.normal, b.l3.normal) << "cluster " << c;
+    EXPECT_EQ(a.times, b.times) << "cluster " << c;
+  }
+}
+
 // ---- degenerate windows: a status, never a crash --------------------------
 
 TEST(ClusterDegenerate, EmptyWindow) {

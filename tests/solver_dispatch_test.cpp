@@ -129,3 +129,31 @@ TEST(SolverDispatch, SharedSolvesGiveTheResultsOfOneCall) {
     }
   }
 }
+
+// The methods side by side on two threads give the results of one thread,
+// sigma_deg included, with and without celc_ml already in the store.
+TEST(SolverDispatch, MethodsOnTwoThreadsGiveTheResultsOfOne) {
+  std::mt19937_64 rng(37);
+  const SolverOptions options;
+  for (int trial = 0; trial < 4; ++trial) {
+    LineSceneOptions o;
+    o.events_per_line = 300;
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    const SampleSeeds seeds{11 + static_cast<std::uint64_t>(trial), 13};
+    SharedSolves one, two;
+    const auto a = solveMethods(tr.observations, tr.given_motion, allMethods(), options, seeds, one, 1);
+    const auto b = solveMethods(tr.observations, tr.given_motion, allMethods(), options, seeds, two, 2);
+    SharedSolves stored;
+    solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options, seeds, stored);
+    const auto c = solveMethods(tr.observations, tr.given_motion, allMethods(), options, seeds, stored, 2);
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(a.size(), c.size());
+    for (size_t m = 0; m < a.size(); ++m) {
+      const std::string name = toString(allMethods()[m]);
+      expectSameResult(a[m], b[m], name.c_str(), trial);
+      expectSameResult(a[m], c[m], name.c_str(), trial);
+      EXPECT_EQ(a[m].sigma_deg, b[m].sigma_deg) << name << ", trial " << trial;
+      EXPECT_EQ(a[m].sigma_deg, c[m].sigma_deg) << name << ", trial " << trial;
+    }
+  }
+}

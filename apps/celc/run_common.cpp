@@ -33,8 +33,9 @@ void addRunOptions(CLI::App* cmd, RunOverrides& o) {
   cmd->add_option("--topic-imu", o.topic_imu, fieldHelp(schema, "input.topic_imu"));
   cmd->add_option("--topic-pose", o.topic_pose, fieldHelp(schema, "input.topic_pose"));
   cmd->add_option("--threads", o.threads,
-                  "windows solved at once (0 = all cores, at most 1024); with 1, a window clusters and redraws on "
-                  "cluster.threads threads (--set cluster.threads=1 for one thread in all)")->capture_default_str();
+                  "windows solved at once (0 = all cores, at most 1024); with 1, a window is clustered, redrawn "
+                  "and solved on cluster.threads threads (--set cluster.threads=1 for one thread in all)")
+      ->capture_default_str();
   cmd->add_option("--set", o.sets,
                   "override any configuration key, e.g. --set cluster.smoothness_deg=15 "
                   "(repeatable; YAML values; `celc config --keys` lists every key)");

@@ -6,6 +6,7 @@
 #include <tuple>
 #include <utility>
 
+#include "celc/core/parallel.hpp"
 #include "merge_fragments.hpp"
 
 namespace celc {
@@ -74,7 +75,8 @@ std::string ObservationOptions::validate() const { return lines.validate() + ran
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
                                   const ObservationOptions& options, const MotionModel* motion,
-                                  ObservationReport* report, std::vector<std::vector<int>>* members_out) {
+                                  ObservationReport* report, std::vector<std::vector<int>>* members_out,
+                                  int threads) {
   WindowObservations out;
   if (members_out) members_out->clear();
   out.focal_px = focal_px;
@@ -92,19 +94,19 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
     const int l = clusters.labels[i];
     if (l >= 0 && static_cast<size_t>(l) < k) members[l].push_back(static_cast<int>(i));
   }
-  // Each cluster's events (sorted by time) and lines.
-  std::vector<ClusterObservation> built;
-  std::vector<ClusterLines> fits;
-  std::vector<std::vector<int>> built_members;  // input event indices of each built cluster's events
-  for (size_t c = 0; c < k; ++c) {
+  // Each cluster's events (sorted by time) and lines. A cluster depends on
+  // its own events only: on `threads` threads the same clusters, kept in order.
+  std::vector<ClusterObservation> each(k);
+  std::vector<ClusterLines> each_fit(k);
+  std::vector<std::vector<int>> each_used(k);
+  parallelFor(k, threads, [&](std::size_t c) {
     auto& idx = members[c];
-    std::stable_sort(idx.begin(), idx.end(),
-                     [&](int a, int b) { return events[a].t < events[b].t; });
-    ClusterObservation obs;
+    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return events[a].t < events[b].t; });
+    ClusterObservation& obs = each[c];
     obs.id = clusters.clusters[c].id;
     obs.times.reserve(idx.size());
     obs.bearings.reserve(idx.size());
-    std::vector<int> used;
+    std::vector<int>& used = each_used[c];
     used.reserve(idx.size());
     for (int i : idx) {
       const Vec3 b = bearing(Vec2(events[i].x, events[i].y));
@@ -113,15 +115,22 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
       obs.bearings.push_back(b);
       used.push_back(i);
     }
-    if (static_cast<int>(obs.size()) < options.min_events) {
+    std::vector<int>().swap(idx);  // the cluster's indices are in `used` now
+    if (static_cast<int>(obs.size()) < options.min_events) return;
+    each_fit[c] = fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion);
+    attachLines(obs, each_fit[c]);
+  });
+  std::vector<ClusterObservation> built;
+  std::vector<ClusterLines> fits;
+  std::vector<std::vector<int>> built_members;  // input event indices of each built cluster's events
+  for (size_t c = 0; c < k; ++c) {
+    if (static_cast<int>(each[c].size()) < options.min_events) {
       ++rep.n_too_few_events;
       continue;
     }
-    fits.push_back(fitClusterLines(obs.times, obs.bearings, focal_px, options.lines, motion));
-    attachLines(obs, fits.back());
-    built.push_back(std::move(obs));
-    built_members.push_back(std::move(used));
-    std::vector<int>().swap(idx);  // the cluster's indices are in `used` now
+    built.push_back(std::move(each[c]));
+    fits.push_back(std::move(each_fit[c]));
+    built_members.push_back(std::move(each_used[c]));
   }
   if (options.merge_px > 0.0) mergeFragments(built, fits, built_members, focal_px, options, motion, rep);
   if (report) {

@@ -150,8 +150,9 @@ struct SequenceRunner::Impl {
     if (clusters.status != ClusterStatus::Ok) return notKept();
     ObservationReport redrawn_report;
     std::vector<std::vector<int>> redrawn_members;
-    WindowObservations redrawn_obs = toObservations(events, clusters, to_bearing, calib.camera.focal(),
-                                                    config.observations, &motion, &redrawn_report, &redrawn_members);
+    WindowObservations redrawn_obs =
+        toObservations(events, clusters, to_bearing, calib.camera.focal(), config.observations, &motion,
+                       &redrawn_report, &redrawn_members, cluster_options.threads);
     SharedSolves redrawn_solves;
     const SolverResult after =
         solveMethods(redrawn_obs, motion, {witness}, witnessOptions(), seeds, redrawn_solves).front();
@@ -496,7 +497,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
   ObservationReport report;
   std::vector<std::vector<int>> members;  // the observations' events (restoreObservationEvents)
   WindowObservations obs =
-      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report, &members);
+      toObservations(events, clusters, bearing, cam.focal(), cfg.observations, &motion, &report, &members,
+                     cluster_options.threads);
   rec.n_clusters = report.n_used;  // with lines; npt also gets the others
   rec.n_line_fit_failed = report.n_line_fit_failed;
   for (std::size_t k = 0; k < report.failed_ids.size(); ++k) {
@@ -560,7 +562,8 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
     start = Clock::now();
   }
   obs.accelerometer = m.accelerometer.window(t0, t1, motion.referenceTime());
-  const std::vector<SolverResult> results = solveMethods(obs, motion, cfg.methods, cfg.solver, seeds, solves);
+  const std::vector<SolverResult> results =
+      solveMethods(obs, motion, cfg.methods, cfg.solver, seeds, solves, cluster_options.threads);
   rec.times.solve += secondsSince(start);
   dump(solved_labels);
   if (m.truth) m.measureAgainstTruth(rec, events, report.event_clusters, motion);

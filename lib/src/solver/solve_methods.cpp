@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ce3lc.hpp"
+#include "celc/core/parallel.hpp"
 #include "celc/solver/direction_information.hpp"
 #include "celc/solver/error_budget.hpp"
 #include "celc/solver/npt.hpp"
@@ -481,14 +482,22 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
 
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods, const SolverOptions& options,
-                                       const SampleSeeds& seeds, SharedSolves& solves) {
+                                       const SampleSeeds& seeds, SharedSolves& solves, int threads) {
   // Window-level checks once; a degenerate window is degenerate for every method.
   const SolverResult window = detail::checkWindow(obs, motion, options.linear, options.check_parallax);
   if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
   const detail::WindowFrames frames(obs, motion);
   SharedEstimates shared(obs, motion, options, frames, seeds, solves.store());
-  std::vector<SolverResult> out;
-  for (Method m : methods) out.push_back(solveMethod(m, shared, obs, motion, options, frames, seeds));
+  // The estimates several methods read are solved first; then each method
+  // only reads them (npt's, solved lazily, is read by npt alone once
+  // celc_ml's is solved), so the methods can run side by side.
+  const auto count = [&](Method m) { return std::count(methods.begin(), methods.end(), m); };
+  if (count(Method::Celc) + count(Method::CelcOpt) + count(Method::CelcAcc) > 0) shared.linear();
+  if (count(Method::CelcMl) + count(Method::CelcAcc) > 0) shared.ml();
+  if (count(Method::Npt) > 1) shared.npt();
+  std::vector<SolverResult> out(methods.size());
+  parallelFor(methods.size(), threads,
+              [&](std::size_t i) { out[i] = solveMethod(methods[i], shared, obs, motion, options, frames, seeds); });
 
   const UncertaintyOptions& u = options.uncertainty;
   UncertaintyModel model(obs, motion, u);

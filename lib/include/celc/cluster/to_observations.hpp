@@ -84,11 +84,14 @@ LabelledObservations observeLabelledEvents(const std::vector<Event>& events, con
 /// the line fit removes (line_fit.hpp; nullptr: no rotation). Never throws on data.
 /// `members`, when given: per output cluster, the indices into `events` of
 /// its times and bearings, in their order (restoreObservationEvents).
+/// The clusters' events and lines are built on `threads` threads (each
+/// cluster from its own events, so the result is the same for any count);
+/// `bearing` must then be safe to call from several threads.
 WindowObservations toObservations(const std::vector<Event>& events, const ClusterResult& clusters,
                                   const BearingFunction& bearing, double focal_px,
                                   const ObservationOptions& options, const MotionModel* motion,
                                   ObservationReport* report = nullptr,
-                                  std::vector<std::vector<int>>* members = nullptr);
+                                  std::vector<std::vector<int>>* members = nullptr, int threads = 1);
 
 /// Frees the clusters' times and bearings (32 B per event), keeping their
 /// ids and lines: a window's observations while another set is built.

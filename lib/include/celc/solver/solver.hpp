@@ -87,9 +87,12 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
                                        const std::vector<Method>& methods,
                                        const SolverOptions& options, const SampleSeeds& seeds);
 /// The same, the shared estimates taken from and kept in `shared` (SharedSolves).
+/// With `threads` > 1 the methods run side by side once the estimates they
+/// share are solved; each result depends on the window only, so the results
+/// are the same for any count.
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods, const SolverOptions& options,
-                                       const SampleSeeds& seeds, SharedSolves& shared);
+                                       const SampleSeeds& seeds, SharedSolves& shared, int threads = 1);
 /// The same with the seeds of the options (options.linear.seed, options.refine.seed).
 std::vector<SolverResult> solveMethods(const WindowObservations& obs, const MotionModel& motion,
                                        const std::vector<Method>& methods,
