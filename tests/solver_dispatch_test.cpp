@@ -157,3 +157,29 @@ TEST(SolverDispatch, MethodsOnTwoThreadsGiveTheResultsOfOne) {
     }
   }
 }
+
+// Linear estimates witness only the linear methods (linear_witness_refined
+// off): celc_ml asked alone, where no linear witness is formed, gets the
+// sigma_deg it gets beside celc and ce3lc.
+TEST(SolverDispatch, CelcMlAloneGetsTheSigmaItGetsBesideTheLinearMethods) {
+  std::mt19937_64 rng(41);
+  const SolverOptions options;
+  ASSERT_FALSE(options.uncertainty.linear_witness_refined);
+  int finite = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    LineSceneOptions o;
+    o.events_per_line = 200;
+    o.event_noise_px = 1.0 + trial % 3;
+    const LineSceneTrial tr = generateLineScene(o, rng);
+    const SampleSeeds seeds{17, 19};
+    const SolverResult alone =
+        solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, options, seeds).front();
+    const auto beside =
+        solveMethods(tr.observations, tr.given_motion, {Method::Celc, Method::Ce3lc, Method::CelcMl}, options, seeds);
+    expectSameResult(alone, beside[2], "celc_ml", trial);
+    EXPECT_EQ(alone.sigma_deg, beside[2].sigma_deg) << "trial " << trial;
+    EXPECT_EQ(alone.sigma_rule, beside[2].sigma_rule) << "trial " << trial;
+    finite += std::isfinite(alone.sigma_deg) ? 1 : 0;
+  }
+  EXPECT_GE(finite, 4);
+}

@@ -432,6 +432,13 @@ Witnesses collectWitnesses(const std::vector<SolverResult>& out, const std::vect
     w.estimates.push_back(out[i]);
     w.linear.push_back(m == Method::Celc);
   }
+  // A linear witness raises the refined methods' sigma only with
+  // u.linear_witness_refined: where no other method is asked, it would
+  // raise none, and its sigma (a bound and a budget) is not formed.
+  bool linear_counts = u.linear_witness_refined;
+  for (Method m : methods)
+    linear_counts = linear_counts || (m != Method::CelcOpt && m != Method::CelcMl && m != Method::CelcAcc);
+  if (!linear_counts) return w;
   if (!celc_asked && solved_linear && solved_linear->ok()) addLinearWitness(w, *solved_linear, model, u.scale_celc);
   if (u.witness_rows > 0 && solved_linear) {
     LinearOptions subset = options.linear;
