@@ -63,7 +63,9 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
   v.field({"min_time_span_s", "s", "shortest cluster duration", atLeast(0)}, o.min_time_span_s);
   v.field({"min_extent_px", "px", "smallest spatial extent", atLeast(0)}, o.min_extent_px);
   v.field({"min_density_per_px2", "1/px^2", "fewest events per px^2 of the plane", atLeast(0)}, o.min_density_per_px2);
-  v.field({"threads", "", "worker threads inside one window: its clustering, lines, redraws and methods", within(1, 256)}, o.threads);
+  v.field({"threads", "", "worker threads inside one window: its clustering, lines, redraws and methods",
+           within(1, 256)},
+          o.threads);
   v.field({"seed", "", "RANSAC seed"}, o.seed);
 }
 

@@ -244,7 +244,19 @@ class SharedEstimates {
   detail::MlEnd& ml_end_;
 };
 
-/// Method m's result on the window, the shared estimates taken from `shared`.
+/// Solves the shared estimates that solveMethod reads for `methods` (keep
+/// the two in step), so that the methods then only read them and can run
+/// side by side. npt's is left to npt itself where celc_ml did not need it
+/// and npt is asked once.
+void solveSharedFirst(const std::vector<Method>& methods, SharedEstimates& shared) {
+  const auto count = [&](Method m) { return std::count(methods.begin(), methods.end(), m); };
+  if (count(Method::Celc) + count(Method::CelcOpt) + count(Method::CelcAcc) > 0) shared.linear();
+  if (count(Method::CelcMl) + count(Method::CelcAcc) > 0) shared.ml();
+  if (count(Method::Npt) > 1) shared.npt();
+}
+
+/// Method m's result on the window, the shared estimates taken from `shared`
+/// (solveSharedFirst solves them first).
 SolverResult solveMethod(Method m, SharedEstimates& shared, const WindowObservations& obs,
                          const MotionModel& motion, const SolverOptions& options,
                          const detail::WindowFrames& frames, const SampleSeeds& seeds) {
@@ -495,13 +507,7 @@ std::vector<SolverResult> solveMethods(const WindowObservations& obs, const Moti
   if (!window.ok()) return std::vector<SolverResult>(methods.size(), window);
   const detail::WindowFrames frames(obs, motion);
   SharedEstimates shared(obs, motion, options, frames, seeds, solves.store());
-  // The estimates several methods read are solved first; then each method
-  // only reads them (npt's, solved lazily, is read by npt alone once
-  // celc_ml's is solved), so the methods can run side by side.
-  const auto count = [&](Method m) { return std::count(methods.begin(), methods.end(), m); };
-  if (count(Method::Celc) + count(Method::CelcOpt) + count(Method::CelcAcc) > 0) shared.linear();
-  if (count(Method::CelcMl) + count(Method::CelcAcc) > 0) shared.ml();
-  if (count(Method::Npt) > 1) shared.npt();
+  solveSharedFirst(methods, shared);
   std::vector<SolverResult> out(methods.size());
   parallelFor(methods.size(), threads,
               [&](std::size_t i) { out[i] = solveMethod(methods[i], shared, obs, motion, options, frames, seeds); });
