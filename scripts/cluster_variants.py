@@ -14,6 +14,12 @@ the run's options, gyro and seed) on five labellings of the same events:
                 (fragments joined, impurity kept);
   true_kept     the true edges, on the events the run clustered (fragments
                 joined and impurity removed, the run's coverage kept);
+  completed     the run's clusters, each unclustered event of an edge added
+                to that edge's largest cluster among those it is the
+                majority of (the left-out events of the edges found);
+  true_found    the true edges on every event of the edges that are the
+                majority of a cluster (the oracle without the edges the run
+                did not find);
   true_all      the true edges on every edge event (the oracle's clusters).
 Prints phi [deg] of the method for each labelling (the pipeline's is the
 run's own, up to the undistortion table's rounding, which can tip a window
@@ -95,7 +101,7 @@ def main():
                 rows[int(r["window"])] = r
     wanted = {int(w) for w in a.windows.split(",")} if a.windows else None
     labels = edge_labels(a.seqdir)
-    names = ["pipeline", "pure", "joined", "true_kept", "true_all"]
+    names = ["pipeline", "pure", "joined", "true_kept", "completed", "true_found", "true_all"]
     print(f"| window | run phi | oracle phi | " + " | ".join(names) + " | edge events clustered |")
     print("|---" * (len(names) + 4) + "|")
     beyond, within = Counter(), Counter()
@@ -118,11 +124,17 @@ def main():
             if c >= 0:
                 counts[c][e] += 1
         majority = {c: k.most_common(1)[0][0] for c, k in counts.items()}
+        largest = {}  # edge -> its largest cluster among those it is the majority of
+        for c, e in majority.items():
+            if e >= 0 and (e not in largest or counts[c][e] > counts[largest[e]][e]):
+                largest[e] = c
         variants = {
             "pipeline": cluster,
             "pure": [c if c >= 0 and e == majority[c] and e >= 0 else -1 for c, e in zip(cluster, edge)],
             "joined": [majority[c] if c >= 0 and majority[c] >= 0 else -1 for c in cluster],
             "true_kept": [e if c >= 0 and e >= 0 else -1 for c, e in zip(cluster, edge)],
+            "completed": [c if c >= 0 else largest.get(e, -1) for c, e in zip(cluster, edge)],
+            "true_found": [e if e in largest else -1 for e in edge],
             "true_all": [e if e >= 0 else -1 for e in edge],
         }
         n_edge = sum(1 for e in edge if e >= 0)

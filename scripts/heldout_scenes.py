@@ -7,10 +7,13 @@ constant twist) and draws a new scene seed, a speed of 0.8-3 m/s and a
 rotation rate of 0.2-2.5 rad/s in random directions, and a background noise
 rate; durations are 0.6 s. `--kinds` chooses other bases: `deep` is the slow,
 deep scene (slow_deep.yaml: 3-6 m away) as a constant twist at 0.5-1.5 m/s
-and 0.05-1 rad/s for 2 s, long enough for two windows of a second. Render
-them with `celc synth FILE -o DIR`.
+and 0.05-1 rad/s for 2 s, long enough for two windows of a second; `lines`
+is a scene of straight bars and nothing else (a far wall at 5-6 m with 4
+bars 0.5-1.2 m long, two planes at 3-4 m with 2 bars each, placed and
+turned at random: 10-40 straight edges in view), as a constant twist at 1-4 m/s and
+0.3-3 rad/s for 0.6 s. Render them with `celc synth FILE -o DIR`.
 
-    scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect]
+    scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect,deep,lines]
                               [--speed LO,HI] [--rate LO,HI] [--input-errors]
 
 --input-errors gives every scene the errors of a real sensor's inputs, drawn
@@ -35,10 +38,11 @@ import re
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BASES = {"room": "e2e_davis346_room_fast", "hand": "handheld_fast_rotation", "rect": "davis240_rectangles",
-         "deep": "slow_deep"}
+         "deep": "slow_deep", "lines": "slow_deep"}  # lines: slow_deep's camera, events and IMU, its own planes
 # Per kind: speed [m/s], rotation rate [rad/s], duration [s].
 RANGES = {"room": ((0.8, 3.0), (0.2, 2.5), 0.6), "hand": ((0.8, 3.0), (0.2, 2.5), 0.6),
-          "rect": ((0.8, 3.0), (0.2, 2.5), 0.6), "deep": ((0.5, 1.5), (0.05, 1.0), 2.0)}
+          "rect": ((0.8, 3.0), (0.2, 2.5), 0.6), "deep": ((0.5, 1.5), (0.05, 1.0), 2.0),
+          "lines": ((1.0, 4.0), (0.3, 3.0), 0.6)}
 
 
 def random_vector(rng, norm):
@@ -58,8 +62,38 @@ def set_key(text, pattern, value):
     return new
 
 
+def bars_plane(rng, position, rotation, size, count):
+    """One `segments` plane of `count` long bars (YAML lines of the planes list)."""
+    fmt = lambda xs: "[" + ", ".join(f"{x:.3f}" for x in xs) + "]"
+    return (f"  - texture: segments\n"
+            f"    position: {fmt(position)}\n"
+            f"    rotation: {fmt(rotation)}\n"
+            f"    size: {fmt(size)}\n"
+            f"    base: {rng.uniform(0.45, 0.65):.2f}\n"
+            f"    count: {count}\n"
+            f"    length_range: [0.5, 1.2]\n"
+            f"    width_range: [0.04, 0.1]\n"
+            f"    intensity_range: [0.05, 0.3]\n")
+
+
+def lines_planes(rng):
+    """The planes of a `lines` scene: a far wall of 4 bars and two nearer planes of 2 bars each."""
+    planes = bars_plane(rng, [rng.uniform(-0.5, 0.5), rng.uniform(-0.3, 0.3), rng.uniform(5.0, 6.0)],
+                        [rng.uniform(-0.2, 0.2), rng.uniform(-0.3, 0.3), rng.uniform(-0.5, 0.5)], [7.0, 5.0], 4)
+    for side in (-1.0, 1.0):
+        planes += bars_plane(rng, [side * rng.uniform(0.6, 1.2), rng.uniform(-0.6, 0.6), rng.uniform(3.0, 4.0)],
+                             [rng.uniform(-0.3, 0.3), side * rng.uniform(0.1, 0.3), rng.uniform(-0.8, 0.8)],
+                             [2.2, 2.2], 2)
+    return planes
+
+
 def variant(rng, index, kind, base, speed_range=None, rate_range=None):
     text = open(os.path.join(ROOT, "config", "scenes", base + ".yaml")).read()
+    if kind == "lines":  # slow_deep's planes replaced by planes of bars, its description dropped
+        text = re.sub(r"\A(?:#.*\n)+", "# Straight bars only: a far wall and two nearer planes (scripts/heldout_scenes.py).\n"
+                      "# Units: metres [m], seconds [s], radians [rad], pixels [px]. Schema: docs/simulation.md.\n", text)
+        text = re.sub(r"^planes:\n(?:(?:  .*)?\n)*?(?=trajectory:)", lambda m: "planes:\n" + lines_planes(rng) + "\n",
+                      text, count=1, flags=re.M)
     speeds, rates, duration = RANGES[kind]
     speeds, rates = speed_range or speeds, rate_range or rates
     speed, rate = rng.uniform(*speeds), rng.uniform(*rates)
@@ -70,10 +104,11 @@ def variant(rng, index, kind, base, speed_range=None, rate_range=None):
     if kind == "rect":  # the shipped wall moves sinusoidally: here a constant twist
         text = set_key(text, r"^(\s*type: )sinusoid", "constant_twist")
         text = re.sub(r"^\s*(amplitude_v|amplitude_w|frequency):.*\n", "", text, flags=re.M)
-    text = set_key(text, r"^(\s*v: )\[[^\]]*\]", str(v))
-    text = set_key(text, r"^(\s*w: )\[[^\]]*\]", str(w))
+    text = set_key(text, r"^(\s*v: )\[[^\]]*\].*", f"{v}  # camera-frame linear velocity [m/s] (|v| = {speed:.2f})")
+    text = set_key(text, r"^(\s*w: )\[[^\]]*\].*", f"{w}  # camera-frame angular velocity [rad/s] (|w| = {rate:.2f})")
     text = set_key(text, r"^(\s*noise_rate: )[0-9.]+", str(noise))
-    header = (f"# Held-out variant {index} of {base}.yaml (scripts/heldout_scenes.py): "
+    source = "the lines kind (slow_deep.yaml's camera, events and IMU)" if kind == "lines" else base + ".yaml"
+    header = (f"# Held-out variant {index} of {source} (scripts/heldout_scenes.py): "
               f"speed {speed:.2f} m/s, rotation {rate:.2f} rad/s, noise {noise} Hz/px.\n")
     return header + text, f"speed {speed:.2f} m/s v {v}, rotation {rate:.2f} rad/s w {w}, noise {noise}"
 
@@ -107,7 +142,7 @@ def main():
     ap.add_argument("--count", type=int, default=16, help="scenes to write (default 16)")
     ap.add_argument("--seed", type=int, default=2026, help="seed of the draw (default 2026)")
     ap.add_argument("--kinds", default="room,hand,rect",
-                    help="bases, taken in turn: room, hand, rect, deep (default room,hand,rect)")
+                    help="bases, taken in turn: room, hand, rect, deep, lines (default room,hand,rect)")
     ap.add_argument("--speed", help="speed range LO,HI [m/s] for every kind")
     ap.add_argument("--rate", help="rotation rate range LO,HI [rad/s] for every kind")
     ap.add_argument("--input-errors", action="store_true",
@@ -130,7 +165,7 @@ def main():
     kinds = a.kinds.split(",")
     for k in kinds:
         if k not in BASES:
-            raise SystemExit(f"heldout_scenes.py: --kinds: unknown kind {k!r} (room, hand, rect, deep)")
+            raise SystemExit(f"heldout_scenes.py: --kinds: unknown kind {k!r} (room, hand, rect, deep, lines)")
     os.makedirs(a.outdir, exist_ok=True)
     rng = random.Random(a.seed)
     for i in range(a.count):

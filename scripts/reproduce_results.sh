@@ -11,7 +11,8 @@
 #   parallax    scripts/parallax_study.sh: parallax.md (15 min after the scenes' renders)
 #   rotation    scripts/rotation_trust.sh: rotation_trust.md (pure rotation, calibration errors; 2 min)
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
-#   speeds      the same at 1 m/s and at 3 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (16 min)
+#   speeds      the same at 1, 3 and 4 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (25 min)
+#   lines       the same on scenes of straight bars only (8 scenes, seed 60000, 1-4 m/s, 0.3-3 rad/s): clusters_lines.md (8 min)
 #   derotate    clusters and speeds again with cluster.derotate true: clusters_derotate.md (5 min after their renders)
 #   fast        clusters and speeds again with -c config/fast.yaml: fast.md (4 min after their renders)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
@@ -33,7 +34,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds derotate fast acceleration accelerometer studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines derotate fast acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -107,14 +108,21 @@ for name in "${names[@]}"; do
         put clusters.md clusters "scripts/cluster_table.sh"
       ;;
     speeds)
-      for v in 1 3; do
+      for v in 1 3 4; do
         scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 \
           > "$work/speed$v.txt"
       done
       { echo "At 1 m/s:"; $tables table 1 < "$work/speed1.txt"; echo; echo "At 3 m/s, the same scenes:";
-        $tables table 1 < "$work/speed3.txt"; echo; $tables table 0 < "$work/speed1.txt"; echo;
-        $tables table 0 < "$work/speed3.txt"; } |
-        put clusters_speeds.md speeds "scripts/cluster_table.sh --seed 50000 --count 8 --speed V,V --rate 0.3,3, V = 1 and 3"
+        $tables table 1 < "$work/speed3.txt"; echo; echo "At 4 m/s, the same scenes:";
+        $tables table 1 < "$work/speed4.txt"; echo; $tables table 0 < "$work/speed1.txt"; echo;
+        $tables table 0 < "$work/speed3.txt"; echo; $tables table 0 < "$work/speed4.txt"; } |
+        put clusters_speeds.md speeds "scripts/cluster_table.sh --seed 50000 --count 8 --speed V,V --rate 0.3,3, V = 1, 3 and 4"
+      ;;
+    lines)
+      scripts/cluster_table.sh "$work/lines" --seed 60000 --count 8 --kinds lines --speed 1,4 --rate 0.3,3 \
+        > "$work/lines.txt"
+      { $tables table 1 < "$work/lines.txt"; echo; $tables table 0 < "$work/lines.txt"; } |
+        put clusters_lines.md lines "scripts/cluster_table.sh --seed 60000 --count 8 --kinds lines --speed 1,4 --rate 0.3,3"
       ;;
     derotate)
       heldout_again derotate clusters_derotate.md --set cluster.derotate=true
