@@ -13,6 +13,7 @@
 #   clusters    scripts/cluster_table.sh (12 held-out scenes, seed 30000): clusters.md (12 min)
 #   speeds      the same at 1, 3 and 4 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (25 min)
 #   lines       the same on scenes of straight bars only (8 scenes, seed 60000, 1-4 m/s, 0.3-3 rad/s): clusters_lines.md (8 min)
+#   gap         every window of clusters, speeds and lines, pipeline against oracle: images/oracle_gap.png (after them)
 #   derotate    clusters and speeds again with cluster.derotate true: clusters_derotate.md (5 min after their renders)
 #   fast        clusters and speeds again with -c config/fast.yaml: fast.md (4 min after their renders)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
@@ -34,7 +35,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines derotate fast acceleration accelerometer studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines gap derotate fast acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -123,6 +124,11 @@ for name in "${names[@]}"; do
         > "$work/lines.txt"
       { $tables table 1 < "$work/lines.txt"; echo; $tables table 0 < "$work/lines.txt"; } |
         put clusters_lines.md lines "scripts/cluster_table.sh --seed 60000 --count 8 --kinds lines --speed 1,4 --rate 0.3,3"
+      ;;
+    gap)
+      /usr/bin/python3 scripts/plot_oracle_gap.py "$root/docs/images/oracle_gap.png" \
+        "seed 30000=$work/clusters/run" "1 m/s=$work/speed1/run" "3 m/s=$work/speed3/run" \
+        "4 m/s=$work/speed4/run" "bars, 1-4 m/s=$work/lines/run"
       ;;
     derotate)
       heldout_again derotate clusters_derotate.md --set cluster.derotate=true
