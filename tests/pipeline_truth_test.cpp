@@ -112,9 +112,10 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   int rows = 0;
   while (std::getline(lines, row_text)) {
     int w;
-    double run_phi, oracle, pipeline, pure, joined, true_kept, true_all, kept;
-    if (std::sscanf(row_text.c_str(), "| %d | %lf | %lf | %lf | %lf | %lf | %lf | %lf | %lf |", &w, &run_phi,
-                    &oracle, &pipeline, &pure, &joined, &true_kept, &true_all, &kept) != 9)
+    double run_phi, oracle, pipeline, pure, joined, true_kept, completed, true_found, true_all, kept;
+    if (std::sscanf(row_text.c_str(), "| %d | %lf | %lf | %lf | %lf | %lf | %lf | %lf | %lf | %lf | %lf |", &w,
+                    &run_phi, &oracle, &pipeline, &pure, &joined, &true_kept, &completed, &true_found, &true_all,
+                    &kept) != 11)
       continue;
     ++rows;
     ASSERT_EQ(ml.count(w), 1u) << row_text;
@@ -124,7 +125,7 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
     EXPECT_NEAR(pipeline, run_phi, 0.02) << row_text;
     EXPECT_NEAR(true_all, oracle, 0.5) << row_text;
     // The sample's clusters are nearly pure and whole: each labelling is a few degrees at most.
-    for (double phi : {pure, joined, true_kept}) EXPECT_LT(phi, 5.0) << row_text;
+    for (double phi : {pure, joined, true_kept, completed, true_found}) EXPECT_LT(phi, 5.0) << row_text;
     EXPECT_NEAR(kept, ml[w].coverage, 0.02) << row_text;
   }
   EXPECT_EQ(rows, 2) << variants.out;
