@@ -10,8 +10,8 @@ deep scene (slow_deep.yaml: 3-6 m away) as a constant twist at 0.5-1.5 m/s
 and 0.05-1 rad/s for 2 s, long enough for two windows of a second; `lines`
 is a scene of straight bars and nothing else (a far wall at 5-6 m with 4
 bars 0.5-1.2 m long, two planes at 3-4 m with 2 bars each, placed and
-turned at random: 10-40 straight edges in view), as a constant twist at 1-4 m/s and
-0.3-3 rad/s for 0.6 s. Render them with `celc synth FILE -o DIR`.
+turned at random: 10-40 straight edges in view), as a constant twist at
+1-4 m/s and 0.3-3 rad/s for 0.6 s. Render them with `celc synth FILE -o DIR`.
 
     scripts/heldout_scenes.py OUTDIR [--count N] [--seed S] [--kinds room,hand,rect,deep,lines]
                               [--speed LO,HI] [--rate LO,HI] [--input-errors]
