@@ -127,11 +127,24 @@ TEST(ClusterQuality, LeftOutEventsAddUpToTheWindow) {
     const ClusterLosses& l = r.left_out;
     return l.invalid + l.no_region + l.small_region + l.failed_checks + l.off_planes + l.off_moving_lines;
   };
+  // The per-event reasons (ClusterResult::loss) count what the fields count.
+  auto reasonsMatch = [](const ClusterResult& r) {
+    std::map<LossReason, int> n;
+    for (LossReason why : r.loss) ++n[why];
+    const ClusterLosses& l = r.left_out;
+    return static_cast<int>(r.loss.size()) == r.n_events && n[LossReason::None] == r.n_clustered &&
+           n[LossReason::Invalid] == l.invalid && n[LossReason::NoRegion] == l.no_region &&
+           n[LossReason::SmallRegion] == l.small_region && n[LossReason::FailedChecks] == l.failed_checks &&
+           n[LossReason::OffPlanes] == l.off_planes && n[LossReason::OffMovingLines] == l.off_moving_lines;
+  };
   for (ClusterMethod m : {ClusterMethod::Grid, ClusterMethod::Pcl}) {
     ClusterOptions opt;
     opt.method = m;
     const ClusterResult r = clusterEvents(w.events, opt);
     ASSERT_EQ(r.status, ClusterStatus::Ok) << toString(m);
+    EXPECT_TRUE(reasonsMatch(r)) << toString(m);
+    for (std::size_t i = 0; i < r.loss.size(); ++i)
+      ASSERT_EQ(r.loss[i] == LossReason::None, r.labels[i] >= 0) << toString(m) << " event " << i;
     EXPECT_EQ(r.n_clustered + left(r), r.n_events) << toString(m);
     EXPECT_EQ(r.left_out.invalid, 2) << toString(m);
     EXPECT_EQ(r.left_out.off_moving_lines, 0) << toString(m);  // no cut in clusterEvents
@@ -142,6 +155,7 @@ TEST(ClusterQuality, LeftOutEventsAddUpToTheWindow) {
   const ClusterResult rs = clusterEvents(w.events, small);
   EXPECT_EQ(rs.status, ClusterStatus::NoClusters);
   EXPECT_EQ(rs.n_clustered + left(rs), rs.n_events);
+  EXPECT_TRUE(reasonsMatch(rs));
   EXPECT_GE(rs.left_out.small_region, 0.9 * line_events);
   EXPECT_EQ(rs.left_out.failed_checks + rs.left_out.off_planes, 0);
   ClusterOptions sparse;
@@ -150,11 +164,13 @@ TEST(ClusterQuality, LeftOutEventsAddUpToTheWindow) {
   EXPECT_EQ(rd.status, ClusterStatus::NoClusters);
   EXPECT_EQ(rd.n_clustered + left(rd), rd.n_events);
   EXPECT_GE(rd.left_out.failed_checks, 0.9 * line_events);
+  EXPECT_TRUE(reasonsMatch(rd));
   // Too few valid events to grow: all of them in no region.
   std::vector<Event> few(10, Event{0.0, 5.0f, 5.0f, true});
   const ClusterResult rf = clusterEvents(few, ClusterOptions{});
   EXPECT_EQ(rf.left_out.no_region, 10);
   EXPECT_EQ(rf.n_clustered + left(rf), 10);
+  EXPECT_TRUE(reasonsMatch(rf));
 }
 
 // The median normal-flow speed of the true lines (per event, from the generator's

@@ -45,6 +45,8 @@ std::string ClusterOptions::validate() const {
   std::string e = rangeProblemsOf(*this);
   if (!(c_max_px_per_s >= c_min_px_per_s)) e += "c_max_px_per_s: must be >= c_min_px_per_s; ";
   if (max_cluster_size < min_cluster_size) e += "max_cluster_size: must be >= min_cluster_size; ";
+  if (recover_cell_px > 0.0 && recover_cell_px < 1.0)
+    e += "recover_cell_px: 0 (off) or at least 1 px (a finer grid joins too few of a sparse edge's events); ";
   if (line_scale_ratio > 0.0 && line_scale_ratio < 1.0)
     e += "line_scale_ratio: 0 (off) or at least 1 (below 1 it drops most of a window's parts); ";
   return e;
@@ -173,6 +175,7 @@ std::vector<std::vector<int>> splitPlanes(const Group& g, double c, std::vector<
 
 struct GroupOutput {
   std::vector<std::vector<int>> clusters;  // event indices
+  std::vector<LossReason> loss;            // per group point: where it went when in no cluster
   std::vector<ClusterStats> stats;
   int n_regions = 0, n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
   ClusterLosses left_out;  // invalid stays 0: a group holds valid events only
@@ -185,6 +188,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
                          const ClusterOptions& opt, int threads,
                          detail::GridNormals* normals = nullptr) {
   GroupOutput out;
+  out.loss.assign(g.size(), LossReason::NoRegion);
   if (static_cast<int>(g.size()) < opt.min_cluster_size) {  // not grown
     out.left_out.no_region = static_cast<int>(g.size());
     return out;
@@ -221,13 +225,18 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
   for (size_t i = 0; i < regions.label.size(); ++i) {
     const int l = regions.label[i];
     if (l >= 0 && slot[l] >= 0) lists[slot[l]].push_back(static_cast<int>(i));
+    if (l >= 0) out.loss[i] = slot[l] >= 0 ? LossReason::OffPlanes : LossReason::SmallRegion;
   }
   out.n_regions = static_cast<int>(lists.size());
   std::mt19937 rng(opt.seed);
+  auto failChecks = [&](const std::vector<int>& idx) {
+    ++out.n_rejected_small;
+    out.left_out.failed_checks += static_cast<int>(idx.size());
+    for (int i : idx) out.loss[static_cast<std::size_t>(i)] = LossReason::FailedChecks;
+  };
   auto accept = [&](std::vector<int>&& idx, const PlaneFit& f) {
     if (static_cast<int>(idx.size()) < opt.min_cluster_size) {
-      ++out.n_rejected_small;
-      out.left_out.failed_checks += static_cast<int>(idx.size());
+      failChecks(idx);
       return;
     }
     double t_lo = 1e300, t_hi = -1e300;
@@ -239,8 +248,7 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
     const double density = static_cast<double>(idx.size()) / std::max(f.area, 1.0);
     if (t_hi - t_lo < opt.min_time_span_s || extent < opt.min_extent_px ||
         density < opt.min_density_per_px2) {
-      ++out.n_rejected_small;
-      out.left_out.failed_checks += static_cast<int>(idx.size());
+      failChecks(idx);
       return;
     }
     ClusterStats s;
@@ -256,7 +264,10 @@ GroupOutput processGroup(const std::vector<Event>& events, const Group& g,
     const double nxy = f.normal.head<2>().norm();
     s.speed_px_per_s = nxy > 1e-9 ? c * std::fabs(f.normal.z()) / nxy : 0.0;
     std::vector<int> ev(idx.size());
-    for (size_t k = 0; k < idx.size(); ++k) ev[k] = g.event_index[idx[k]];
+    for (size_t k = 0; k < idx.size(); ++k) {
+      ev[k] = g.event_index[idx[k]];
+      out.loss[static_cast<std::size_t>(idx[k])] = LossReason::None;
+    }
     size_t n_on = 0;
     for (int e : ev) n_on += events[e].on ? 1 : 0;
     s.on = 2 * n_on >= ev.size();  // the group's polarity, or the majority when merged
@@ -344,8 +355,11 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
   for (const Event& e : events)
     if (validEvent(e)) t0 = std::min(t0, e.t), ++n_valid;
   res.left_out.invalid = res.n_events - n_valid;
+  res.loss.assign(events.size(), LossReason::Invalid);
   if (n_valid < opt.min_cluster_size) {
     res.left_out.no_region = n_valid;  // not grown
+    for (std::size_t i = 0; i < events.size(); ++i)
+      if (validEvent(events[i])) res.loss[i] = LossReason::NoRegion;
     res.status = n_valid == 0 ? ClusterStatus::EmptyWindow : ClusterStatus::TooFewEvents;
     res.message = std::to_string(n_valid) + " valid events, fewer than min_cluster_size";
     return res;
@@ -408,6 +422,9 @@ ClusterResult clusterEvents(const std::vector<Event>& events, const ClusterOptio
     std::vector<int>* ev;
   };
   std::vector<Item> items;
+  for (std::size_t k = 0; k < groups.size(); ++k)
+    for (std::size_t i = 0; i < groups[k].size(); ++i)
+      res.loss[static_cast<std::size_t>(groups[k].event_index[i])] = outs[k].loss[i];
   for (auto& o : outs) {
     if (o.smoothness_deg > 0.0) res.smoothness_deg = std::max(res.smoothness_deg, o.smoothness_deg);
     res.n_regions += o.n_regions;

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -25,6 +26,8 @@ constexpr double kLooseFactor = 1.5;  // hypotheses (linear in time) are scored 
 constexpr double kRefineFactors[] = {3.0, 2.0, 1.5, 1.0, 1.0};  // the local optimisation's thresholds
 constexpr double kShadowFactor = 3.0;  // a part within this times the threshold of an earlier one is its residuals' tail
 constexpr std::size_t kMinPartsForScale = 6;  // parts a window needs before line_scale_ratio compares them
+constexpr int kRecoverMaxParts = 16;  // moving lines drawn from one group of left-out events, at most
+constexpr double kRecoverWidthRatio = 2.0;  // a recovered line's median distance, at most, in window scales
 // [px] the least median distance line_scale_ratio multiplies: events on whole
 // pixels lie a median 0.25 px from their line (an offset uniform in +-0.5
 // px), whatever the noise; an edge that barely moves gives less
@@ -236,6 +239,150 @@ std::vector<bool> widerThanTheWindow(const std::vector<Part>& all, double ratio)
   return wide;
 }
 
+
+/// `idx` (event indices in time order) as points in the reference frame;
+/// `source` gets each point's event (events without a finite bearing are skipped).
+void toLinePoints(const std::vector<Event>& events, const std::vector<int>& idx, const BearingFunction& bearing,
+                  const MotionModel* motion, std::vector<LinePoint>& pts, std::vector<int>& source) {
+  pts.reserve(idx.size());
+  source.reserve(idx.size());
+  Mat3 r = Mat3::Identity();  // R(r_time); the events are in time order
+  double r_time = std::numeric_limits<double>::quiet_NaN();
+  for (int i : idx) {
+    const Event& e = events[static_cast<std::size_t>(i)];
+    const Vec3 f = bearing(Vec2(e.x, e.y));
+    if (!f.allFinite() || !(std::abs(f.z()) > 0.0)) continue;
+    if (motion && !(std::abs(e.t - r_time) <= kRotationStep)) r = motion->rotation(e.t), r_time = e.t;
+    pts.push_back({r * (f / f.z()), r.col(2), e.t});
+    source.push_back(i);
+  }
+}
+
+/// The events in no part (`in_part` 0, of a known LossReason other than
+/// Invalid) in groups connected on a grid of `cell_px` cells in (x, y, c t),
+/// one polarity per group when options.separate_polarity; each group in time
+/// order, groups of fewer than min_cluster_size events dropped.
+std::vector<std::vector<int>> leftOutGroups(const std::vector<Event>& events, const std::vector<char>& in_part,
+                                            const ClusterResult& clusters, const ClusterOptions& options) {
+  const double cell = options.recover_cell_px;
+  const double c = clusters.c_px_per_s > 0.0 ? clusters.c_px_per_s : options.c_min_px_per_s;
+  // Cell key: (c t / cell, x / cell, y / cell, polarity) packed as 37 + 13 + 13 + 1 bits.
+  constexpr std::uint64_t kXY = 8192;  // cells per image axis at most (4096 px at cell >= 1 px)
+  constexpr std::uint64_t kMaxT = std::uint64_t{1} << 36;
+  auto cellKey = [](std::uint64_t ct, std::uint64_t cx, std::uint64_t cy, std::uint64_t pol) {
+    return ((ct * kXY + cx) * kXY + cy) * 2 + pol;
+  };
+  std::vector<std::pair<std::uint64_t, int>> keyed;  // (cell, event)
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    if (in_part[i] || clusters.loss[i] == LossReason::Invalid || clusters.loss[i] == LossReason::None) continue;
+    const Event& e = events[i];
+    const double ct = std::floor(c * (e.t - clusters.t0) / cell);
+    if (!(ct >= 0.0 && ct < static_cast<double>(kMaxT))) continue;
+    const auto cx = static_cast<std::uint64_t>(e.x / cell), cy = static_cast<std::uint64_t>(e.y / cell);
+    const std::uint64_t pol = options.separate_polarity && e.on ? 1 : 0;
+    keyed.emplace_back(cellKey(static_cast<std::uint64_t>(ct), cx, cy, pol), static_cast<int>(i));
+  }
+  std::sort(keyed.begin(), keyed.end());
+  // Cells (runs of one key) joined with their 26 neighbours by union-find.
+  std::vector<std::uint64_t> keys;
+  std::vector<std::size_t> first;  // each cell's first entry in `keyed`
+  for (std::size_t q = 0; q < keyed.size(); ++q)
+    if (q == 0 || keyed[q].first != keyed[q - 1].first) keys.push_back(keyed[q].first), first.push_back(q);
+  first.push_back(keyed.size());
+  std::vector<std::size_t> parent(keys.size());
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  auto find = [&](std::size_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const std::uint64_t pol = keys[k] % 2, cy = keys[k] / 2 % kXY, cx = keys[k] / 2 / kXY % kXY,
+                        ct = keys[k] / 2 / kXY / kXY;
+    for (int dt = 0; dt <= 1; ++dt)  // later cells only: each pair once
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy) {
+          if (dt == 0 && (dx < 0 || (dx == 0 && dy <= 0))) continue;
+          if ((dx < 0 && cx == 0) || (dy < 0 && cy == 0) || (dx > 0 && cx + 1 >= kXY) || (dy > 0 && cy + 1 >= kXY))
+            continue;
+          const std::uint64_t n = cellKey(ct + static_cast<std::uint64_t>(dt), cx + dx, cy + dy, pol);
+          const auto it = std::lower_bound(keys.begin(), keys.end(), n);
+          if (it == keys.end() || *it != n) continue;
+          const std::size_t a = find(k), b = find(static_cast<std::size_t>(it - keys.begin()));
+          if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+  }
+  std::vector<std::vector<int>> groups;
+  std::vector<int> group_of(keys.size(), -1);
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const std::size_t root = find(k);
+    if (group_of[root] < 0) group_of[root] = static_cast<int>(groups.size()), groups.emplace_back();
+    for (std::size_t q = first[k]; q < first[k + 1]; ++q)
+      groups[static_cast<std::size_t>(group_of[root])].push_back(keyed[q].second);
+  }
+  std::vector<std::vector<int>> kept;
+  for (auto& g : groups) {
+    if (static_cast<int>(g.size()) < options.min_cluster_size) continue;
+    std::sort(g.begin(), g.end(), [&](int a, int b) {
+      return events[static_cast<std::size_t>(a)].t < events[static_cast<std::size_t>(b)].t ||
+             (events[static_cast<std::size_t>(a)].t == events[static_cast<std::size_t>(b)].t && a < b);
+    });
+    kept.push_back(std::move(g));
+  }
+  return kept;
+}
+
+/// Moving lines among the events in no part (ClusterOptions::recover_cell_px):
+/// each group of leftOutGroups cut by the same sequential RANSAC (up to
+/// kRecoverMaxParts lines); a line's events become a part when they are
+/// min_cluster_size or more, span min_extent_px, and lie within
+/// kRecoverWidthRatio times the window's scale of it (median distance; the
+/// scale is the median of the existing parts' medians, at least
+/// kPixelFloorPx): a band of noise events along a line spreads its distances
+/// over the threshold, where an edge's lie within its noise.
+std::vector<Part> recoverLeftOut(const std::vector<Event>& events, const ClusterResult& clusters,
+                                 const std::vector<Part>& existing, const BearingFunction& bearing, double threshold,
+                                 double focal_px, const MotionModel* motion, const ClusterOptions& options) {
+  std::vector<char> in_part(events.size(), 0);
+  for (const Part& p : existing)
+    for (int i : p.events) in_part[static_cast<std::size_t>(i)] = 1;
+  std::vector<std::vector<int>> groups = leftOutGroups(events, in_part, clusters, options);
+  std::vector<double> medians;
+  for (const Part& p : existing) medians.push_back(p.median_px);
+  double scale_px = kPixelFloorPx;
+  if (!medians.empty()) {
+    auto mid = medians.begin() + static_cast<std::ptrdiff_t>(medians.size() / 2);
+    std::nth_element(medians.begin(), mid, medians.end());
+    scale_px = std::max(*mid, kPixelFloorPx);
+  }
+  const double max_median_px = kRecoverWidthRatio * scale_px;
+  std::vector<std::vector<Part>> found(groups.size());
+  parallelFor(groups.size(), options.threads, [&](std::size_t g) {
+    std::vector<LinePoint> pts;
+    std::vector<int> source;
+    toLinePoints(events, groups[g], bearing, motion, pts, source);
+    std::mt19937 rng(options.seed + 7919u * static_cast<unsigned>(g + 1));
+    const Parts parts = splitCluster(pts, threshold, options.min_cluster_size, kRecoverMaxParts, rng);
+    for (std::size_t q = 0; q < parts.members.size(); ++q) {
+      Part part;
+      float x0 = std::numeric_limits<float>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+      for (std::size_t j : parts.members[q]) {
+        const Event& e = events[static_cast<std::size_t>(source[j])];
+        part.events.push_back(source[j]);
+        x0 = std::min(x0, e.x), x1 = std::max(x1, e.x), y0 = std::min(y0, e.y), y1 = std::max(y1, e.y);
+      }
+      if (std::max(x1 - x0, y1 - y0) < options.min_extent_px) continue;
+      part.median_px = medianDistance(pts, parts.members[q], parts.lines[q]) * focal_px;
+      if (part.median_px > max_median_px) continue;
+      std::sort(part.events.begin(), part.events.end());
+      found[g].push_back(std::move(part));
+    }
+  });
+  std::vector<Part> recovered;
+  for (auto& f : found)
+    for (Part& p : f) recovered.push_back(std::move(p));
+  return recovered;
+}
+
 }  // namespace
 
 LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResult& clusters,
@@ -261,17 +408,7 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
     if (!std::is_sorted(idx.begin(), idx.end(), earlier)) std::stable_sort(idx.begin(), idx.end(), earlier);
     std::vector<LinePoint> pts;
     std::vector<int> source;
-    pts.reserve(idx.size());
-    Mat3 r = Mat3::Identity();  // R(r_time); the events are in time order
-    double r_time = std::numeric_limits<double>::quiet_NaN();
-    for (int i : idx) {
-      const Event& e = events[i];
-      const Vec3 f = bearing(Vec2(e.x, e.y));
-      if (!f.allFinite() || !(std::abs(f.z()) > 0.0)) continue;
-      if (motion && !(std::abs(e.t - r_time) <= kRotationStep)) r = motion->rotation(e.t), r_time = e.t;
-      pts.push_back({r * (f / f.z()), r.col(2), e.t});
-      source.push_back(i);
-    }
+    toLinePoints(events, idx, bearing, motion, pts, source);
     std::mt19937 rng(options.seed + static_cast<unsigned>(c));
     const Parts parts = splitCluster(pts, threshold, options.min_cluster_size, options.max_split, rng);
     std::size_t kept = 0;
@@ -309,6 +446,35 @@ LineSplitReport splitByMovingLines(const std::vector<Event>& events, ClusterResu
     clusters.left_out.off_moving_lines += static_cast<int>(all[q].events.size());
   }
   all.swap(narrow);
+  // Where every event went: the cut's and the dropped parts' events are off the moving lines.
+  const bool reasons = clusters.loss.size() == events.size();
+  if (reasons) {
+    std::vector<char> in_part(events.size(), 0);
+    for (const Part& p : all)
+      for (int i : p.events) in_part[static_cast<std::size_t>(i)] = 1;
+    for (std::size_t i = 0; i < events.size(); ++i)
+      if (clusters.labels[i] >= 0 && !in_part[i]) clusters.loss[i] = LossReason::OffMovingLines;
+  }
+  if (options.recover_cell_px > 0.0 && reasons) {
+    std::vector<Part> recovered = recoverLeftOut(events, clusters, all, bearing, threshold, focal_px, motion, options);
+    for (Part& p : recovered) {
+      for (int i : p.events) {
+        LossReason& why = clusters.loss[static_cast<std::size_t>(i)];
+        ClusterLosses& l = clusters.left_out;
+        int* count = why == LossReason::NoRegion         ? &l.no_region
+                     : why == LossReason::SmallRegion    ? &l.small_region
+                     : why == LossReason::FailedChecks   ? &l.failed_checks
+                     : why == LossReason::OffPlanes      ? &l.off_planes
+                     : why == LossReason::OffMovingLines ? &l.off_moving_lines
+                                                         : nullptr;
+        if (count) --*count;
+        why = LossReason::None;
+      }
+      ++report.n_recovered;
+      report.n_recovered_events += static_cast<int>(p.events.size());
+      all.push_back(std::move(p));
+    }
+  }
   // New clusters: each part keeps its cluster's plane statistics.
   for (Part& p : all) {
     double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;

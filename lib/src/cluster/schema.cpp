@@ -48,6 +48,12 @@ void describe(FieldVisitor& v, ClusterOptions& o) {
            "window's (event-weighted median part, at least 0.25 px): two edges one line fits, at a corner; needs "
            "6 parts; 0 = keep every part, else >= 1", within(0, 100)},
           o.line_scale_ratio);
+  v.field({"recover_cell_px", "px",
+           "after the cut, the events in no cluster are grouped where they touch on a grid of this cell in "
+           "(x, y, c t) and cut to moving lines the same way; lines of min_cluster_size events whose median "
+           "distance is at most twice the window's become clusters; 0 = not recovered, else >= 1",
+           within(0, 32)},
+          o.recover_cell_px);
   v.field({"motion_reassign_px", "px",
            "after a first solve, each event joins the one cluster whose line under the window's estimated motion "
            "passes within this distance (kept where the first method still answers and the window's cost per "

@@ -468,8 +468,12 @@ WindowRecord SequenceRunner::processWindow(std::uint64_t index, double t0, doubl
       cluster_options.derotate
           ? clusterEvents(derotateEvents(events, bearing, m.calib.camera, motion, 0.5 * (t0 + t1)), cluster_options)
           : clusterEvents(events, cluster_options);
-  splitByMovingLines(events, clusters, bearing, m.calib.camera.focal(), &motion, cluster_options);
+  const LineSplitReport cut =
+      splitByMovingLines(events, clusters, bearing, m.calib.camera.focal(), &motion, cluster_options);
   rec.times.cluster = secondsSince(start);
+  if (cut.n_recovered > 0)
+    spdlog::debug("window {}: {} clusters of {} events recovered from the left-out events (cluster.recover_cell_px)",
+                  index, cut.n_recovered, cut.n_recovered_events);
   const ClusterLosses& left = clusters.left_out;
   rec.n_events_clustered = clusters.n_clustered;
   rec.left_out = left;

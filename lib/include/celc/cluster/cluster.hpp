@@ -23,6 +23,7 @@
 /// region), and what is still not planar is rejected; clusters smaller than
 /// `min_cluster_size` events, shorter than `min_time_span_s` or spatially
 /// shorter than `min_extent_px` are dropped. Their events become noise (-1).
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,14 @@ struct ClusterOptions {
   /// kept, else >= 1. Off: it raises purity without bringing celc_ml nearer
   /// the oracle (docs/decisions.md).
   double line_scale_ratio = 0.0;
+  /// After the cut, the events in no cluster (left out by the growing, its
+  /// checks or the cut) are grouped where they touch on a grid of this cell
+  /// [px] in (x, y, c t), one polarity per group, and each group is cut to
+  /// moving lines the same way (line_split.hpp): low-contrast edges too sparse
+  /// for the growing's neighbourhoods. 0 = not recovered, else >= 1. Off:
+  /// coverage 0.86-0.89 -> 0.93-0.97, but purity falls and celc_ml comes no
+  /// nearer the oracle at 1 m/s (docs/decisions.md).
+  double recover_cell_px = 0.0;
   /// After a first solve, the clusters are redrawn under the window's
   /// estimated motion (motion_reassign.hpp; `celc run` keeps them where the
   /// first method still answers on them and they hold 95% of the events):
@@ -172,6 +181,9 @@ struct ClusterLosses {
   int off_moving_lines = 0;  ///< taken out by the moving-line cut (splitByMovingLines, line_split.hpp)
 };
 
+/// Why one event is in no cluster (ClusterResult::loss): the ClusterLosses
+/// field it is counted in.
+enum class LossReason : std::uint8_t { None, Invalid, NoRegion, SmallRegion, FailedChecks, OffPlanes, OffMovingLines };
 struct ClusterResult {
   ClusterStatus status = ClusterStatus::EmptyWindow;
   std::string message;             ///< reason when not Ok
@@ -182,6 +194,9 @@ struct ClusterResult {
   int n_regions = 0;               ///< regions grown before the checks
   int n_split = 0, n_rejected_planar = 0, n_rejected_small = 0;
   ClusterLosses left_out;          ///< where the unclustered events went
+  /// Per input event, where it went when in no cluster (None when clustered);
+  /// filled by clusterEvents and splitByMovingLines, empty from other producers.
+  std::vector<LossReason> loss;
   /// The smoothness angle the growing used [deg] (the larger of the polarities'
   /// with separate_polarity; ClusterOptions::smoothness_noise_factor).
   double smoothness_deg = 0.0;

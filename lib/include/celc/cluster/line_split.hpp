@@ -25,6 +25,17 @@
 /// parts' medians, at least 0.25 px: whole-pixel rounding) is dropped: a
 /// corner's two edges that one line fits within the threshold spread their
 /// distances across it, where one edge's lie within its noise.
+///
+/// With ClusterOptions::recover_cell_px > 0, the events then in no cluster
+/// (ClusterResult::loss: left out by the growing, its checks or the cut;
+/// not the invalid ones) are grouped where they touch on a grid of that cell
+/// in (x, y, c t), one polarity per group, and each group of at least
+/// min_cluster_size events is cut by the same RANSAC (up to 16 lines). A
+/// line becomes a cluster when it holds min_cluster_size events spanning
+/// min_extent_px and its events' median distance is at most twice the
+/// window's scale (the median of the other parts' medians, at least
+/// 0.25 px): noise events within the threshold of a line spread over it. The
+/// recovered events leave their ClusterLosses fields.
 #include <vector>
 
 #include "celc/cluster/cluster.hpp"
@@ -39,6 +50,8 @@ struct LineSplitReport {
   int n_removed = 0;       ///< events taken out of clusters (no moving line within line_split_px)
   int n_dropped = 0;       ///< clusters left with fewer than min_cluster_size events explained
   int n_wide = 0;          ///< parts dropped by ClusterOptions::line_scale_ratio (their events in n_removed)
+  int n_recovered = 0;         ///< clusters found among the left-out events (ClusterOptions::recover_cell_px)
+  int n_recovered_events = 0;  ///< their events
 };
 
 /// Cuts every cluster of `clusters` to its moving lines (see the file
