@@ -14,6 +14,7 @@
 #   speeds      the same at 1, 3 and 4 m/s (8 scenes, seed 50000, 0.3-3 rad/s): clusters_speeds.md (25 min)
 #   lines       the same on scenes of straight bars only (8 scenes, seed 60000, 1-4 m/s, 0.3-3 rad/s): clusters_lines.md (8 min)
 #   gap         every window of clusters, speeds and lines, pipeline against oracle: images/oracle_gap.png (after them)
+#   seeds       clusters, speeds and lines again at cluster.seed 2 and 3: clusters_seeds.md (50 min after their renders)
 #   derotate    clusters and speeds again with cluster.derotate true: clusters_derotate.md (5 min after their renders)
 #   fast        clusters and speeds again with -c config/fast.yaml: fast.md (4 min after their renders)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
@@ -35,7 +36,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines gap derotate fast acceleration accelerometer studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines gap seeds derotate fast acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -129,6 +130,26 @@ for name in "${names[@]}"; do
       /usr/bin/python3 scripts/plot_oracle_gap.py "$root/docs/images/oracle_gap.png" \
         "seed 30000=$work/clusters/run" "1 m/s=$work/speed1/run" "3 m/s=$work/speed3/run" \
         "4 m/s=$work/speed4/run" "bars, 1-4 m/s=$work/lines/run"
+      ;;
+    seeds)
+      # The same scenes (rendered by clusters, speeds and lines) run again
+      # with other RANSAC seeds of the clustering.
+      sets=("seed 30000=clusters:" "1 m/s=speed1:--seed 50000 --count 8 --speed 1,1 --rate 0.3,3"
+            "3 m/s=speed3:--seed 50000 --count 8 --speed 3,3 --rate 0.3,3"
+            "4 m/s=speed4:--seed 50000 --count 8 --speed 4,4 --rate 0.3,3"
+            "bars, 1-4 m/s=lines:--seed 60000 --count 8 --kinds lines --speed 1,4 --rate 0.3,3")
+      specs=()
+      for entry in "${sets[@]}"; do
+        label="${entry%%=*}" rest="${entry#*=}"
+        dir="${rest%%:*}" draw="${rest#*:}"
+        for s in 2 3; do
+          # shellcheck disable=SC2086  # draw holds several arguments
+          scripts/cluster_table.sh "$work/$dir" $draw --runs "seed$s" -- --set "cluster.seed=$s" > /dev/null
+        done
+        specs+=("$label=$work/$dir/run,$work/$dir/seed2,$work/$dir/seed3")
+      done
+      $py scripts/seed_spread.py "${specs[@]}" |
+        put clusters_seeds.md seeds "scripts/cluster_table.sh [as for clusters, speeds, lines] --runs seedS -- --set cluster.seed=S, S = 2 and 3; scripts/seed_spread.py"
       ;;
     derotate)
       heldout_again derotate clusters_derotate.md --set cluster.derotate=true
