@@ -116,7 +116,7 @@ struct ClusterOptions {
   /// moving lines the same way (line_split.hpp): low-contrast edges too sparse
   /// for the growing's neighbourhoods. 0 = not recovered, else >= 1. Off:
   /// coverage 0.86-0.89 -> 0.93-0.97, but purity falls and celc_ml comes no
-  /// nearer the oracle at 1 m/s (docs/decisions.md).
+  /// nearer the oracle on balance (docs/decisions.md).
   double recover_cell_px = 0.0;
   /// After a first solve, the clusters are redrawn under the window's
   /// estimated motion (motion_reassign.hpp; `celc run` keeps them where the
