@@ -239,7 +239,6 @@ std::vector<bool> widerThanTheWindow(const std::vector<Part>& all, double ratio)
   return wide;
 }
 
-
 /// `idx` (event indices in time order) as points in the reference frame;
 /// `source` gets each point's event (events without a finite bearing are skipped).
 void toLinePoints(const std::vector<Event>& events, const std::vector<int>& idx, const BearingFunction& bearing,
@@ -258,10 +257,11 @@ void toLinePoints(const std::vector<Event>& events, const std::vector<int>& idx,
   }
 }
 
-/// The events in no part (`in_part` 0, of a known LossReason other than
-/// Invalid) in groups connected on a grid of `cell_px` cells in (x, y, c t),
-/// one polarity per group when options.separate_polarity; each group in time
-/// order, groups of fewer than min_cluster_size events dropped.
+/// The events in no part (`in_part` 0; left out for a reason other than
+/// Invalid) in groups connected on a grid of options.recover_cell_px cells in
+/// (x, y, c t) (26 neighbours), one polarity per group when
+/// options.separate_polarity; each group in time order, groups of fewer than
+/// min_cluster_size events dropped.
 std::vector<std::vector<int>> leftOutGroups(const std::vector<Event>& events, const std::vector<char>& in_part,
                                             const ClusterResult& clusters, const ClusterOptions& options) {
   const double cell = options.recover_cell_px;
