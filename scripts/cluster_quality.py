@@ -40,6 +40,29 @@ def within_gap(phi, oracle):
     return phi <= max(1.5 * oracle, oracle + math.radians(1.0))
 
 
+def oracle_windows(rundir, method, script):
+    """(sequence, window, method phi or None when refused, oracle phi) [rad]
+    of every window with an oracle in RUNDIR/<sequence>/windows.csv; exits
+    with a one-line error naming `script` when there is none or a file lacks
+    the truth columns."""
+    files = sorted(glob.glob(os.path.join(rundir, "*", "windows.csv")))
+    if not files:
+        raise SystemExit(f"{script}: {rundir}: no <sequence>/windows.csv")
+    out = []
+    for path in files:
+        name = os.path.basename(os.path.dirname(path))
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            if "oracle_phi" not in (reader.fieldnames or []):
+                raise SystemExit(f"{script}: {path}: no oracle_phi column (a run without truth labels)")
+            for r in reader:
+                if r["method"] != method or r["oracle_phi"] in ("", None):
+                    continue
+                phi = float(r["phi"]) if r["status"] == "ok" and r["phi"] else None
+                out.append((name, int(r["window"]), phi, float(r["oracle_phi"])))
+    return out
+
+
 def one_polarity_edges(seq_dir, spans, min_edge_events=20, share=0.8):
     """Per window span (t_start, t_end) [s]: (edges with at least
     min_edge_events events, of them those whose ON or OFF events are at least

@@ -14,8 +14,6 @@ LABEL; the legend counts each set's windows within the gap. Needs
 python3-matplotlib.
 """
 import argparse
-import csv
-import glob
 import math
 import os
 import sys
@@ -24,6 +22,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cluster_quality import oracle_windows  # noqa: E402
 
 FLOOR_DEG = 0.01
 
@@ -35,21 +36,8 @@ def gap_limit_deg(oracle_deg):
 
 def read_points(rundir, method):
     """(oracle phi, method phi) [deg] of every window with an oracle under rundir."""
-    files = sorted(glob.glob(os.path.join(rundir, "*", "windows.csv")))
-    if not files:
-        raise SystemExit(f"plot_oracle_gap.py: {rundir}: no <sequence>/windows.csv")
-    points = []
-    for path in files:
-        with open(path, newline="") as f:
-            reader = csv.DictReader(f)
-            if "oracle_phi" not in (reader.fieldnames or []):
-                raise SystemExit(f"plot_oracle_gap.py: {path}: no oracle_phi column (a run without truth labels)")
-            for r in reader:
-                if r["method"] != method or r["oracle_phi"] in ("", None):
-                    continue
-                phi = math.degrees(float(r["phi"])) if r["status"] == "ok" and r["phi"] else 180.0
-                points.append((math.degrees(float(r["oracle_phi"])), phi))
-    return points
+    return [(math.degrees(oracle), math.degrees(phi) if phi is not None else 180.0)
+            for _, _, phi, oracle in oracle_windows(rundir, method, "plot_oracle_gap.py")]
 
 
 def main():

@@ -15,37 +15,22 @@ refused window counts as 180 deg), and of those the ones within the gap in
 some runs and beyond it in others.
 """
 import argparse
-import csv
-import glob
 import math
 import os
 import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cluster_quality import within_gap  # noqa: E402
+from cluster_quality import oracle_windows, within_gap  # noqa: E402
 
 REFUSED_DEG = 180.0
 
 
 def read_run(rundir, method):
     """{(sequence, window): (method phi, oracle phi)} [rad] of the windows with an oracle."""
-    files = sorted(glob.glob(os.path.join(rundir, "*", "windows.csv")))
-    if not files:
-        raise SystemExit(f"seed_spread.py: {rundir}: no <sequence>/windows.csv")
-    out = {}
-    for path in files:
-        name = os.path.basename(os.path.dirname(path))
-        with open(path, newline="") as f:
-            reader = csv.DictReader(f)
-            if "oracle_phi" not in (reader.fieldnames or []):
-                raise SystemExit(f"seed_spread.py: {path}: no oracle_phi column (a run without truth labels)")
-            for r in reader:
-                if r["method"] != method or r["oracle_phi"] in ("", None):
-                    continue
-                phi = float(r["phi"]) if r["status"] == "ok" and r["phi"] else math.radians(REFUSED_DEG)
-                out[(name, int(r["window"]))] = (phi, float(r["oracle_phi"]))
-    return out
+    refused = math.radians(REFUSED_DEG)
+    return {(name, w): (phi if phi is not None else refused, oracle)
+            for name, w, phi, oracle in oracle_windows(rundir, method, "seed_spread.py")}
 
 
 def summarise(runs, spread_deg):

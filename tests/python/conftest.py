@@ -6,6 +6,7 @@ The module is imported from the build tree (PYTHONPATH=build/python); the CLI
 import os
 import pathlib
 import subprocess
+import sys
 
 import pytest
 
@@ -22,6 +23,18 @@ def run_cli(*args, cwd=None):
     proc = subprocess.run([CELC_BINARY, *map(str, args)], cwd=cwd, capture_output=True, text=True)
     assert proc.returncode == 0, f"celc {' '.join(map(str, args))} failed:\n{proc.stderr}"
     return proc
+
+
+def run_script(script, *args):
+    """Runs a script of scripts/ with this interpreter; returns the finished process."""
+    return subprocess.run([sys.executable, str(SOURCE_DIR / "scripts" / script), *map(str, args)],
+                          capture_output=True, text=True)
+
+
+def write_windows_run(root, rows, header="window,method,status,phi,oracle_phi\n"):
+    """A run folder of one sequence, root/seq/windows.csv, with the given CSV rows."""
+    (root / "seq").mkdir(parents=True)
+    (root / "seq" / "windows.csv").write_text(header + "".join(rows))
 
 
 @pytest.fixture(scope="session")

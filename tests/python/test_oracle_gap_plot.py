@@ -1,20 +1,13 @@
 """scripts/plot_oracle_gap.py: the held-out windows' pipeline-against-oracle plot."""
-import subprocess
 import sys
 
-from conftest import SOURCE_DIR
+from conftest import SOURCE_DIR, run_script, write_windows_run as write_run
 
 SCRIPT = SOURCE_DIR / "scripts" / "plot_oracle_gap.py"
-HEADER = "window,method,status,phi,oracle_phi\n"
 
 
 def run(*args):
-    return subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True)
-
-
-def write_run(root, rows):
-    (root / "seq").mkdir(parents=True)
-    (root / "seq" / "windows.csv").write_text(HEADER + "".join(rows))
+    return run_script("plot_oracle_gap.py", *args)
 
 
 def test_counts_the_windows_within_the_gap(tmp_path):
@@ -36,8 +29,7 @@ def test_counts_the_windows_within_the_gap(tmp_path):
 
 
 def test_a_run_without_truth_columns_is_an_error(tmp_path):
-    (tmp_path / "r" / "seq").mkdir(parents=True)
-    (tmp_path / "r" / "seq" / "windows.csv").write_text("window,method,status,phi\n0,celc_ml,ok,0.1\n")
+    write_run(tmp_path / "r", ["0,celc_ml,ok,0.1\n"], header="window,method,status,phi\n")
     proc = run(tmp_path / "x.png", f"r={tmp_path / 'r'}")
     assert proc.returncode != 0 and "no oracle_phi column" in proc.stderr
     proc = run(tmp_path / "x.png", f"none={tmp_path / 'missing'}")

@@ -1,20 +1,9 @@
 """scripts/seed_spread.py: the oracle-gap counts of one set over runs with different seeds."""
-import subprocess
-import sys
-
-from conftest import SOURCE_DIR
-
-SCRIPT = SOURCE_DIR / "scripts" / "seed_spread.py"
-HEADER = "window,method,status,phi,oracle_phi\n"
+from conftest import run_script, write_windows_run as write_run
 
 
 def run(*args):
-    return subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True)
-
-
-def write_run(root, rows):
-    (root / "seq").mkdir(parents=True)
-    (root / "seq" / "windows.csv").write_text(HEADER + "".join(rows))
+    return run_script("seed_spread.py", *args)
 
 
 def test_counts_each_run_and_the_windows_that_move(tmp_path):
@@ -41,7 +30,6 @@ def test_bad_arguments_are_errors(tmp_path):
     assert proc.returncode != 0 and "at least two runs" in proc.stderr
     proc = run(str(tmp_path / "a"))
     assert proc.returncode != 0 and "LABEL=RUNDIR" in proc.stderr
-    (tmp_path / "b" / "seq").mkdir(parents=True)
-    (tmp_path / "b" / "seq" / "windows.csv").write_text("window,method,status,phi\n0,celc_ml,ok,0.1\n")
+    write_run(tmp_path / "b", ["0,celc_ml,ok,0.1\n"], header="window,method,status,phi\n")
     proc = run(f"x={tmp_path / 'a'},{tmp_path / 'b'}")
     assert proc.returncode != 0 and "no oracle_phi column" in proc.stderr
