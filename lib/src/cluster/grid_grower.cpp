@@ -41,10 +41,13 @@ GridIndex::GridIndex(const Group& g) {
   std::vector<int> fill(start_.begin(), start_.end() - 1);
   point_.resize(n);
   cells_.resize(n);
-  for (int i : by_time) {
+  by_time_.resize(n);
+  for (size_t j = 0; j < n; ++j) {
+    const int i = by_time[j];
     const int k = fill[pix[i]]++;
     point_[k] = i;
     cells_[k] = {g.t[i], static_cast<int16_t>(pix[i] % w_), static_cast<int16_t>(pix[i] / w_)};
+    by_time_[j] = k;
   }
 }
 
@@ -87,6 +90,24 @@ bool normalFromCovariance(const Eigen::Matrix3d& cov, float* out_n, float* out_c
 
 }  // namespace
 
+bool normalFromSums(const double s[10], double c, int min_neighbours, float* out_n, float* out_curv) {
+  *out_curv = 2.0f;
+  const double s0 = s[0];
+  if (s0 < min_neighbours) return false;
+  // Central moments of (dx, dy, c t).
+  const double mx = s[1] / s0, my = s[2] / s0, mt = s[6] / s0;
+  Eigen::Matrix3d cov;
+  cov(0, 0) = s[3] / s0 - mx * mx;
+  cov(0, 1) = cov(1, 0) = s[4] / s0 - mx * my;
+  cov(1, 1) = s[5] / s0 - my * my;
+  cov(0, 2) = cov(2, 0) = c * (s[8] / s0 - mx * mt);
+  cov(1, 2) = cov(2, 1) = c * (s[9] / s0 - my * mt);
+  cov(2, 2) = c * c * std::max(0.0, s[7] / s0 - mt * mt);
+  if (normalFromCovariance(cov, out_n, out_curv)) return true;
+  *out_curv = 2.0f;
+  return false;
+}
+
 bool GridIndex::normal(int k, double c, const ClusterOptions& opt, float* out_n,
                        float* out_curv) const {
   float s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
@@ -128,74 +149,59 @@ void GridIndex::allNormals(double c, const ClusterOptions& opt, int threads, flo
     double t, tt;
   };
   std::vector<Prefix> pre(n + 1, Prefix{0.0, 0.0});
-  std::vector<float> ts(n + 1, std::numeric_limits<float>::infinity());
-  for (size_t k = 0; k < n; ++k) ts[k] = cells_[k].t;
   for (size_t k = 0; k < n; ++k) {
     const double t = cells_[k].t;
     pre[k + 1] = {pre[k].t + t, pre[k].tt + t * t};
   }
+  // The normals of the events of pixels p_begin .. p_end - 1.
   auto work = [&](int p_begin, int p_end) {
-    constexpr int kMaxNb = 121;  // (2 * 5 + 1)^2, grid_radius_px <= 5
-    int lo[kMaxNb], hi[kMaxNb], end[kMaxNb];
-    double dx[kMaxNb], dy[kMaxNb], dxx[kMaxNb], dxy[kMaxNb], dyy[kMaxNb];
-    double M[kMaxNb], T[kMaxNb], TT[kMaxNb];
-    for (int p = p_begin; p < p_end; ++p) {
-      const int b = start_[p], e = start_[p + 1];
-      if (b == e) continue;
-      const int px = p % w_, py = p / w_;
-      int m = 0;
-      for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); ++y)
-        for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); ++x) {
-          const int q = y * w_ + x;
-          if (start_[q] == start_[q + 1]) continue;
-          lo[m] = hi[m] = start_[q];
-          end[m] = start_[q + 1];
-          dx[m] = x - px, dy[m] = y - py;
-          dxx[m] = dx[m] * dx[m], dxy[m] = dx[m] * dy[m], dyy[m] = dy[m] * dy[m];
-          ++m;
-        }
-      int last = -1;  // last event of this pixel whose normal was computed
-      for (int k = b; k < e; ++k) {
-        const float tk = cells_[k].t;
-        // An event right after one of the same pixel shares its neighbourhood
-        // (within reuse_dt): take its normal instead of recomputing it.
-        if (last >= 0 && tk - cells_[last].t <= reuse_dt) {
-          std::copy_n(&nrm[3 * static_cast<size_t>(last)], 3, &nrm[3 * static_cast<size_t>(k)]);
-          curv[k] = curv[last];
-          continue;
-        }
-        last = k;
-        const float t_hi = static_cast<float>(tk + tau), t_lo = static_cast<float>(tk - tau);
-        for (int i = 0; i < m; ++i) {
-          int h = hi[i], l = lo[i];
-          const int en = end[i];
-          while (h < en && ts[h] <= t_hi) ++h;
-          while (l < h && ts[l] < t_lo) ++l;
-          hi[i] = h, lo[i] = l;
-          M[i] = h - l;
-          T[i] = pre[h].t - pre[l].t;
-          TT[i] = pre[h].tt - pre[l].tt;
-        }
-        // Sums over the neighbourhood: count, dx, dy, dx^2, dx dy, dy^2, t, t^2, dx t, dy t.
-        double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0, s9 = 0;
-        for (int i = 0; i < m; ++i) {
-          s0 += M[i], s1 += dx[i] * M[i], s2 += dy[i] * M[i], s3 += dxx[i] * M[i];
-          s4 += dxy[i] * M[i], s5 += dyy[i] * M[i], s6 += T[i], s7 += TT[i];
-          s8 += dx[i] * T[i], s9 += dy[i] * T[i];
-        }
-        curv[k] = 2.0f;
-        if (s0 < opt.min_neighbours) continue;
-        // Central moments of (dx, dy, c t).
-        const double mx = s1 / s0, my = s2 / s0, mt = s6 / s0;
-        Eigen::Matrix3d cov;
-        cov(0, 0) = s3 / s0 - mx * mx;
-        cov(0, 1) = cov(1, 0) = s4 / s0 - mx * my;
-        cov(1, 1) = s5 / s0 - my * my;
-        cov(0, 2) = cov(2, 0) = c * (s8 / s0 - mx * mt);
-        cov(1, 2) = cov(2, 1) = c * (s9 / s0 - my * mt);
-        cov(2, 2) = c * c * std::max(0.0, s7 / s0 - mt * mt);
-        if (!normalFromCovariance(cov, &nrm[3 * static_cast<size_t>(k)], &curv[k])) curv[k] = 2.0f;
+    // Per pixel, its run within the current event's time window: bucket
+    // positions [lo, hi), the events with t_lo <= t <= t_hi. Both only grow,
+    // as the sweep's time does. `last`: the pixel's last event whose normal
+    // was computed.
+    std::vector<int> lo(start_.begin(), start_.end() - 1), hi(lo), last(static_cast<size_t>(n_pix), -1);
+    size_t entered = 0, left = 0;  // sweep positions in by_time_
+    for (size_t j = 0; j < n; ++j) {
+      const int k = by_time_[j];
+      const Cell& ck = cells_[k];
+      const int p = ck.y * w_ + ck.x;
+      if (p < p_begin || p >= p_end) continue;
+      const float tk = ck.t;
+      // An event right after one of the same pixel shares its neighbourhood
+      // (within reuse_dt): take its normal instead of recomputing it.
+      const int prev = last[static_cast<size_t>(p)];
+      if (prev >= 0 && tk - cells_[prev].t <= reuse_dt) {
+        std::copy_n(&nrm[3 * static_cast<size_t>(prev)], 3, &nrm[3 * static_cast<size_t>(k)]);
+        curv[k] = curv[prev];
+        continue;
       }
+      last[static_cast<size_t>(p)] = k;
+      const float t_hi = static_cast<float>(tk + tau), t_lo = static_cast<float>(tk - tau);
+      for (; entered < n && cells_[by_time_[entered]].t <= t_hi; ++entered) {
+        const Cell& q = cells_[by_time_[entered]];
+        ++hi[static_cast<size_t>(q.y * w_ + q.x)];
+      }
+      for (; left < n && cells_[by_time_[left]].t < t_lo; ++left) {
+        const Cell& q = cells_[by_time_[left]];
+        ++lo[static_cast<size_t>(q.y * w_ + q.x)];
+      }
+      // Sums over the neighbourhood (normalFromSums' order); a pixel without
+      // events in the window adds exact zeros.
+      double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0, s9 = 0;
+      for (int y = std::max(0, ck.y - r); y <= std::min(h_ - 1, ck.y + r); ++y) {
+        const double dy = y - ck.y;
+        for (int x = std::max(0, ck.x - r); x <= std::min(w_ - 1, ck.x + r); ++x) {
+          const size_t q = static_cast<size_t>(y) * w_ + x;
+          const int l = lo[q], h = hi[q];
+          const double dx = x - ck.x;
+          const double M = h - l, T = pre[h].t - pre[l].t, TT = pre[h].tt - pre[l].tt;
+          s0 += M, s1 += dx * M, s2 += dy * M, s3 += dx * dx * M;
+          s4 += dx * dy * M, s5 += dy * dy * M, s6 += T, s7 += TT;
+          s8 += dx * T, s9 += dy * T;
+        }
+      }
+      const double sums[10] = {s0, s1, s2, s3, s4, s5, s6, s7, s8, s9};
+      normalFromSums(sums, c, opt.min_neighbours, &nrm[3 * static_cast<size_t>(k)], &curv[k]);
     }
   };
   threads = std::max(1, std::min(threads, static_cast<int>(size() / 4096) + 1));

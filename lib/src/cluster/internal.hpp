@@ -109,10 +109,13 @@ class GridIndex {
   /// one spot or one line).
   bool normal(int k, double c, const ClusterOptions& opt, float* out_n, float* out_curv) const;
 
-  /// The same for every event at once (no per-pixel cap), in O(events x window
-  /// pixels) by sliding time windows: per pixel, its events in time order, and
-  /// per neighbouring pixel two pointers that add and remove events from running
-  /// moment sums. nrm: 3 per event, curvature 2 where degenerate.
+  /// The same for every event at once (no per-pixel cap): one sweep over the
+  /// events in time order keeps, per pixel, the run of its bucket within
+  /// +-time_radius_px / c of the current event (two counts that only grow), and
+  /// the moments of a run are differences of prefix sums over the buckets. Each
+  /// event then reads its (2r+1)^2 pixels' runs, without a search. Pixels are
+  /// split into `threads` ranges of about equal events; the result does not
+  /// depend on `threads`. nrm: 3 per event, curvature 2 where degenerate.
   void allNormals(double c, const ClusterOptions& opt, int threads, float* nrm, float* curv) const;
 
  private:
@@ -120,7 +123,15 @@ class GridIndex {
   std::vector<int> start_;   ///< w*h + 1 bucket starts
   std::vector<int> point_;   ///< bucket position -> group index
   std::vector<Cell> cells_;  ///< in bucket order
+  std::vector<int> by_time_; ///< bucket positions in time order (ties: the group's order)
 };
+
+/// Plane normal and curvature lambda_min / sum(lambda) of a neighbourhood in
+/// (dx, dy, t) from its sums, in this order: count, dx, dy, dx^2, dx dy, dy^2,
+/// t, t^2, dx t, dy t [px, s]; c [px/s] scales t. False, curvature 2 and the
+/// normal not written, with fewer than min_neighbours events or a degenerate
+/// spread (one spot, one line).
+bool normalFromSums(const double s[10], double c, int min_neighbours, float* nrm, float* curv);
 
 /// Normals (3 per event) and curvatures (2 = none) in bucket order.
 struct GridNormals {
