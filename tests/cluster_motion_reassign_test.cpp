@@ -6,6 +6,8 @@
 
 #include <map>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "celc/cluster/motion_reassign.hpp"
 #include "celc/cluster/synthetic.hpp"
@@ -176,15 +178,18 @@ TEST(MotionReassign, OffOrWithoutAVelocityLeavesTheLabels) {
 // Lines fitted once (fitMotionLines: the cost of a redraw's result, which
 // the next redraw starts from) give the redraw the lines it would fit
 // itself: the same labels, counts and cost, with fragments joined (1 px) and
-// without; lines of other labels or another v are not taken.
+// without, on one thread (where the redraw's pass sums the cost before) and
+// two; lines of other labels or another v are not taken.
 TEST(MotionReassign, PrefittedLinesGiveTheSameRedraw) {
   const LabelledWindow w = window(6);
   const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
   const auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
   const Vec3 v = w.v.normalized();
-  for (double join_px : {0.0, 1.0}) {
+  for (const auto& [join_px, threads] : {std::pair{0.0, 1}, {0.0, 2}, {1.0, 1}, {1.0, 2}}) {
+    SCOPED_TRACE("join " + std::to_string(join_px) + ", threads " + std::to_string(threads));
     ClusterOptions options;
     options.motion_join_px = join_px;
+    options.threads = threads;
     const std::vector<int> start = corrupted(w, 6);
     std::vector<int> fitted = start, prefitted = start;
     const MotionReassignReport a =

@@ -187,25 +187,27 @@ double medianDistance(const std::vector<MotionPoint>& pts, const MotionLine& lin
 
 /// Sorts keys ascending, the order std::sort gives: LSD radix passes of 11
 /// bits, each a stable counting sort, over the bits some key sets (a
-/// window's cell-and-group marks use about 40 of 64).
-void sortKeys(std::vector<std::uint64_t>& keys) {
+/// window's cell-and-group marks use about 40 of 64, its cells about 27 of 32).
+template <class Key>
+void sortKeys(std::vector<Key>& keys) {
   if (keys.size() < 1024) {
     std::sort(keys.begin(), keys.end());
     return;
   }
-  std::uint64_t used = 0;
-  for (std::uint64_t k : keys) used |= k;
-  std::vector<std::uint64_t> moved(keys.size());
+  constexpr int kBits = 8 * static_cast<int>(sizeof(Key));
+  Key used = 0;
+  for (Key k : keys) used |= k;
+  std::vector<Key> moved(keys.size());
   std::vector<std::size_t> start(2049);
-  for (int shift = 0; shift < 64;) {
+  for (int shift = 0; shift < kBits;) {
     if (((used >> shift) & 1u) == 0) {
       ++shift;
       continue;
     }
     std::fill(start.begin(), start.end(), 0);
-    for (std::uint64_t k : keys) ++start[((k >> shift) & 2047u) + 1];
+    for (Key k : keys) ++start[((k >> shift) & 2047u) + 1];
     for (std::size_t d = 1; d < start.size(); ++d) start[d] += start[d - 1];
-    for (std::uint64_t k : keys) moved[start[(k >> shift) & 2047u]++] = k;
+    for (Key k : keys) moved[start[(k >> shift) & 2047u]++] = k;
     keys.swap(moved);
     shift += 11;
   }
@@ -379,13 +381,19 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
                                            MotionLines* prefit) {
   MotionReassignReport report;
   std::unique_ptr<MotionLinesFit> taken;
+  // The cost of the clusters before (windowCost) is summed in event order:
+  // on one thread and without joins the redraw's own pass over the events
+  // adds it up, each event's point computed once for both.
+  const std::size_t parts = static_cast<std::size_t>(std::max(1, options.threads));
+  bool cost_in_pass = false;
   if (prefit && prefit->fittedFor(labels, v)) {
     report.cost = prefit->cost();
     taken = MotionLinesAccess::take(*prefit);
   } else {
     taken = std::make_unique<MotionLinesFit>();
     if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, taken->w)) return report;
-    report.cost = windowCost(events, labels, bearing, taken->w);
+    cost_in_pass = parts == 1 && !(options.motion_join_px > 0.0);
+    if (!cost_in_pass) report.cost = windowCost(events, labels, bearing, taken->w);
   }
   WindowLines& w = taken->w;
   const double threshold = w.threshold;
@@ -487,7 +495,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
     if (!groups[a].explained) continue;
     std::vector<std::uint32_t> cells;
     for (int i : groups[a].events) cells.push_back(cellOf(events[static_cast<std::size_t>(i)]));
-    std::sort(cells.begin(), cells.end());
+    sortKeys(cells);
     cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     for (std::uint32_t c : cells)
       for (int dt = -1; dt <= 1; ++dt)
@@ -519,16 +527,34 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
   struct Counts {
     int moved = 0, ambiguous = 0, removed = 0;
   };
-  const std::size_t parts = static_cast<std::size_t>(std::max(1, options.threads));
   std::vector<Counts> counts(parts);
+  double cost_sum = 0.0;  // windowCost's sum and count, with cost_in_pass
+  std::size_t cost_events = 0;
   parallelFor(parts, options.threads, [&](std::size_t part) {
     Counts& count = counts[part];
     const std::size_t i_end = events.size() * (part + 1) / parts;
     for (std::size_t i = events.size() * part / parts; i < i_end; ++i) {
       const Event& e = events[i];
+      if (!std::isfinite(e.t)) continue;
+      MotionPoint p;
+      int have_point = -1;  // -1: not computed yet, else whether pointOf gave one
+      auto point = [&] {
+        if (have_point < 0) have_point = pointOf(events, bearing, w, static_cast<int>(i), p) ? 1 : 0;
+        return have_point == 1;
+      };
+      if (cost_in_pass) {  // windowCost's term of this event (labels are the groups: no joins)
+        ++cost_events;
+        const int l = labels[i];
+        if (l < 0 || !groups[l].fitted || !point()) {
+          cost_sum += 1.0;
+        } else {
+          const double r = groups[l].line.distance(p) / threshold;
+          cost_sum += std::min(r * r, 1.0);
+        }
+      }
       const int current = labels[i] >= 0 ? label_of[labels[i]] : -1;
-      if (current < 0 || !std::isfinite(e.t)) continue;  // unclustered events stay noise
-      if (!groups[current].explained) {                  // left as it was
+      if (current < 0) continue;           // unclustered events stay noise
+      if (!groups[current].explained) {  // left as it was
         out[i] = current;
         continue;
       }
@@ -536,8 +562,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
       int best = -1;
       double d1 = std::numeric_limits<double>::infinity(), d2 = d1, d_current = d1;
       if (it != range.end()) {
-        MotionPoint p;
-        if (pointOf(events, bearing, w, static_cast<int>(i), p)) {
+        if (point()) {
           for (std::uint32_t k = it->second.first; k < it->second.second; ++k) {
             const int a = static_cast<int>(marks[k] & 0xffffffffu);
             const Group& g = groups[a];
@@ -560,6 +585,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
       }
     }
   });
+  if (cost_in_pass) report.cost = cost_events > 0 ? cost_sum / static_cast<double>(cost_events) : NAN;
   for (const Counts& c : counts) {
     report.n_moved += c.moved;
     report.n_ambiguous += c.ambiguous;
