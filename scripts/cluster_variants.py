@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where a window's gap to the oracle comes from: its clusters changed one way at a time.
 
-usage: cluster_variants.py RUNDIR SEQDIR [--method celc_ml] [--windows 0,3]
+usage: cluster_variants.py RUNDIR SEQDIR [--method celc_ml] [--windows 0,3] [--per-edge]
 
 RUNDIR is a `celc run SEQDIR -o RUNDIR --dump-windows RUNDIR/windows` of a
 `celc synth` sequence (SEQDIR holds events.txt and labels.txt). Each dumped
@@ -26,8 +26,11 @@ run's own, up to the undistortion table's rounding, which can tip a window
 whose basins are tied: docs/running.md), the share of edge events the run
 clustered, then how many windows each labelling puts within the oracle gap
 (max(1.5x, +1 deg)), and of those beyond it with the pipeline's clusters,
-how many each brings within it. Needs
-Debian's python3 only.
+how many each brings within it. With --per-edge, also each edge that is
+the majority of several clusters on its own: the run's clusters with only
+that edge's joined, which tells the edges whose fragments decide a window
+(a window whose basins are tied tips on one edge). Needs Debian's python3
+only.
 """
 import argparse
 import csv
@@ -83,12 +86,24 @@ def solve(script, csv_path, variant_path, method):
     return None
 
 
+def solve_labelling(script, csv_path, header, events, labels, method, tmp, name):
+    """The method's unit velocity on the window's events under `labels` (None if refused)."""
+    path = os.path.join(tmp, f"{name}.csv")
+    with open(path, "w") as f:
+        f.write(",".join(header) + "\n")
+        for ev, c in zip(events, labels):
+            f.write(f"{ev[0]},{ev[1]},{ev[2]},{c}\n")
+    return solve(script, csv_path, path, method)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("rundir")
     ap.add_argument("seqdir")
     ap.add_argument("--method", default="celc_ml")
     ap.add_argument("--windows", help="comma-separated window indices (default: every dumped window)")
+    ap.add_argument("--per-edge", action="store_true",
+                    help="also solve with one edge's clusters joined at a time (each edge with several)")
     a = ap.parse_args()
     dump = os.path.join(os.path.abspath(a.rundir), "windows")
     scripts = sorted(glob.glob(os.path.join(dump, "window_*.sh")))
@@ -105,6 +120,7 @@ def main():
     print(f"| window | run phi | oracle phi | " + " | ".join(names) + " | edge events clustered |")
     print("|---" * (len(names) + 4) + "|")
     beyond, within = Counter(), Counter()
+    per_edge = []  # (window, edge, clusters, its events in them, phi, the run within the gap)
     n_beyond = n_windows = 0
     for script in scripts:
         w = int(os.path.basename(script)[len("window_"):-len(".sh")])
@@ -140,17 +156,25 @@ def main():
         n_edge = sum(1 for e in edge if e >= 0)
         kept = sum(1 for c, e in zip(cluster, edge) if c >= 0 and e >= 0)
         phis = {}
-        with tempfile.TemporaryDirectory() as tmp:
-            for name, cl in variants.items():
-                path = os.path.join(tmp, f"{name}.csv")
-                with open(path, "w") as f:
-                    f.write(",".join(header) + "\n")
-                    for ev, c in zip(events, cl):
-                        f.write(f"{ev[0]},{ev[1]},{ev[2]},{c}\n")
-                v = solve(script, csv_path, path, a.method)
-                phis[name] = angle(v, gt) if v else math.pi
         run_phi = float(r["phi"]) if r["phi"] else math.pi
         oracle = float(r["oracle_phi"])
+        with tempfile.TemporaryDirectory() as tmp:
+            for name, cl in variants.items():
+                v = solve_labelling(script, csv_path, header, events, cl, a.method, tmp, name)
+                phis[name] = angle(v, gt) if v else math.pi
+            if a.per_edge:
+                of_edge = defaultdict(list)  # edge -> the clusters it is the majority of
+                for c, e in sorted(majority.items()):
+                    if e >= 0:
+                        of_edge[e].append(c)
+                for e, cs in sorted(of_edge.items()):
+                    if len(cs) < 2:
+                        continue
+                    members = set(cs)
+                    cl = [cs[0] if c in members else c for c in cluster]
+                    v = solve_labelling(script, csv_path, header, events, cl, a.method, tmp, "edge")
+                    per_edge.append((w, e, len(cs), sum(counts[c][e] for c in cs), angle(v, gt) if v else math.pi,
+                                     within_gap(run_phi, oracle)))
         deg = lambda x: "%.2f" % math.degrees(x)
         print(f"| {w} | {deg(run_phi)} | {deg(oracle)} | " + " | ".join(deg(phis[n]) for n in names) +
               f" | {kept / n_edge if n_edge else math.nan:.2f} |")
@@ -166,6 +190,21 @@ def main():
     print(f"Within the oracle gap, of {n_windows} windows: " + ", ".join(f"{n} {within[n]}" for n in names))
     print(f"Windows where the pipeline's clusters are beyond the oracle gap: {n_beyond}; brought within it by "
           + ", ".join(f"{n} {beyond[n]}" for n in names[1:]))
+    if a.per_edge:
+        oracle_of = {int(w): float(r["oracle_phi"]) for w, r in rows.items() if r["oracle_phi"]}
+        print()
+        print("One edge's clusters joined, the others as the run drew them:")
+        print("| window | edge | its clusters | its events in them | phi [deg] | within the gap |")
+        print("|---|---|---|---|---|---|")
+        for w, e, n, events_in, phi, _ in per_edge:
+            print(f"| {w} | {e} | {n} | {events_in} | {math.degrees(phi):.2f} | "
+                  f"{'yes' if within_gap(phi, oracle_of[w]) else 'no'} |")
+        beyond_windows = sorted({w for w, *_, run_within in per_edge if not run_within})
+        brought = sorted({w for w, e, n, k, phi, run_within in per_edge
+                          if not run_within and within_gap(phi, oracle_of[w])})
+        print(f"Edges with several clusters: {len(per_edge)}; windows beyond the gap with such an edge: "
+              f"{len(beyond_windows)}, brought within it by joining one edge's clusters: {len(brought)}"
+              + (f" (windows {', '.join(map(str, brought))})" if brought else ""))
 
 
 if __name__ == "__main__":

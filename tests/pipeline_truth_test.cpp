@@ -77,7 +77,10 @@ TEST(RunTruth, SampleWindowsCarryClusterQualityAndTheOracle) {
 // its `celc solve` command, so its "pipeline" column is the run's phi (the
 // dump's contract) and its "true_all" column, celc_ml on the true edges with
 // the same seed, is the oracle's phi (0.5 deg allowed: the script finds an
-// event's label by its pixel and microsecond, the run by its index).
+// event's label by its pixel and microsecond, the run by its index). With
+// --per-edge it also solves each edge of several clusters with only those
+// joined: the sample has such edges, and like every labelling there they
+// stay within a few degrees.
 TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   const fs::path d = test::freshTempDir("run_truth_scripts");
   const fs::path run = d / "sample_seq";
@@ -105,7 +108,7 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   EXPECT_LE(one, counted);
 
   const auto variants = test::runShell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/cluster_variants.py' '" + run.string() +
-                              "' '" CELC_SOURCE_DIR "/data/sample_seq'");
+                              "' '" CELC_SOURCE_DIR "/data/sample_seq' --per-edge");
   ASSERT_EQ(variants.status, 0) << variants.out;
   std::istringstream lines(variants.out);
   std::string row_text;
@@ -131,6 +134,27 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   EXPECT_EQ(rows, 2) << variants.out;
   EXPECT_NE(variants.out.find("Windows where the pipeline's clusters are beyond the oracle gap: 0"),
             std::string::npos)
+      << variants.out;
+  // The per-edge table: | window | edge | its clusters | its events in them | phi [deg] | within the gap |
+  const std::size_t edge_table = variants.out.find("One edge's clusters joined");
+  ASSERT_NE(edge_table, std::string::npos) << variants.out;
+  std::istringstream edge_lines(variants.out.substr(edge_table));
+  int edge_rows = 0;
+  while (std::getline(edge_lines, row_text)) {
+    int w, edge, clusters, events_in;
+    double phi;
+    char within[4] = {};
+    if (std::sscanf(row_text.c_str(), "| %d | %d | %d | %d | %lf | %3s |", &w, &edge, &clusters, &events_in, &phi,
+                    within) != 6)
+      continue;
+    ++edge_rows;
+    EXPECT_EQ(ml.count(w), 1u) << row_text;
+    EXPECT_GE(clusters, 2) << row_text;
+    EXPECT_GT(events_in, 0) << row_text;
+    EXPECT_LT(phi, 5.0) << row_text;
+  }
+  EXPECT_GE(edge_rows, 1) << variants.out;
+  EXPECT_NE(variants.out.find("Edges with several clusters: " + std::to_string(edge_rows) + ";"), std::string::npos)
       << variants.out;
   fs::remove_all(d);
 }
