@@ -315,8 +315,18 @@ bool fitWindowLines(const std::vector<Event>& events, const std::vector<int>& la
 
 namespace {
 
-/// The mean over the events with a finite time of min((d / T)^2, 1) (1 for an
-/// event in no fitted cluster), the clusters' lines in `w`.
+/// One event's term of windowCost: min((d / T)^2, 1) to the line of its
+/// cluster `l`; 1 in no fitted cluster or without a point (`p` null). Whether
+/// the term needs the event's point: costNeedsPoint.
+bool costNeedsPoint(const WindowLines& w, int l) { return l >= 0 && w.groups[l].fitted; }
+double costTerm(const WindowLines& w, int l, const MotionPoint* p) {
+  if (!p || !costNeedsPoint(w, l)) return 1.0;
+  const double r = w.groups[l].line.distance(*p) / w.threshold;
+  return std::min(r * r, 1.0);
+}
+
+/// The mean over the events with a finite time of costTerm, the clusters'
+/// lines in `w`.
 double windowCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
                   const WindowLines& w) {
   double sum = 0.0;
@@ -326,12 +336,8 @@ double windowCost(const std::vector<Event>& events, const std::vector<int>& labe
     ++n;
     const int l = labels[i];
     MotionPoint p;
-    if (l < 0 || !w.groups[l].fitted || !pointOf(events, bearing, w, static_cast<int>(i), p)) {
-      sum += 1.0;
-      continue;
-    }
-    const double r = w.groups[l].line.distance(p) / w.threshold;
-    sum += std::min(r * r, 1.0);
+    const bool have = costNeedsPoint(w, l) && pointOf(events, bearing, w, static_cast<int>(i), p);
+    sum += costTerm(w, l, have ? &p : nullptr);
   }
   return n > 0 ? sum / static_cast<double>(n) : NAN;
 }
@@ -545,12 +551,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
       if (cost_in_pass) {  // windowCost's term of this event (labels are the groups: no joins)
         ++cost_events;
         const int l = labels[i];
-        if (l < 0 || !groups[l].fitted || !point()) {
-          cost_sum += 1.0;
-        } else {
-          const double r = groups[l].line.distance(p) / threshold;
-          cost_sum += std::min(r * r, 1.0);
-        }
+        cost_sum += costTerm(w, l, costNeedsPoint(w, l) && point() ? &p : nullptr);
       }
       const int current = labels[i] >= 0 ? label_of[labels[i]] : -1;
       if (current < 0) continue;           // unclustered events stay noise
