@@ -164,5 +164,57 @@ TEST(GridNormals, AnEdgesEventsGetTheNormalOfTheSurfaceItSweeps) {
   EXPECT_LT(angles[angles.size() / 2], 5.0);
 }
 
+// The growing's low-curvature events: each region is a connected component of
+// the graph whose edges are the pairs sweepPairs gives with both ends below
+// the curvature threshold and normals within the growing angle. Found here by
+// a breadth-first search over the pairs, against growGrid's union-find (whose
+// roots follow the unions it makes pair by pair).
+TEST(GridGrowing, LowCurvatureRegionsAreTheComponentsOfSimilarNeighbours) {
+  const detail::Group g = movingEdges(13, 30000, 150.0f);
+  const GridIndex index(g);
+  const double c = 150.0;
+  const ClusterOptions opt;
+  detail::GridNormals normals = detail::computeGridNormals(index, c, opt, 1);
+  const detail::Regions regions = detail::growGrid(index, c, opt, 1, &normals);
+  const float cos_thr = static_cast<float>(std::cos(regions.smoothness_deg * M_PI / 180.0));
+  const size_t n = index.size();
+  auto low = [&](size_t k) { return normals.curv[k] < static_cast<float>(opt.curvature_threshold); };
+  std::vector<std::vector<int>> adjacent(n);
+  index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, [](int) { return true; }, [&](int k, int j) {
+    const float* a = &normals.nrm[3 * size_t(k)];
+    const float* b = &normals.nrm[3 * size_t(j)];
+    if (low(k) && low(j) && std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) >= cos_thr) {
+      adjacent[k].push_back(j);
+      adjacent[j].push_back(k);
+    }
+  });
+  std::vector<int> component(n, -1);
+  int components = 0;
+  for (size_t s = 0; s < n; ++s) {
+    if (!low(s) || component[s] >= 0) continue;
+    std::vector<int> queue{static_cast<int>(s)};
+    component[s] = components;
+    for (size_t q = 0; q < queue.size(); ++q)
+      for (int j : adjacent[queue[q]])
+        if (component[j] < 0) component[j] = components, queue.push_back(j);
+    ++components;
+  }
+  ASSERT_GT(components, 3);
+  // The same partition: one region per component and one component per region.
+  std::map<int, int> region_of_component, component_of_region;
+  size_t low_events = 0;
+  for (size_t k = 0; k < n; ++k) {
+    if (!low(k)) continue;
+    ++low_events;
+    const int region = regions.label[index.point(k)];
+    ASSERT_GE(region, 0) << "event " << k;
+    const auto [a, fresh_a] = region_of_component.try_emplace(component[k], region);
+    const auto [b, fresh_b] = component_of_region.try_emplace(region, component[k]);
+    ASSERT_EQ(a->second, region) << "event " << k;
+    ASSERT_EQ(b->second, component[k]) << "event " << k;
+  }
+  EXPECT_GT(low_events, n / 2);
+}
+
 }  // namespace
 }  // namespace celc

@@ -93,6 +93,8 @@ double recoveredShare(const celc::LabelledWindow& w, const celc::ClusterResult& 
   return w.n_lines() ? static_cast<double>(rec) / w.n_lines() : 0.0;
 }
 
+/// Arguments: the window's events, and cluster.threads (`celc run --threads 2`
+/// clusters two windows at once, each on one thread; a window alone on two).
 /// `line_split`: each cluster cut to its moving lines; `redraw`: then the
 /// clusters redrawn under the window's true velocity (motion_reassign.hpp),
 /// the stage `celc run` adds after a first solve.
@@ -100,7 +102,7 @@ void runCluster(benchmark::State& state, celc::ClusterMethod method, bool line_s
   const celc::LabelledWindow& w = window(static_cast<int>(state.range(0)));
   celc::ClusterOptions opt;
   opt.method = method;
-  opt.threads = 2;
+  opt.threads = state.range(1) > 0 ? static_cast<int>(state.range(1)) : 2;
   celc::ClusterResult r;
   long long peak_extra = 0;
   double cpu_ms = 0.0;
@@ -155,7 +157,7 @@ void BM_ClusterGridRedraw(benchmark::State& state) { runCluster(state, celc::Clu
 
 }  // namespace
 
-BENCHMARK(BM_ClusterGrid)->Arg(1000000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_ClusterGridLineSplit)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_ClusterGridRedraw)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_ClusterPcl)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_ClusterGrid)->Args({1000000, 2})->Args({1000000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_ClusterGridLineSplit)->Args({1000000, 2})->Args({1000000, 1})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_ClusterGridRedraw)->Args({1000000, 2})->Args({1000000, 1})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_ClusterPcl)->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);

@@ -274,12 +274,21 @@ Regions growGrid(const GridIndex& index, double c, const ClusterOptions& opt, in
     return std::fabs(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) >= cos_thr;
   };
   auto valid = [&](int k) { return curv[k] <= 1.0f; };  // pairs with an invalid k change nothing
+  // A root is its component's smallest index (the larger root is linked under
+  // the smaller), so the regions do not depend on the order of the unions.
+  // sweepPairs gives k's pairs one after another: k's root is found once per
+  // k and follows k's own unions.
+  int root_of = -1, root = -1;  // the event whose root is held, and that root
   index.sweepPairs(opt.grow_radius_px, opt.grow_time_radius_px / c, valid, [&](int k, int j) {
     const bool lk = curv[k] < curv_thr, lj = curv[j] < curv_thr;
     if (lk && lj) {
+      if (k != root_of) root_of = k, root = find(k);
       // Already in one region (the common case): nothing to test.
-      const int rk = find(k), rj = find(j);
-      if (rk != rj && similar(k, j)) parent[std::max(rk, rj)] = std::min(rk, rj);
+      const int rj = find(j);
+      if (root != rj && similar(k, j)) {
+        parent[std::max(root, rj)] = std::min(root, rj);
+        root = std::min(root, rj);
+      }
     } else if (lk != lj) {
       const int hi = lk ? j : k, lo = lk ? k : j;  // high- and low-curvature point
       if (curv[hi] <= 1.0f && attach[hi] < 0 && similar(hi, lo)) attach[hi] = lo;
