@@ -156,6 +156,32 @@ TEST(RunTruth, ScriptsReadTheRunAgainstTheTruth) {
   EXPECT_GE(edge_rows, 1) << variants.out;
   EXPECT_NE(variants.out.find("Edges with several clusters: " + std::to_string(edge_rows) + ";"), std::string::npos)
       << variants.out;
+
+  // Where the foreign events come from: the shares add up to the run's own
+  // purity, and the sample's edges are parallel stripes, so its foreign edge
+  // events are of a parallel neighbour (none at a corner, none crossing).
+  const auto sources = test::runShell("/usr/bin/python3 '" CELC_SOURCE_DIR "/scripts/impurity_sources.py' '" +
+                                      run.string() + "' '" CELC_SOURCE_DIR "/data/sample_seq'");
+  ASSERT_EQ(sources.status, 0) << sources.out;
+  std::istringstream source_lines(sources.out);
+  int source_rows = 0;
+  while (std::getline(source_lines, row_text)) {
+    int w, clustered;
+    double purity, noise, foreign, corner, crossing, parallel;
+    if (std::sscanf(row_text.c_str(), "| %d | %d | %lf | %lf | %lf | %lf | %lf | %lf |", &w, &clustered, &purity,
+                    &noise, &foreign, &corner, &crossing, &parallel) != 8)
+      continue;
+    ++source_rows;
+    ASSERT_EQ(ml.count(w), 1u) << row_text;
+    EXPECT_GT(clustered, 0) << row_text;
+    EXPECT_NEAR(purity, ml[w].purity, 0.0006) << row_text;  // both rounded to 3 and 4 decimals
+    EXPECT_NEAR(noise + foreign, 1.0 - purity, 0.0016) << row_text;
+    EXPECT_NEAR(corner + crossing + parallel, foreign, 0.0016) << row_text;
+    EXPECT_GT(foreign, 0.0) << row_text;
+    EXPECT_EQ(corner, 0.0) << row_text;
+    EXPECT_EQ(crossing, 0.0) << row_text;
+  }
+  EXPECT_EQ(source_rows, 2) << sources.out;
   fs::remove_all(d);
 }
 
