@@ -4,6 +4,7 @@
 // whole with the true velocity; with the threshold 0 nothing changes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
 #include <string>
@@ -210,6 +211,39 @@ TEST(MotionReassign, PrefittedLinesGiveTheSameRedraw) {
     EXPECT_EQ(a.n_removed, b.n_removed);
     EXPECT_EQ(a.n_lines, b.n_lines);
   }
+}
+
+// The window's cost per event is a mean over every event. On two threads its
+// terms are formed in parallel and added in event order, so it equals the
+// one-thread sum to the last bit, here over three of its 65,536-event blocks
+// (an order of additions per thread would differ in the last bits). The
+// redraw's one-thread cost, summed in its own pass over the events, is the
+// same number.
+TEST(MotionReassign, WindowCostOnTwoThreadsIsTheOneThreadSum) {
+  LabelledWindowOptions o;
+  o.seed = 8;
+  o.n_events = 150000;
+  o.duration_s = 0.3;
+  o.omega_rad_per_s = 1.0;
+  o.pixel_noise_px = 0.5;
+  const LabelledWindow w = generateLabelledWindow(o);
+  const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
+  const auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
+  const Vec3 v = w.v.normalized();
+  const std::vector<int> start = corrupted(w, 8);
+  ClusterOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const double cost_one = motionCost(w.events, start, bearing, w.camera.focal(), motion, v, one);
+  ASSERT_TRUE(std::isfinite(cost_one));
+  EXPECT_GT(cost_one, 0.0);
+  EXPECT_EQ(cost_one, motionCost(w.events, start, bearing, w.camera.focal(), motion, v, two));
+  std::vector<int> labels_one = start, labels_two = start;
+  const MotionReassignReport a = reassignToMotionLines(w.events, labels_one, bearing, w.camera.focal(), motion, v, one);
+  const MotionReassignReport b = reassignToMotionLines(w.events, labels_two, bearing, w.camera.focal(), motion, v, two);
+  EXPECT_EQ(a.cost, cost_one);
+  EXPECT_EQ(b.cost, cost_one);
+  EXPECT_EQ(labels_one, labels_two);
 }
 
 }  // namespace

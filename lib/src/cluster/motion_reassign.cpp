@@ -80,64 +80,94 @@ class MotionTable {
 struct MotionLine {
   Vec3 n_c = Vec3::UnitZ(), c_c = Vec3::Zero(), d = Vec3::Zero();
   Vec3 normal(const MotionPoint& p) const { return n_c + (c_c - p.c).cross(d); }
-  /// Distance in the image at the event's time [normalised units].
-  double distance(const MotionPoint& p) const {
+  /// Distance in the image at the event's time [normalised units]; `den2`,
+  /// when given, receives |n|^2 - (n.z)^2 (infinite distance where it is not
+  /// above 1e-18).
+  double distance(const MotionPoint& p, double* den2_out = nullptr) const {
     const Vec3 n = normal(p);
     const double den2 = n.squaredNorm() - std::pow(n.dot(p.z), 2);
+    if (den2_out) *den2_out = den2;
     if (!(den2 > 1e-18)) return std::numeric_limits<double>::infinity();
     return std::abs(n.dot(p.g)) / std::sqrt(den2);
   }
 };
 
+/// The normal equations of g^T n_c + (g x (c_c - c))^T d = 0, summed over
+/// weighted points.
+struct MotionLineSums {
+  Mat3 nn = Mat3::Zero(), nd = Mat3::Zero(), dd = Mat3::Zero();
+  void add(const MotionPoint& p, const Vec3& c_c, double w) {
+    const Vec3 e = p.g.cross(c_c - p.c);
+    nn += w * p.g * p.g.transpose();
+    nd += w * p.g * e.transpose();
+    dd += w * e * e.transpose();
+  }
+  /// n_c (|n_c| = 1) and d of the sums' least squares: d eliminated, n_c the
+  /// Schur complement's smallest eigenvector. Under a translation along v
+  /// alone d's component along v does not move the planes (a small ridge
+  /// fixes it). False when the sums do not fix a line.
+  bool solve(MotionLine& line) const {
+    const double ridge = 1e-12 * std::max(dd.trace(), 1e-300);
+    const Mat3 k = (dd + ridge * Mat3::Identity()).ldlt().solve(nd.transpose());  // d = -k n_c
+    const Mat3 schur = nn - nd * k;
+    const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (schur + schur.transpose()));
+    if (es.info() != Eigen::Success) return false;
+    line.n_c = es.eigenvectors().col(0);
+    line.d = -k * line.n_c;
+    return line.n_c.allFinite() && line.d.allFinite();
+  }
+};
+
+/// Tukey's biweight over the pixel distance's variance, w = (1 - u^2)^2 /
+/// den2 with u = distance / cutoff; false (no row) beyond the cutoff or
+/// without a distance.
+bool tukeyPlaneWeight(double distance, double den2, double cutoff, double& w) {
+  if (!(den2 > 1e-18)) return false;
+  const double u = distance / cutoff;
+  if (!(u < 1.0)) return false;
+  w = (1.0 - u * u) * (1.0 - u * u) / den2;
+  return true;
+}
+
 /// Weighted least squares of g^T n_c + (g x (c_c - c))^T d = 0 over the
-/// points `idx` with |n_c| = 1 (d eliminated: the Schur complement's
-/// smallest eigenvector); `line` gives c_c, and with `prior` true its
-/// current planes weight each row by 1 / (|n|^2 - (n.z)^2) (the pixel
-/// distance) times Tukey's biweight at `cutoff` [normalised units]. Under a
-/// translation along v alone d's component along v does not move the planes
-/// (a small ridge fixes it). False when the points do not fix a line.
+/// points `idx` with |n_c| = 1 (MotionLineSums::solve); `line` gives c_c,
+/// and with `prior` true its current planes weight each row by
+/// tukeyPlaneWeight at `cutoff` [normalised units]: the pixel distance's
+/// variance times Tukey's biweight. False when the points do not fix a line.
 bool solveMotionLine(const std::vector<MotionPoint>& pts, const std::vector<std::size_t>& idx, bool prior,
                      double cutoff, MotionLine& line) {
-  Mat3 mnn = Mat3::Zero(), mnd = Mat3::Zero(), mdd = Mat3::Zero();
+  MotionLineSums sums;
   for (std::size_t k : idx) {
     const MotionPoint& p = pts[k];
     double w = 1.0;
     if (prior) {
-      const Vec3 n = line.normal(p);
-      const double den2 = n.squaredNorm() - std::pow(n.dot(p.z), 2);
-      if (!(den2 > 1e-18)) continue;
-      const double u = std::abs(n.dot(p.g)) / std::sqrt(den2) / cutoff;
-      if (!(u < 1.0)) continue;
-      w = (1.0 - u * u) * (1.0 - u * u) / den2;
+      double den2 = 0.0;
+      const double distance = line.distance(p, &den2);
+      if (!tukeyPlaneWeight(distance, den2, cutoff, w)) continue;
     }
-    const Vec3 e = p.g.cross(line.c_c - p.c);
-    mnn += w * p.g * p.g.transpose();
-    mnd += w * p.g * e.transpose();
-    mdd += w * e * e.transpose();
+    sums.add(p, line.c_c, w);
   }
-  const double ridge = 1e-12 * std::max(mdd.trace(), 1e-300);
-  const Mat3 k = (mdd + ridge * Mat3::Identity()).ldlt().solve(mnd.transpose());  // d = -k n_c
-  const Mat3 schur = mnn - mnd * k;
-  const Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (schur + schur.transpose()));
-  if (es.info() != Eigen::Success) return false;
-  line.n_c = es.eigenvectors().col(0);
-  line.d = -k * line.n_c;
-  return line.n_c.allFinite() && line.d.allFinite();
+  return sums.solve(line);
 }
 
 /// IRLS of `line` over `pts` with Tukey's biweight at 4.685 robust scales
-/// (1.4826 MAD, at least `min_scale` [normalised units]).
+/// (1.4826 MAD, at least `min_scale` [normalised units]). Each iteration
+/// measures the distances once, for the MAD and for the weights.
 bool refineMotionLine(const std::vector<MotionPoint>& pts, double min_scale, MotionLine& line) {
   const std::size_t n = pts.size();
-  std::vector<std::size_t> all(n);
-  std::iota(all.begin(), all.end(), std::size_t{0});
-  std::vector<double> dist(n);
+  std::vector<double> dist(n), den2(n), sorted(n);
   for (int it = 0; it < kIrlsIterations; ++it) {
-    for (std::size_t k = 0; k < n; ++k) dist[k] = line.distance(pts[k]);
-    auto mid = dist.begin() + static_cast<std::ptrdiff_t>(n / 2);
-    std::nth_element(dist.begin(), mid, dist.end());
+    for (std::size_t k = 0; k < n; ++k) dist[k] = line.distance(pts[k], &den2[k]);
+    sorted = dist;
+    auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(n / 2);
+    std::nth_element(sorted.begin(), mid, sorted.end());
     const double cutoff = kTukey * std::max(kMadToSigma * *mid, min_scale);
-    if (!solveMotionLine(pts, all, true, cutoff, line)) return false;
+    MotionLineSums sums;
+    for (std::size_t k = 0; k < n; ++k) {
+      double w = 0.0;
+      if (tukeyPlaneWeight(dist[k], den2[k], cutoff, w)) sums.add(pts[k], line.c_c, w);
+    }
+    if (!sums.solve(line)) return false;
   }
   return true;
 }
@@ -326,18 +356,33 @@ double costTerm(const WindowLines& w, int l, const MotionPoint* p) {
 }
 
 /// The mean over the events with a finite time of costTerm, the clusters'
-/// lines in `w`.
+/// lines in `w`. On `threads` threads the terms are formed block by block
+/// and added in event order: the one-thread sum, to the last bit.
 double windowCost(const std::vector<Event>& events, const std::vector<int>& labels, const BearingFunction& bearing,
-                  const WindowLines& w) {
+                  const WindowLines& w, int threads) {
+  constexpr double kNoTerm = -1.0;  // an event without a finite time
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  const std::size_t parts = static_cast<std::size_t>(std::max(1, threads));
+  std::vector<double> terms(std::min(events.size(), kBlock));
   double sum = 0.0;
   std::size_t n = 0;
-  for (std::size_t i = 0; i < events.size(); ++i) {
-    if (!std::isfinite(events[i].t)) continue;
-    ++n;
-    const int l = labels[i];
-    MotionPoint p;
-    const bool have = costNeedsPoint(w, l) && pointOf(events, bearing, w, static_cast<int>(i), p);
-    sum += costTerm(w, l, have ? &p : nullptr);
+  for (std::size_t begin = 0; begin < events.size(); begin += kBlock) {
+    const std::size_t count = std::min(kBlock, events.size() - begin);
+    parallelFor(parts, threads, [&](std::size_t part) {
+      for (std::size_t k = count * part / parts; k < count * (part + 1) / parts; ++k) {
+        const std::size_t i = begin + k;
+        if (!std::isfinite(events[i].t)) {
+          terms[k] = kNoTerm;
+          continue;
+        }
+        const int l = labels[i];
+        MotionPoint p;
+        const bool have = costNeedsPoint(w, l) && pointOf(events, bearing, w, static_cast<int>(i), p);
+        terms[k] = costTerm(w, l, have ? &p : nullptr);
+      }
+    });
+    for (std::size_t k = 0; k < count; ++k)
+      if (terms[k] != kNoTerm) sum += terms[k], ++n;
   }
   return n > 0 ? sum / static_cast<double>(n) : NAN;
 }
@@ -369,7 +414,7 @@ MotionLines fitMotionLines(const std::vector<Event>& events, const std::vector<i
   MotionLines out;
   auto fit = std::make_unique<MotionLinesFit>();
   if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, fit->w)) return out;
-  out.cost_ = windowCost(events, labels, bearing, fit->w);
+  out.cost_ = windowCost(events, labels, bearing, fit->w, options.threads);
   out.lines_ = std::move(fit);
   out.labels_ = labels;
   out.v_ = v;
@@ -399,7 +444,7 @@ MotionReassignReport reassignToMotionLines(const std::vector<Event>& events, std
     taken = std::make_unique<MotionLinesFit>();
     if (!fitWindowLines(events, labels, bearing, focal_px, motion, v, options, taken->w)) return report;
     cost_in_pass = parts == 1 && !(options.motion_join_px > 0.0);
-    if (!cost_in_pass) report.cost = windowCost(events, labels, bearing, taken->w);
+    if (!cost_in_pass) report.cost = windowCost(events, labels, bearing, taken->w, options.threads);
   }
   WindowLines& w = taken->w;
   const double threshold = w.threshold;

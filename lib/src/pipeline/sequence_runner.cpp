@@ -189,11 +189,19 @@ struct SequenceRunner::Impl {
 
   /// Unit-plane bearing (x, y, 1) of a pixel: the undistortion table at whole
   /// pixels, the camera model elsewhere.
+  /// Every pass over a window's events asks for it (the cut, the lines, each
+  /// redraw), so the whole-pixel test is two conversions, not calls of round.
   Vec3 bearing(const Vec2& p) const {
     Vec3 b;
-    const double rx = std::round(p.x()), ry = std::round(p.y());
-    if (rx == p.x() && ry == p.y() && lut->bearing(static_cast<int>(rx), static_cast<int>(ry), b)) return b;
+    int x, y;
+    if (wholePixel(p.x(), x) && wholePixel(p.y(), y) && lut->bearing(x, y, b)) return b;
     return calib.camera.bearing(p);  // sub-pixel or outside the table
+  }
+  /// Whether v is a whole number in int's range, `out` then v.
+  static bool wholePixel(double v, int& out) {
+    if (!(v > -2147483648.0 && v < 2147483647.0)) return false;
+    out = static_cast<int>(v);
+    return static_cast<double>(out) == v;
   }
   /// The window's motion model, or false with the reason (no_gyro, a gyro window status).
   bool motionFor(double t0, double t1, MotionModel& motion, Vec3& omega, std::string& status) const {
