@@ -123,6 +123,30 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
+// Sub-pixel coordinates go to the nearest pixel, halves away from zero (as
+// std::lround rounds), also just below a half, where float's 0.5 - 2^-25
+// plus 0.5 would round up in float.
+TEST(GridIndex, CoordinatesGoToTheNearestPixelHalvesUp) {
+  const std::vector<std::pair<float, int>> cases = {
+      {0.0f, 0}, {0.49999997f, 0}, {0.5f, 1}, {1.5f, 2}, {2.4999998f, 2}, {2.5f, 3}, {7.75f, 8}, {4095.4f, 4095}};
+  detail::Group g;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    g.x.push_back(cases[i].first);
+    g.y.push_back(cases[i].first);
+    g.t.push_back(0.001f * static_cast<float>(i));
+    g.event_index.push_back(static_cast<int>(i));
+  }
+  const GridIndex index(g);
+  ASSERT_EQ(index.size(), cases.size());
+  for (std::size_t k = 0; k < index.size(); ++k) {
+    const int i = index.point(static_cast<int>(k));
+    SCOPED_TRACE("x = y = " + std::to_string(cases[i].first));
+    EXPECT_EQ(index.cell(static_cast<int>(k)).x, cases[i].second);  // the box starts at pixel 0
+    EXPECT_EQ(index.cell(static_cast<int>(k)).y, cases[i].second);
+    EXPECT_EQ(cases[i].second, static_cast<int>(std::lround(cases[i].first)));
+  }
+}
+
 TEST(GridNormals, TheSweepGivesTheDirectSearchsValuesForAnyThreadCount) {
   const detail::Group g = movingEdges(7, 30000, 150.0f);
   const GridIndex index(g);

@@ -1,8 +1,10 @@
 // Property tests of SO(3), the motion models and the camera model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "celc/geometry/camera.hpp"
 #include "celc/geometry/motion_model.hpp"
@@ -219,6 +221,33 @@ TEST(MotionModel, GyroIntegratedFollowsVaryingRate) {
     // integral of R is then off by at most that times t (|R - R'| <= sqrt(2) angle).
     EXPECT_LT((gyro.positionMatrix(t) - integral).norm(), 1.5e-4 * std::sqrt(2.0) * t) << t;
   }
+}
+
+// pieceIndex guesses the sample after t from the mean step and searches
+// where the guess misses: it must give upper_bound's index everywhere, on a
+// jittered clock, across a 50 ms gap (the guess then far off), at the
+// sample times themselves, outside the samples, and for NaN.
+TEST(MotionModel, PieceIndexIsTheFirstSampleAfterT) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.3e-3, 0.3e-3), unit(0.0, 1.0);
+  std::vector<double> times;
+  std::vector<Vec3> rates;
+  double t = 10.0;
+  for (int i = 0; i < 400; ++i) {
+    times.push_back(t);
+    rates.push_back(Vec3(0.1, -0.2, 0.3));
+    t += (i == 200 ? 0.05 : 1e-3) + jitter(rng);
+  }
+  const MotionModel m = MotionModel::gyroIntegrated(times, rates, 10.1);
+  auto want = [&](double x) {
+    if (!(x > times.front())) return std::size_t{0};
+    return static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), x) - times.begin());
+  };
+  std::vector<double> asked = {times.front() - 1.0, times.back(), times.back() + 1.0, std::nextafter(times.back(), 0.0)};
+  for (double s : times) asked.insert(asked.end(), {s, std::nextafter(s, 0.0), std::nextafter(s, 1e9)});
+  for (int k = 0; k < 20000; ++k) asked.push_back(times.front() - 0.01 + (times.back() - times.front() + 0.02) * unit(rng));
+  for (double x : asked) EXPECT_EQ(m.pieceIndex(x), want(x)) << "t = " << x;
+  EXPECT_EQ(m.pieceIndex(NAN), times.size());
 }
 
 TEST(Camera, DistortUndistortRoundTrip) {

@@ -14,21 +14,31 @@
 
 namespace celc::detail {
 
+namespace {
+
+/// std::lround(v) without a call: for v >= 0, v + 0.5 in double is exact
+/// (or, below 2^-30, still under 1) and truncation gives the nearest whole
+/// number, halves away from zero. A group's coordinates lie in [0, 4096).
+int nearestPixel(float v) {
+  return v >= 0.0f ? static_cast<int>(static_cast<double>(v) + 0.5) : static_cast<int>(std::lround(v));
+}
+
+}  // namespace
+
 GridIndex::GridIndex(const Group& g) {
   const size_t n = g.size();
   if (n == 0) return;
   int xmin = 1 << 30, ymin = 1 << 30, xmax = -(1 << 30), ymax = -(1 << 30);
   std::vector<int> pix(n);
   for (size_t i = 0; i < n; ++i) {
-    const int xi = static_cast<int>(std::lround(g.x[i])), yi = static_cast<int>(std::lround(g.y[i]));
+    const int xi = nearestPixel(g.x[i]), yi = nearestPixel(g.y[i]);
     xmin = std::min(xmin, xi), xmax = std::max(xmax, xi);
     ymin = std::min(ymin, yi), ymax = std::max(ymax, yi);
   }
   w_ = xmax - xmin + 1;
   h_ = ymax - ymin + 1;
   for (size_t i = 0; i < n; ++i)
-    pix[i] = (static_cast<int>(std::lround(g.y[i])) - ymin) * w_ +
-             static_cast<int>(std::lround(g.x[i])) - xmin;
+    pix[i] = (nearestPixel(g.y[i]) - ymin) * w_ + nearestPixel(g.x[i]) - xmin;
   // Points in order of increasing time (usually already so).
   std::vector<int> by_time(n);
   std::iota(by_time.begin(), by_time.end(), 0);

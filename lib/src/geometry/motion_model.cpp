@@ -40,6 +40,7 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   m.t_ref_ = t_ref;
   m.times_ = times;
   m.rates_ = rates;
+  if (times.size() > 1) m.samples_per_s_ = static_cast<double>(times.size() - 1) / (times.back() - times.front());
   // R_0_ti and Q_i = integral of R_0_s ds over [t_0, t_i], from the first
   // sample: each step turns at its mean rate w, so its rotation is exp(w dt)
   // and its integral R_0_ti J_l(w dt) dt.
@@ -64,13 +65,21 @@ MotionModel MotionModel::gyroIntegrated(const std::vector<double>& times,
   return m;
 }
 
-Vec3 MotionModel::rateSlope(size_t i) const {
+inline Vec3 MotionModel::rateSlope(size_t i) const {
   return (rates_[i + 1] - rates_[i]) / (2.0 * (times_[i + 1] - times_[i]));
 }
 
 size_t MotionModel::pieceIndex(double t) const {
   if (kind_ == MotionModelKind::ConstantTwist || times_.size() == 1 || t <= times_.front()) return 0;
-  if (t >= times_.back()) return times_.size();
+  if (!(t < times_.back())) return times_.size();  // also NaN, as upper_bound gives it
+  // The first sample after t (upper_bound's answer, in 1..n-1): guessed
+  // from the mean step, which a gyroscope's near-even clock makes right or
+  // one off; searched where it is not.
+  const size_t last = times_.size() - 1;
+  size_t i = std::min(last, std::max<size_t>(1, static_cast<size_t>((t - times_.front()) * samples_per_s_) + 1));
+  if (times_[i] <= t && i < last && times_[i + 1] > t) return i + 1;
+  if (times_[i] > t && times_[i - 1] <= t) return i;
+  if (times_[i] > t && i > 1 && times_[i - 2] <= t) return i - 1;
   return static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin());
 }
 

@@ -6,14 +6,6 @@
 
 namespace celc::so3 {
 
-Mat3 hat(const Vec3& w) {
-  Mat3 W;
-  W << 0.0, -w.z(), w.y(),  //
-      w.z(), 0.0, -w.x(),   //
-      -w.y(), w.x(), 0.0;
-  return W;
-}
-
 Vec3 vee(const Mat3& W) { return Vec3(W(2, 1), W(0, 2), W(1, 0)); }
 
 void coefficients(double x, double& A, double& B, double& C) {

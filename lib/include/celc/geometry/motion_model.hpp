@@ -108,6 +108,8 @@ class MotionModel {
   std::vector<Vec3> rates_;
   std::vector<Mat3> rotations_;
   std::vector<Mat3> positions_;  ///< P at each sample time
+  /// (samples - 1) / (last time - first time) [1/s]: pieceIndex's first guess.
+  double samples_per_s_ = 0.0;
   /// GyroIntegrated: R(t) and P(t) from the samples (rotations_ / positions_
   /// anchored at t_ref, or from the first sample while they are being built);
   /// P is skipped when null.

@@ -39,8 +39,15 @@ inline void seriesCoefficients(double x, double& A, double& B, double& C) {
 /// (th - sin th) / th^3.
 void coefficients(double x, double& A, double& B, double& C);
 
-/// Skew-symmetric matrix of w: hat(w) * u == w.cross(u).
-Mat3 hat(const Vec3& w);
+/// Skew-symmetric matrix of w: hat(w) * u == w.cross(u). Inline: exp and
+/// the Jacobians build one per event and pose.
+inline Mat3 hat(const Vec3& w) {
+  Mat3 W;
+  W << 0.0, -w.z(), w.y(),  //
+      w.z(), 0.0, -w.x(),   //
+      -w.y(), w.x(), 0.0;
+  return W;
+}
 /// Inverse of hat for a skew-symmetric matrix.
 Vec3 vee(const Mat3& W);
 /// Rotation matrix exp(hat(phi)); phi is an axis-angle vector [rad].
