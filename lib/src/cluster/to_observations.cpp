@@ -101,7 +101,10 @@ WindowObservations toObservations(const std::vector<Event>& events, const Cluste
   std::vector<std::vector<int>> each_used(k);
   parallelFor(k, threads, [&](std::size_t c) {
     auto& idx = members[c];
-    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return events[a].t < events[b].t; });
+    // Usually in time order already (a window's events come so): then the
+    // stable sort would leave them as they are.
+    auto earlier = [&](int a, int b) { return events[a].t < events[b].t; };
+    if (!std::is_sorted(idx.begin(), idx.end(), earlier)) std::stable_sort(idx.begin(), idx.end(), earlier);
     ClusterObservation& obs = each[c];
     obs.id = clusters.clusters[c].id;
     obs.times.reserve(idx.size());

@@ -69,9 +69,12 @@ NptLineSolution solveNptLine(const std::vector<double>& times, const std::vector
     Vec6 row;
     row << (displacementScale(P) - s0) * fp, fp;
     if (!row.allFinite()) continue;
-    G.noalias() += row * row.transpose();
+    // The upper triangle only: G is symmetric (the lower one is copied below).
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i <= j; ++i) G(i, j) += row(i) * row(j);
     ++out.events;
   }
+  G.triangularView<Eigen::StrictlyLower>() = G.transpose();
   if (out.events < opt.min_line_events) return out;
   const Eigen::SelfAdjointEigenSolver<Mat6> es(G);
   if (es.info() != Eigen::Success) return out;

@@ -25,10 +25,12 @@ SparePool<Owner, T>& sparePool() {
   return pool;
 }
 
-/// Takes the largest spare vector into v (emptied; v must be empty); an
-/// empty vector when every spare is borrowed.
+/// Takes the largest spare vector into v (v must be empty): emptied, or
+/// with `keep_size` as it was given back (its elements the last values,
+/// for a user that overwrites them: resizing it then writes only the
+/// elements beyond); an empty vector when every spare is borrowed.
 template <typename Owner, typename T>
-void borrowSpareVector(std::vector<T>& v) {
+void borrowSpareVector(std::vector<T>& v, bool keep_size = false) {
   SparePool<Owner, T>& pool = sparePool<Owner, T>();
   {
     std::lock_guard<std::mutex> lock(pool.mu);
@@ -39,7 +41,7 @@ void borrowSpareVector(std::vector<T>& v) {
       pool.spares.erase(largest);
     }
   }
-  v.clear();
+  if (!keep_size) v.clear();
 }
 
 /// Gives v's memory back to the spares (v is left empty).
