@@ -154,34 +154,6 @@ TEST(JointKernel, BlockSumsAndCostMatchEventByEvent) {
   EXPECT_GT(tukey_beyond, 50);
 }
 
-// The columns' storage comes back from a spare buffer with its last values
-// (startRows writes no element twice). The rows after the last one appended
-// must still read as zeros, the padding a pass reads past its last event:
-// here after a buffer filled with NaN by an earlier, larger problem (the
-// largest spare is the one borrowed).
-TEST(JointKernel, ReusedStorageReadsZerosAfterTheLastRow) {
-  std::mt19937_64 rng(9);
-  std::vector<EventTerm> terms = randomTerms(201, rng);
-  {
-    EventTerm bad = terms[0];
-    bad.fp.setConstant(NAN), bad.Rt01.setConstant(NAN), bad.De.setConstant(NAN), bad.Ds.setConstant(NAN);
-    JointColumns dirty(JointColumns::Spare::Full);
-    dirty.startRows(100000, true);
-    for (int k = 0; k < 100000; ++k) dirty.appendRow(bad, Eigen::Vector2d(NAN, NAN));
-  }
-  JointColumns rows(JointColumns::Spare::Full);
-  rows.startRows(250, true);
-  for (const EventTerm& e : terms) rows.appendRow(e, Eigen::Vector2d(0.5, -0.5));
-  ASSERT_EQ(rows.size(), terms.size());
-  int nan_after_n = 0;
-  for (int j = 0; j < JointColumns::kAccelerationColumns; ++j) {
-    const double* column = rows.data() + static_cast<size_t>(j) * rows.stride();
-    for (size_t r = rows.size(); r < rows.size() + JointColumns::kPadding; ++r) EXPECT_EQ(column[r], 0.0) << j << ", " << r;
-    for (size_t r = rows.size() + JointColumns::kPadding; r < 250; ++r) nan_after_n += std::isnan(column[r]) ? 1 : 0;
-  }
-  EXPECT_GT(nan_after_n, 0) << "the buffer was not the reused one: the test proves nothing";
-}
-
 // A problem's columns are written row by row (startRows, appendRow, room for
 // more rows than written) and strided from those rows (assignStrided): every
 // sum and distance equals the one from columns packed at that step from the

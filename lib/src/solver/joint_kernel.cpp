@@ -19,11 +19,10 @@ struct FullColumnsSpare;
 }  // namespace
 
 JointColumns::JointColumns(Spare spare) : spare_(spare) {
-  // The spare keeps its size: startRows then writes no element twice.
   if (spare_ == Spare::Full)
-    borrowSpareVector<FullColumnsSpare>(data_, true);
+    borrowSpareVector<FullColumnsSpare>(data_);
   else
-    borrowSpareVector<JointColumns>(data_, true);
+    borrowSpareVector<JointColumns>(data_);
 }
 
 JointColumns::~JointColumns() {
@@ -75,7 +74,8 @@ void JointColumns::assignStrided(const JointColumns& full, const std::vector<siz
                                  std::vector<size_t>& strided_begin) {
   step = std::max<size_t>(1, step);
   layOut(begin, step, strided_begin, full.acceleration_);
-  for (size_t j = 0; j < columns(); ++j) {
+  const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
+  for (size_t j = 0; j < columns; ++j) {
     const double* from = full.data_.data() + j * full.stride_;
     double* to = data_.data() + j * stride_;
     size_t row = 0;
@@ -88,27 +88,14 @@ void JointColumns::startRows(size_t max_rows, bool acceleration) {
   n_ = 0;
   stride_ = max_rows + kPadding;
   acceleration_ = acceleration;
-  reserveWithHeadroom(data_, columns() * stride_);
-  // Every row is written before a pass reads it (writeRow, or assign's
-  // copies of all rows), so the storage keeps what it held (the spare
-  // buffer's last values) and only the rows a pass may read past the last
-  // event are zeroed: the first kPadding (none written yet) and the
-  // padding after max_rows; appendRow zeroes the row kPadding ahead of each
-  // row it writes.
-  data_.resize(columns() * stride_);
-  zeroRows(0, kPadding);
-  zeroRows(max_rows, stride_);
-}
-
-void JointColumns::zeroRows(size_t from, size_t to) {
-  for (size_t j = 0; j < columns(); ++j) std::fill(data_.begin() + static_cast<std::ptrdiff_t>(j * stride_ + from),
-                                                   data_.begin() + static_cast<std::ptrdiff_t>(j * stride_ + to), 0.0);
+  const size_t columns = static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns);
+  reserveWithHeadroom(data_, columns * stride_);
+  data_.assign(columns * stride_, 0.0);
 }
 
 void JointColumns::appendRow(const EventTerm& e, const Eigen::Vector2d& dq) {
   if (n_ + kPadding >= stride_) throw std::logic_error("JointColumns::appendRow: more rows than startRows allowed");
   writeRow(n_, e, dq);
-  zeroRows(n_ + kPadding, n_ + kPadding + 1);
   ++n_;
 }
 

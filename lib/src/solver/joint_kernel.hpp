@@ -55,13 +55,9 @@ class JointColumns {
 
  private:
   void writeRow(size_t row, const EventTerm& e, const Eigen::Vector2d& dq);
-  /// Columns for every step-th event of each cluster [begin[c],
-  /// begin[c + 1]) (their padding zeroed, the rows to be written), their
-  /// ranges into strided_begin; size() rows.
+  /// Zeroed columns for every step-th event of each cluster [begin[c],
+  /// begin[c + 1]), their ranges into strided_begin; size() rows.
   void layOut(const std::vector<size_t>& begin, size_t step, std::vector<size_t>& strided_begin, bool acceleration);
-  /// Sets rows [from, to) of every column to 0.
-  void zeroRows(size_t from, size_t to);
-  size_t columns() const { return static_cast<size_t>(acceleration_ ? kAccelerationColumns : kColumns); }
   Spare spare_;
   size_t n_ = 0;
   size_t stride_ = kPadding;

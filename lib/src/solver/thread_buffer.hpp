@@ -25,12 +25,10 @@ SparePool<Owner, T>& sparePool() {
   return pool;
 }
 
-/// Takes the largest spare vector into v (v must be empty): emptied, or
-/// with `keep_size` as it was given back (its elements the last values,
-/// for a user that overwrites them: resizing it then writes only the
-/// elements beyond); an empty vector when every spare is borrowed.
+/// Takes the largest spare vector into v (emptied; v must be empty); an
+/// empty vector when every spare is borrowed.
 template <typename Owner, typename T>
-void borrowSpareVector(std::vector<T>& v, bool keep_size = false) {
+void borrowSpareVector(std::vector<T>& v) {
   SparePool<Owner, T>& pool = sparePool<Owner, T>();
   {
     std::lock_guard<std::mutex> lock(pool.mu);
@@ -41,7 +39,7 @@ void borrowSpareVector(std::vector<T>& v, bool keep_size = false) {
       pool.spares.erase(largest);
     }
   }
-  if (!keep_size) v.clear();
+  v.clear();
 }
 
 /// Gives v's memory back to the spares (v is left empty).
