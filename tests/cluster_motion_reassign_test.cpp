@@ -16,9 +16,10 @@
 namespace celc {
 namespace {
 
-LabelledWindow window(unsigned seed) {
+LabelledWindow window(unsigned seed, int n_events = LabelledWindowOptions{}.n_events) {
   LabelledWindowOptions o;
   o.seed = seed;
+  o.n_events = n_events;
   o.duration_s = 0.3;
   o.omega_rad_per_s = 1.0;
   o.pixel_noise_px = 0.5;
@@ -220,13 +221,7 @@ TEST(MotionReassign, PrefittedLinesGiveTheSameRedraw) {
 // redraw's one-thread cost, summed in its own pass over the events, is the
 // same number.
 TEST(MotionReassign, WindowCostOnTwoThreadsIsTheOneThreadSum) {
-  LabelledWindowOptions o;
-  o.seed = 8;
-  o.n_events = 150000;
-  o.duration_s = 0.3;
-  o.omega_rad_per_s = 1.0;
-  o.pixel_noise_px = 0.5;
-  const LabelledWindow w = generateLabelledWindow(o);
+  const LabelledWindow w = window(8, 150000);
   const MotionModel motion = MotionModel::constantTwist(w.omega, 0.0);
   const auto bearing = [&](const Vec2& p) { return w.camera.bearing(p); };
   const Vec3 v = w.v.normalized();
