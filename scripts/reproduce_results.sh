@@ -17,6 +17,7 @@
 #   seeds       clusters, speeds and lines again at cluster.seed 2 and 3: clusters_seeds.md (50 min after their renders)
 #   derotate    clusters and speeds again with cluster.derotate true: clusters_derotate.md (5 min after their renders)
 #   fast        clusters and speeds again with -c config/fast.yaml: fast.md (4 min after their renders)
+#   cluster_test clusters, speeds and lines again with solver.ml.cluster_test 20: clusters_cluster_test.md (25 min after their renders)
 #   acceleration scripts/acceleration_sweep.sh: acceleration_sweep.md (celc_acc against celc_ml, rho 0-30; 30 s)
 #   accelerometer scripts/accelerometer_table.sh: accelerometer.md (the scenes with a still IMU start; 15 min)
 #   studies     build/celc_acceleration_study, celc_rate_offset_study, celc_solve_path_study
@@ -36,7 +37,7 @@ py=/usr/bin/python3
 tables="$py $root/scripts/results_tables.py"
 mkdir -p "$work" "$res" "$root/docs/images"
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines gap seeds derotate fast acceleration accelerometer studies summary)
+[ ${#names[@]} -gt 0 ] || names=(simulation peers scenes sample sigma parallax rotation clusters speeds lines gap seeds derotate fast cluster_test acceleration accelerometer studies summary)
 
 put() {  # put FILE NAME COMMAND: stdin's tables into docs/results/FILE
   $tables put "$res/$1" "\`scripts/reproduce_results.sh $2\` (runs \`$3\`)"
@@ -153,6 +154,25 @@ for name in "${names[@]}"; do
       ;;
     derotate)
       heldout_again derotate clusters_derotate.md --set cluster.derotate=true
+      ;;
+    cluster_test)
+      # The five held-out sets again, celc_ml leaving out the clusters that
+      # disagree with the others (its oracle too: the same options).
+      test=(--set solver.ml.cluster_test=20)
+      scripts/cluster_table.sh "$work/clusters" --runs cluster_test -- "${test[@]}" > "$work/cluster_test30.txt"
+      for v in 1 3 4; do
+        scripts/cluster_table.sh "$work/speed$v" --seed 50000 --count 8 --speed "$v,$v" --rate 0.3,3 \
+          --runs cluster_test -- "${test[@]}" > "$work/cluster_test$v.txt"
+      done
+      scripts/cluster_table.sh "$work/lines" --seed 60000 --count 8 --kinds lines --speed 1,4 --rate 0.3,3 \
+        --runs cluster_test -- "${test[@]}" > "$work/cluster_test_lines.txt"
+      { echo "The 12 scenes of clusters.md (seed 30000):"; $tables table 1 < "$work/cluster_test30.txt"; echo;
+        for v in 1 3 4; do
+          echo "At $v m/s (clusters_speeds.md):"; $tables table 1 < "$work/cluster_test$v.txt"; echo
+        done
+        echo "The bars (clusters_lines.md):"; $tables table 1 < "$work/cluster_test_lines.txt"; } |
+        put clusters_cluster_test.md cluster_test \
+          "scripts/cluster_table.sh [as for clusters, speeds, lines] --runs cluster_test -- --set solver.ml.cluster_test=20"
       ;;
     fast)
       heldout_again fast fast.md -c config/fast.yaml

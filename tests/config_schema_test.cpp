@@ -262,7 +262,7 @@ TEST(ConfigSchema, SetAssignments) {
             "--set solver.ml.grid_start=3: unknown key 'solver.ml.grid_start' (allowed here: second_start, "
             "second_start_max_twist, second_start_deg, grid_starts, max_events, screen_events, profile_lattice, "
             "profile_starts, profile_events, start_iterations, finalists, cheiral_tie, cheiral_min, cheiral_clusters, "
-            "huber_scale, cauchy_scale, cauchy_min_tail, tukey_scale, rate_offset)");
+            "huber_scale, cauchy_scale, cauchy_min_tail, tukey_scale, cluster_test, rate_offset)");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.events", c); }), "--set windows.events: expected key.path=value");
   EXPECT_EQ(errorOf([&] { applyRunSetting("windows.overlap=2", c); }),
             "--set windows.overlap=2: windows.overlap: must be in [0, 1), got 2");

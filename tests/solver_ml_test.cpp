@@ -13,6 +13,7 @@
 
 #include "celc/cluster/to_observations.hpp"
 #include "celc/eval/crlb.hpp"
+#include "celc/geometry/so3.hpp"
 #include "celc/lines/line_fit.hpp"
 #include "celc/pipeline/run_config.hpp"
 #include "celc/pipeline/peer_study.hpp"
@@ -913,4 +914,131 @@ TEST(CelcMl, RateOffsetFindsAGyroBias) {
       EXPECT_GE(same, n - 2);
     }
   }
+}
+
+namespace {
+
+/// Cluster 0 of the trial turned about the camera's y axis at 6 deg/s
+/// (about its reference time) beyond the rotation the motion gives: its events
+/// still lie on one moving line, but one whose motion no v explains, as a
+/// cluster holding two edges that meet at a small angle, whose one line moves
+/// like neither. Its lines are fitted again; false when that fails.
+bool withDriftingCluster(const PeerSceneTrial& tr, WindowObservations& obs) {
+  obs = tr.observations;
+  ClusterObservation& cl = obs.clusters[0];
+  const double t_ref = tr.given_motion.referenceTime(), rate = 6.0 / kDeg;
+  std::vector<std::pair<double, Vec3>> events;
+  for (size_t k = 0; k < cl.size(); ++k) {
+    const Vec3 f = so3::exp(Vec3(0.0, rate * (cl.times[k] - t_ref), 0.0)) * cl.bearings[k];
+    events.emplace_back(cl.times[k], f / f.z());
+  }
+  return refitWith(std::move(events), obs.focal_px, tr.given_motion, cl);
+}
+
+PeerSceneTrial twelveLineTrial(std::uint64_t seed) {
+  PeerSceneOptions cell = peerCell(2.0, 0.5, 200);
+  cell.n_lines = 12;
+  cell.min_separation_px = 40.0;
+  std::mt19937_64 rng(seed);
+  return generatePeerScene(cell, rng);
+}
+
+}  // namespace
+
+// The agreement test (JointProblem::clusterAgreement) at the joint minimum
+// from the truth: on clean clusters its statistic is that of a chi-square of
+// up to 2 degrees of freedom (median 1.39 at 2, 0.45 at 1); a cluster whose
+// line moves as no v explains (withDriftingCluster) has the largest, beyond
+// the threshold celc_ml's test uses (20). 12 lines, V = 2 m/s, 0.5 px, 12
+// fixed trials. Measured: the drifting cluster's median 30.8, the clean
+// clusters' 0.57, the drifting one the largest in 11 of 12.
+TEST(JointProblem, AgreementTestPicksTheClusterNoMotionExplains) {
+  const RefineOptions ro = SolverOptions::paper().refine;
+  int picked = 0, trials = 0;
+  std::vector<double> clean_T, drifting_T;
+  for (std::uint64_t t = 0; t < 12; ++t) {
+    const PeerSceneTrial tr = twelveLineTrial(700 + t);
+    ASSERT_TRUE(tr.ok) << tr.message;
+    WindowObservations obs;
+    ASSERT_TRUE(withDriftingCluster(tr, obs));
+    const detail::WindowFrames frames(obs, tr.given_motion);
+    const detail::JointProblem problem(obs, tr.given_motion, frames, 0, false, 1, ro.huber_px);
+    const auto m = problem.refine(problem.start(tr.true_direction), ro.max_iterations, ro.function_tolerance);
+    ASSERT_TRUE(m.ok);
+    const std::vector<double> T = problem.clusterAgreement(m.state, problem.robustScale(m.state));
+    ASSERT_EQ(T.size(), problem.clusters());
+    ASSERT_EQ(problem.observationIndex()[0], 0);
+    ++trials;
+    picked += std::max_element(T.begin(), T.end()) == T.begin();
+    drifting_T.push_back(T[0]);
+    for (size_t c = 1; c < T.size(); ++c) clean_T.push_back(T[c]);
+  }
+  std::printf("agreement: drifting cluster's T median %.1f, clean clusters' median %.2f, picked %d / %d\n",
+              medianOf(drifting_T), medianOf(clean_T), picked, trials);
+  EXPECT_GE(picked, trials - 1);
+  EXPECT_GT(medianOf(drifting_T), 20.0);
+  EXPECT_LT(medianOf(clean_T), 2.0);
+}
+
+// celc_ml with the agreement test on (solver.ml.cluster_test 20) where one
+// cluster's line moves as no v explains (withDriftingCluster): Tukey's loss
+// cannot let it go (its events lie on their line), the test leaves it out and
+// celc_ml lands near its answer on the clean window; on the clean windows it
+// leaves out nothing in almost every trial. Measured, median phi: 1.02 deg
+// without the test, 0.46 with it, 0.38 on the clean windows; 0 of 12 clean
+// windows with a cluster left out.
+TEST(CelcMl, AgreementTestLeavesOutTheClusterNoMotionExplains) {
+  SolverOptions off;
+  off.check_parallax = false;
+  off.uncertainty.enabled = false;
+  SolverOptions on = off;
+  on.ml.cluster_test = 20.0;
+  std::vector<double> phi_off, phi_on, phi_clean;
+  int left_clean = 0, n = 0;
+  for (std::uint64_t t = 0; t < 12; ++t) {
+    const PeerSceneTrial tr = twelveLineTrial(700 + t);
+    ASSERT_TRUE(tr.ok);
+    WindowObservations obs;
+    ASSERT_TRUE(withDriftingCluster(tr, obs));
+    const SolverResult a = solveMethods(obs, tr.given_motion, {Method::CelcMl}, off)[0];
+    const SolverResult b = solveMethods(obs, tr.given_motion, {Method::CelcMl}, on)[0];
+    const SolverResult c = solveMethods(tr.observations, tr.given_motion, {Method::CelcMl}, on)[0];
+    ASSERT_TRUE(a.ok() && b.ok() && c.ok()) << "trial " << t;
+    phi_off.push_back(angleBetweenSignAgnostic(a.v, tr.true_direction) * kDeg);
+    phi_on.push_back(angleBetweenSignAgnostic(b.v, tr.true_direction) * kDeg);
+    phi_clean.push_back(angleBetweenSignAgnostic(c.v, tr.true_direction) * kDeg);
+    left_clean += c.message.find("agreement test") != std::string::npos;
+    ++n;
+  }
+  std::printf("celc_ml: off %.2f, on %.2f, clean %.2f deg; clean windows with a cluster left out %d / %d\n",
+              medianOf(phi_off), medianOf(phi_on), medianOf(phi_clean), left_clean, n);
+  EXPECT_LT(medianOf(phi_on), 0.5 * medianOf(phi_off));
+  EXPECT_LT(medianOf(phi_on), 1.5 * medianOf(phi_clean));
+  EXPECT_LE(left_clean, 1);
+}
+
+// A cluster left out (JointProblem::leaveOut) is as if it were not in the
+// window: the cost and the refinement's end point are those of the problem
+// built without it, and the test gives it no statistic.
+TEST(JointProblem, ALeftOutClusterIsAsIfAbsent) {
+  const RefineOptions ro = SolverOptions::paper().refine;
+  const PeerSceneTrial tr = twelveLineTrial(720);
+  ASSERT_TRUE(tr.ok);
+  WindowObservations without = tr.observations;
+  without.clusters.erase(without.clusters.begin() + 3);
+  const detail::WindowFrames frames(tr.observations, tr.given_motion), frames_without(without, tr.given_motion);
+  detail::JointProblem problem(tr.observations, tr.given_motion, frames, 0, false, 1, ro.huber_px);
+  const detail::JointProblem reference(without, tr.given_motion, frames_without, 0, false, 1, ro.huber_px);
+  problem.leaveOut({3});
+  const Vec3 start = (tr.true_direction + Vec3(0.05, -0.03, 0.02)).normalized();
+  const auto a = problem.refine(problem.start(start), ro.max_iterations, ro.function_tolerance);
+  const auto b = reference.refine(reference.start(start), ro.max_iterations, ro.function_tolerance);
+  ASSERT_TRUE(a.ok && b.ok);
+  EXPECT_NEAR(a.cost, b.cost, 1e-12 * b.cost);
+  EXPECT_EQ(a.events, b.events);
+  EXPECT_LT(angleBetweenSignAgnostic(a.state.v, b.state.v), 1e-10);
+  const std::vector<double> T = problem.clusterAgreement(a.state, problem.robustScale(a.state));
+  ASSERT_EQ(T.size(), 12u);
+  EXPECT_TRUE(std::isnan(T[3]));
+  EXPECT_TRUE(std::isfinite(T[2]) && std::isfinite(T[4]));
 }

@@ -369,6 +369,31 @@ JointProblem::Result redescend(JointProblem& problem, JointProblem::Result best,
   return r.ok ? r : best;
 }
 
+/// ml.cluster_test: the cluster whose events disagree most with the others'
+/// at `best` (JointProblem::clusterAgreement, above ml.cluster_test) left out
+/// of `problem` and v refined again under the problem's loss, one cluster at
+/// a time until none disagrees, at most a tenth of the clusters (at least
+/// one). Returns the clusters left out (observation indices).
+std::vector<int> leaveOutDisagreeing(JointProblem& problem, JointProblem::Result& best, const Schedule& s,
+                                     const MlOptions& ml) {
+  std::vector<int> left;
+  if (!(ml.cluster_test > 0.0)) return left;
+  const size_t most = std::max<size_t>(1, problem.clusters() / 10);
+  while (left.size() < most) {
+    const std::vector<double> T = problem.clusterAgreement(best.state, problem.robustScale(best.state));
+    size_t worst = T.size();
+    for (size_t c = 0; c < T.size(); ++c)
+      if (T[c] > ml.cluster_test && (worst == T.size() || T[c] > T[worst])) worst = c;
+    if (worst == T.size()) break;
+    problem.leaveOut({worst});
+    JointProblem::Result r = problem.refine(best.state, s.iterations, s.tolerance, 1);
+    if (!r.ok) break;
+    best = std::move(r);
+    left.push_back(problem.observationIndex()[worst]);
+  }
+  return left;
+}
+
 /// The solver's result from the winning end point: v with its start's sign;
 /// the start's singular values and sign margin, or for a start that is no
 /// method's estimate the linear stage's singular values and (with
@@ -458,8 +483,11 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.result.cost / std::max(1, best.result.events));
   best.result = redescend(*active, std::move(best.result), schedule, options.ml);
+  std::string test_note;
+  if (const std::vector<int> left = leaveOutDisagreeing(*active, best.result, schedule, options.ml); !left.empty())
+    test_note = std::to_string(left.size()) + " clusters left out by the agreement test";
   const SignView used = shift ? SignView{obs, shift->motion, shift->frames} : view;
-  SolverResult out = answer(best, residual_px, linear, {tie_note, cheiral_note, rate_note}, used, options);
+  SolverResult out = answer(best, residual_px, linear, {tie_note, cheiral_note, rate_note, test_note}, used, options);
   out.time_us =
       time_us + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   return out;

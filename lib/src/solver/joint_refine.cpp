@@ -75,7 +75,14 @@ JointProblem::JointProblem(const WindowObservations& obs, const MotionModel& mot
     begin_.push_back(terms_.size());
     m1_.push_back(frame.m1.normalized());
     m3_.push_back(frame.m3.normalized());
+    obs_index_.push_back(usable[ci]);
   }
+}
+
+void JointProblem::leaveOut(const std::vector<size_t>& clusters) {
+  left_out_.resize(begin_.size() - 1, 0);
+  for (size_t c : clusters)
+    if (c < left_out_.size()) left_out_[c] = 1;
 }
 
 const JointColumns& JointProblem::columns(int stride) const {
@@ -99,7 +106,7 @@ ResidualSpread JointProblem::spread(const State& s) const {
     std::vector<double> d;
     d.reserve(terms_.size());
     for (size_t c = 0; c + 1 < begin_.size(); ++c)
-      for (size_t k = begin_[c]; k < begin_[c + 1]; ++k)
+      for (size_t k = begin_[c]; k < begin_[c + 1] && !isLeftOut(c); ++k)
         d.push_back(eventDistance(terms_.term(k), s.v, s.m1[c], s.m3[c], focal_, nullptr, nullptr, nullptr));
     return residualSpread(std::move(d));
   }
@@ -123,7 +130,8 @@ double JointProblem::cost(const State& s, int stride) const {
   if (loss_.type == RobustLoss::Type::Huber) {
     const JointColumns& cols = columns(stride);
     for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
-      total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
+      if (!isLeftOut(c))
+        total += jointHuberCost(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
                               loss_.scale, acceleration_ ? &s.a : nullptr);
     return 0.5 * total;  // +inf when a distance is not finite
   }
@@ -132,9 +140,13 @@ double JointProblem::cost(const State& s, int stride) const {
   for (size_t c = 0; c + 1 < column_begin_.size(); ++c)
     jointDistances(cols, column_begin_[c], column_begin_[c + 1], s.v, s.m1[c], s.m3[c], focal_,
                    distances_.data() + column_begin_[c], acceleration_ ? &s.a : nullptr);
-  for (double d : distances_) {
-    if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
-    total += loss_.rho(d);
+  for (size_t c = 0; c + 1 < column_begin_.size(); ++c) {
+    if (isLeftOut(c)) continue;
+    for (size_t i = column_begin_[c]; i < column_begin_[c + 1]; ++i) {
+      const double d = distances_[i];
+      if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
+      total += loss_.rho(d);
+    }
   }
   return 0.5 * total;
 }
@@ -149,6 +161,14 @@ void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen:
     ClusterBlocks<G>& k = blocks[c];
     k.B1 = tangentBasis(s.m1[c]);
     k.B3 = tangentBasis(s.m3[c]);
+    if (isLeftOut(c)) {  // no terms: its lines do not move
+      k.U.setIdentity();
+      k.W.setZero();
+      k.bc.setZero();
+      k.bg.setZero();
+      k.Vc.setZero();
+      continue;
+    }
     // An event whose distance is not finite adds nothing (not at s: its
     // cost is finite).
     const double *sum_v, *sum_bv, *sum_u, *sum_w, *sum_bc;
@@ -164,10 +184,8 @@ void JointProblem::linearise(const State& s, int stride, const Mat32& Bv, Eigen:
       sum_v = ba.G, sum_bv = ba.bg, sum_u = ba.U, sum_w = ba.W, sum_bc = ba.bc;
     }
     for (int i = 0, n = 0; i < G; ++i)
-      for (int j = i; j < G; ++j, ++n) {
-        V(i, j) += sum_v[n];
-        if (j != i) V(j, i) += sum_v[n];
-      }
+      for (int j = i; j < G; ++j, ++n) k.Vc(i, j) = k.Vc(j, i) = sum_v[n];
+    V += k.Vc;
     for (int i = 0; i < G; ++i) k.bg(i) = sum_bv[i];
     bv += k.bg;
     for (int i = 0, n = 0; i < 4; ++i)
@@ -229,6 +247,50 @@ Eigen::MatrixXd JointProblem::clusterRobustCovariance(const State& s) const {
     return Hinv * B * Hinv * (static_cast<double>(K) / static_cast<double>(K - G));
   };
   return acceleration_ ? sandwich(std::integral_constant<int, 5>{}) : sandwich(std::integral_constant<int, 2>{});
+}
+
+std::vector<double> JointProblem::clusterAgreement(const State& s, double sigma_px) const {
+  if (acceleration_) return {};
+  const size_t K = begin_.size() - 1;
+  std::vector<ClusterBlocks<2>> blocks(K);
+  Eigen::Matrix2d V;
+  Eigen::Vector2d bv;
+  linearise<2>(s, 1, tangentBasis(s.v), V, bv, blocks);
+  // Per cluster: H_k = V_k - W_k U_k^-1 W_k^T and g_k = bg_k - W_k U_k^-1 bc_k.
+  std::vector<Eigen::Matrix2d> Hk(K);
+  std::vector<Eigen::Vector2d> gk(K);
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  for (size_t c = 0; c < K; ++c) {
+    ClusterBlocks<2>& k = blocks[c];
+    k.X.leftCols<2>() = k.W.transpose();
+    k.X.col(2) = k.bc;
+    solveSpd4(k.U, k.X);
+    Hk[c] = k.Vc - k.X.leftCols<2>().transpose() * k.W.transpose();
+    Hk[c] = 0.5 * (Hk[c] + Hk[c].transpose()).eval();
+    gk[c] = k.bg - k.X.leftCols<2>().transpose() * k.bc;
+    if (!isLeftOut(c)) H += Hk[c];
+  }
+  const double s2 = sigma_px * sigma_px;
+  std::vector<double> T(K, NAN);
+  for (size_t c = 0; c < K; ++c) {
+    if (isLeftOut(c) || !Hk[c].allFinite() || !gk[c].allFinite() || !(s2 > 0.0)) continue;
+    // H_k^+ over the eigenvalues above 1e-9 of H's largest (a line fixes
+    // v's tangent in one direction or two).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ek(Hk[c]);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eh(H);
+    const double floor = 1e-9 * std::max(eh.eigenvalues()(1), 1e-300);
+    Eigen::Matrix2d Hk_pinv = Eigen::Matrix2d::Zero();
+    for (int i = 0; i < 2; ++i)
+      if (ek.eigenvalues()(i) > floor)
+        Hk_pinv += ek.eigenvectors().col(i) * ek.eigenvectors().col(i).transpose() / ek.eigenvalues()(i);
+    const Eigen::Matrix2d A = H - Hk[c];
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ea(A);
+    if (!(ea.eigenvalues()(0) > floor)) continue;
+    const Eigen::Matrix2d A_inv =
+        ea.eigenvectors() * ea.eigenvalues().cwiseInverse().asDiagonal() * ea.eigenvectors().transpose();
+    T[c] = gk[c].dot((Hk_pinv + A_inv) * gk[c]) / s2;
+  }
+  return T;
 }
 
 JointProblem::Result JointProblem::refineConstantVelocity(State s, int max_iterations, double function_tolerance,
@@ -293,7 +355,7 @@ JointProblem::Result JointProblem::refineSteps(State s, int max_iterations, doub
   Result out;
   const size_t nc = begin_.size() - 1;
   for (size_t c = 0; c < nc; ++c)
-    out.events += static_cast<int>((begin_[c + 1] - begin_[c] + stride - 1) / stride);
+    if (!isLeftOut(c)) out.events += static_cast<int>((begin_[c + 1] - begin_[c] + stride - 1) / stride);
   double f = cost(s, stride);
   if (!std::isfinite(f) || out.events < 3) return out;
   std::vector<ClusterBlocks<G>> blocks(nc);

@@ -88,6 +88,23 @@ class JointProblem {
   /// singular or K <= G.
   Eigen::MatrixXd clusterRobustCovariance(const State& s) const;
 
+  /// Per cluster, whether its events agree with the other clusters' at s (a
+  /// minimum of the cost, no acceleration): with g_k its efficient score
+  /// (its gradient over v's tangent, its lines at their own optimum), H_k
+  /// its information with its lines eliminated and H the window's, leaving
+  /// it out moves v by about (H - H_k)^-1 g_k, and
+  ///   T_k = g_k^T (H_k^+ + (H - H_k)^-1) g_k / sigma^2
+  /// is that move against its spread under the model (events of one edge
+  /// with independent noise of sigma [px]): chi-square with rank(H_k) <= 2
+  /// degrees of freedom. NaN for a cluster left out or where H - H_k is
+  /// singular; empty with an acceleration.
+  std::vector<double> clusterAgreement(const State& s, double sigma_px) const;
+  /// The clusters (indices of this problem) whose events every later
+  /// cost, step and spread leaves out; their lines stay where they are.
+  void leaveOut(const std::vector<size_t>& clusters);
+  /// The WindowObservations index of each cluster of this problem.
+  const std::vector<int>& observationIndex() const { return obs_index_; }
+
   /// Events in the problem.
   size_t events() const;
   /// Clusters in the problem.
@@ -111,6 +128,7 @@ class JointProblem {
     Eigen::Matrix<double, G, 4> W;
     Eigen::Vector4d bc;
     Eigen::Matrix<double, G, 1> bg;  ///< the cluster's part of the global gradient
+    Eigen::Matrix<double, G, G> Vc;  ///< the cluster's part of the global block
     Eigen::Matrix<double, 3, 2> B1, B3;
     Eigen::Matrix<double, 4, G + 1> X;
   };
@@ -154,6 +172,9 @@ class JointProblem {
   const JointColumns& columns(int stride) const;
   mutable std::vector<double> distances_;  // cost()'s under a loss other than Huber's, per event
   std::vector<Vec3> m1_, m3_;                  // fitted lines (frames), unit
+  std::vector<int> obs_index_;                 // each cluster's index in the observations
+  std::vector<unsigned char> left_out_;        // per cluster: 1 = left out (leaveOut)
+  bool isLeftOut(size_t c) const { return !left_out_.empty() && left_out_[c]; }
   double focal_;
   RobustLoss loss_;
 };

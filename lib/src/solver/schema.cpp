@@ -143,6 +143,12 @@ void describe(FieldVisitor& v, MlOptions& o) {
            "> 0: that last refinement uses Tukey's biweight at this times the robust scale instead of the "
            "Cauchy loss (cauchy_scale 0 still turns it off)", atLeast(0)},
           o.tukey_scale);
+  v.field({"cluster_test", "-",
+           "> 0: then the cluster that disagrees most with the others (leaving it out moves v by more than this "
+           "chi-square value allows, up to 2 degrees of freedom) is left out and v refined again, one at a time, "
+           "at most a tenth of the clusters (0 = off)",
+           atLeast(0)},
+          o.cluster_test);
   v.field({"rate_offset", "", "also estimate a constant gyro-rate offset with v, kept where a likelihood-ratio test "
                               "(p = 0.001) finds one (30-60 joint refinements more)"},
           o.rate_offset);

@@ -223,6 +223,16 @@ struct MlOptions {
   /// (docs/method.md, "celc_ml's last refinement under Tukey's biweight").
   /// cauchy_scale = 0 still turns the last refinement off.
   double tukey_scale = 3.0;  ///< [-]
+  /// > 0: after that last refinement, the cluster whose events disagree most
+  /// with the other clusters' is left out and v refined again, while one's
+  /// statistic exceeds this, at most a tenth of the clusters (at least one):
+  /// T_k of JointProblem::clusterAgreement, how far leaving the cluster out
+  /// would move v against the noise's spread of that move, a chi-square
+  /// value of up to 2 degrees of freedom. A cluster whose one moving line
+  /// moves as no v explains (two edges that meet at a small angle, grown into
+  /// one region) biases v, and Tukey's loss cannot let it go: its events lie
+  /// near their line. 0 = off.
+  double cluster_test = 0.0;  ///< [-]
   /// Also estimate a constant offset of the given angular velocity (a
   /// gyroscope bias) with v, kept where a likelihood-ratio test (p = 0.001)
   /// finds one (solver/rate_offset.hpp; docs/method.md): some 30-60 joint
