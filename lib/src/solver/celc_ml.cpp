@@ -373,12 +373,15 @@ JointProblem::Result redescend(JointProblem& problem, JointProblem::Result best,
 /// at `best` (JointProblem::clusterAgreement, above ml.cluster_test) left out
 /// of `problem` and v refined again under the problem's loss, one cluster at
 /// a time until none disagrees, at most a tenth of the clusters (at least
-/// one). Returns the clusters left out (observation indices).
+/// one). A step whose answer puts the lines less in front of the camera than
+/// ml.cheiral_min (or than before, where that was below it) is not taken, and
+/// the test stops there. Returns the clusters left out (observation indices).
 std::vector<int> leaveOutDisagreeing(JointProblem& problem, JointProblem::Result& best, const Schedule& s,
-                                     const MlOptions& ml) {
+                                     const SignView& view, const MlOptions& ml) {
   std::vector<int> left;
   if (!(ml.cluster_test > 0.0)) return left;
   const size_t most = std::max<size_t>(1, problem.clusters() / 10);
+  double margin = view.margin(best.state.v);
   while (left.size() < most) {
     const std::vector<double> T = problem.clusterAgreement(best.state, problem.robustScale(best.state));
     size_t worst = T.size();
@@ -387,8 +390,13 @@ std::vector<int> leaveOutDisagreeing(JointProblem& problem, JointProblem::Result
     if (worst == T.size()) break;
     problem.leaveOut({worst});
     JointProblem::Result r = problem.refine(best.state, s.iterations, s.tolerance, 1);
-    if (!r.ok) break;
+    const double m = r.ok ? view.margin(r.state.v) : 0.0;
+    if (!r.ok || m < std::min(margin, ml.cheiral_min)) {
+      problem.takeBack(worst);
+      break;
+    }
     best = std::move(r);
+    margin = m;
     left.push_back(problem.observationIndex()[worst]);
   }
   return left;
@@ -483,10 +491,11 @@ SolverResult solveCelcMl(const WindowObservations& obs, const MotionModel& motio
   // The residual reported is the Huber cost's (the starts' competition).
   const double residual_px = std::sqrt(2.0 * best.result.cost / std::max(1, best.result.events));
   best.result = redescend(*active, std::move(best.result), schedule, options.ml);
-  std::string test_note;
-  if (const std::vector<int> left = leaveOutDisagreeing(*active, best.result, schedule, options.ml); !left.empty())
-    test_note = std::to_string(left.size()) + " clusters left out by the agreement test";
   const SignView used = shift ? SignView{obs, shift->motion, shift->frames} : view;
+  std::string test_note;
+  if (const std::vector<int> left = leaveOutDisagreeing(*active, best.result, schedule, used, options.ml);
+      !left.empty())
+    test_note = std::to_string(left.size()) + " clusters left out by the agreement test";
   SolverResult out = answer(best, residual_px, linear, {tie_note, cheiral_note, rate_note, test_note}, used, options);
   out.time_us =
       time_us + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();

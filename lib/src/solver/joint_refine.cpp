@@ -85,6 +85,10 @@ void JointProblem::leaveOut(const std::vector<size_t>& clusters) {
     if (c < left_out_.size()) left_out_[c] = 1;
 }
 
+void JointProblem::takeBack(size_t c) {
+  if (c < left_out_.size()) left_out_[c] = 0;
+}
+
 const JointColumns& JointProblem::columns(int stride) const {
   if (stride <= 1) {  // the terms themselves
     if (column_stride_ != 1) column_begin_ = begin_, column_stride_ = 1;

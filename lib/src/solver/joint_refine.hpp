@@ -102,6 +102,8 @@ class JointProblem {
   /// The clusters (indices of this problem) whose events every later
   /// cost, step and spread leaves out; their lines stay where they are.
   void leaveOut(const std::vector<size_t>& clusters);
+  /// Cluster c (an index of this problem) back in, after leaveOut.
+  void takeBack(size_t c);
   /// The WindowObservations index of each cluster of this problem.
   const std::vector<int>& observationIndex() const { return obs_index_; }
 
