@@ -146,7 +146,7 @@ void describe(FieldVisitor& v, MlOptions& o) {
   v.field({"cluster_test", "-",
            "> 0: then the cluster that disagrees most with the others (leaving it out moves v by more than this "
            "chi-square value allows, up to 2 degrees of freedom) is left out and v refined again, one at a time, "
-           "at most a tenth of the clusters (0 = off)",
+           "at most a tenth of the clusters, while the answer stays in front of the camera (0 = off)",
            atLeast(0)},
           o.cluster_test);
   v.field({"rate_offset", "", "also estimate a constant gyro-rate offset with v, kept where a likelihood-ratio test "
