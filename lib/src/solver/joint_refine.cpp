@@ -275,14 +275,14 @@ std::vector<double> JointProblem::clusterAgreement(const State& s, double sigma_
     if (!isLeftOut(c)) H += Hk[c];
   }
   const double s2 = sigma_px * sigma_px;
+  // H_k^+ over the eigenvalues above 1e-9 of H's largest (a line fixes v's
+  // tangent in one direction or two).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eh(H, Eigen::EigenvaluesOnly);
+  const double floor = 1e-9 * std::max(eh.eigenvalues()(1), 1e-300);
   std::vector<double> T(K, NAN);
   for (size_t c = 0; c < K; ++c) {
     if (isLeftOut(c) || !Hk[c].allFinite() || !gk[c].allFinite() || !(s2 > 0.0)) continue;
-    // H_k^+ over the eigenvalues above 1e-9 of H's largest (a line fixes
-    // v's tangent in one direction or two).
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ek(Hk[c]);
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eh(H);
-    const double floor = 1e-9 * std::max(eh.eigenvalues()(1), 1e-300);
     Eigen::Matrix2d Hk_pinv = Eigen::Matrix2d::Zero();
     for (int i = 0; i < 2; ++i)
       if (ek.eigenvalues()(i) > floor)
