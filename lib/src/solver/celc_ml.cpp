@@ -402,11 +402,18 @@ std::vector<int> leaveOutDisagreeing(JointProblem& problem, JointProblem::Result
   return left;
 }
 
+/// A method's sign says nothing of an answer 60 deg or more from its
+/// estimate. Applied with ml.cluster_test on, whose leaving out and the
+/// redraws that follow carry answers far from their starts; with the
+/// defaults it would move one held-out window in 136 (docs/decisions.md).
+constexpr double kStartSignMinCos = 0.5;
+
 /// The solver's result from the winning end point: v with its start's sign;
 /// the start's singular values and sign margin, or for a start that is no
-/// method's estimate the linear stage's singular values and (with
-/// linear.resolve_sign) the sign by cheirality in `used`; the non-empty
-/// notes joined by "; ".
+/// method's estimate the linear stage's singular values; the sign by
+/// cheirality in `used` (with linear.resolve_sign) where the start is no
+/// method's estimate or, with ml.cluster_test, lies 60 deg or more from v;
+/// the non-empty notes joined by "; ".
 SolverResult answer(const End& best, double residual_px, const SolverResult& linear,
                     const std::vector<std::string>& notes, const SignView& used, const SolverOptions& options) {
   SolverResult out;
@@ -418,13 +425,13 @@ SolverResult answer(const End& best, double residual_px, const SolverResult& lin
   out.residual_px = residual_px;
   out.iterations = best.result.iterations;
   out.rows_used = best.result.events;
-  if (const SolverResult* from = best.start->from) {
-    out.sigma_min = from->sigma_min;
-    out.sigma_second = from->sigma_second;
+  const SolverResult* from = best.start->from;
+  out.sigma_min = from ? from->sigma_min : linear.sigma_min;
+  out.sigma_second = from ? from->sigma_second : linear.sigma_second;
+  const bool far_from_start = options.ml.cluster_test > 0.0 && std::abs(state.v.dot(best.start->v)) < kStartSignMinCos;
+  if (from && !far_from_start) {
     out.sign_margin = from->sign_margin;
   } else {
-    out.sigma_min = linear.sigma_min;
-    out.sigma_second = linear.sigma_second;
     if (options.linear.resolve_sign) {
       const SignDecision sd = resolveSign(used.obs, used.motion, out.v, used.frames);
       out.v *= sd.sign;
