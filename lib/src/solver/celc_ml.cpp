@@ -431,12 +431,10 @@ SolverResult answer(const End& best, double residual_px, const SolverResult& lin
   const bool far_from_start = options.ml.cluster_test > 0.0 && std::abs(state.v.dot(best.start->v)) < kStartSignMinCos;
   if (from && !far_from_start) {
     out.sign_margin = from->sign_margin;
-  } else {
-    if (options.linear.resolve_sign) {
-      const SignDecision sd = resolveSign(used.obs, used.motion, out.v, used.frames);
-      out.v *= sd.sign;
-      out.sign_margin = sd.margin * sd.sign;
-    }
+  } else if (options.linear.resolve_sign) {
+    const SignDecision sd = resolveSign(used.obs, used.motion, out.v, used.frames);
+    out.v *= sd.sign;
+    out.sign_margin = sd.margin * sd.sign;
   }
   return out;
 }
